@@ -1,0 +1,71 @@
+//! `reldesign`: the command line. Each subcommand is a thin layer over the
+//! library (`designer`): parse arguments, call, format, write atomically.
+//! Errors go to stderr with the file, key or row they concern, exit status 1;
+//! never a panic or a backtrace.
+
+mod atomic;
+mod check;
+mod eval;
+mod plot;
+mod simulate;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use designer::description::{parse_file, Description};
+use miette::Report;
+
+#[derive(Parser)]
+#[command(
+    name = "reldesign",
+    version,
+    about = "Control-design compiler for single-coil reluctance actuators"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Validate a description and print a readable summary.
+    Check {
+        /// The actuator description (valve.toml)
+        model: PathBuf,
+    },
+    /// Evaluate model quantities at given states (JSON in, JSON out).
+    Eval {
+        model: PathBuf,
+        /// {"x": [[z, v, phi(, Hc)], …], "u": [u, …], "t": [t, …] (optional)}
+        states: PathBuf,
+    },
+    /// Replay an input through the hybrid model from rest at z_max.
+    Simulate(simulate::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Check { model } => check::run(&model),
+        Command::Eval { model, states } => eval::run(&model, &states),
+        Command::Simulate(args) => simulate::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(report) => {
+            eprintln!("{report:?}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Reads and validates a description; errors render with source and caret.
+pub fn load(path: &Path) -> Result<Description, Report> {
+    parse_file(path).map_err(Report::new)
+}
+
+/// A plain error message as a report.
+pub fn fail(message: impl std::fmt::Display) -> Report {
+    miette::miette!("{message}")
+}

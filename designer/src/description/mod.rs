@@ -1,0 +1,130 @@
+//! The actuator description (`valve.toml`): typed, validated values.
+//!
+//! The file format is the contract of `shared/spec/actuator.md`. Parsing
+//! (`parse.rs`) turns text into a [`Description`] or a [`DescriptionError`]
+//! that names the file, the key, the line/column and what was expected.
+//! Everything downstream (model, simulator, designers) reads only these types.
+
+mod error;
+mod parse;
+
+pub use error::DescriptionError;
+pub use parse::{parse_file, parse_str};
+
+/// A whole, validated actuator description. All quantities SI.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Description {
+    /// Identifier used for generated module/type names.
+    pub name: String,
+    pub coil: Coil,
+    pub gap: Gap,
+    pub core: Core,
+    pub mechanics: Mechanics,
+    pub supply: Supply,
+    /// Where the description came from (file name as given, full text).
+    pub source: Source,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Source {
+    pub file_name: String,
+    pub text: String,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Coil {
+    /// N, number of turns (> 0).
+    pub turns: f64,
+    /// R [Ω] (> 0).
+    pub resistance: f64,
+    /// k_e [A/V] (≥ 0): eddy current i_ec = −k_e·dφ/dt.
+    pub eddy: f64,
+    /// dR/dt [Ω/s], self-heating; 0 when absent.
+    pub resistance_drift: f64,
+}
+
+/// Air-gap reluctance model R_gap(z).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Gap {
+    /// R_gap = offset + slope·z.
+    Linear { slope: f64, offset: f64 },
+    /// McLyman fringing: R_gap = (z/(μ0·A)) / (1 + z/√A · ln(2·l_w/z)).
+    McLyman { area: f64, winding_length: f64 },
+    /// R_gap = r0 + r0_prime·z / (1 + k1·z·ln(k2/z)).
+    McLymanFit {
+        r0: f64,
+        r0_prime: f64,
+        k1: f64,
+        k2: f64,
+    },
+    /// Tabulated, strictly increasing z (≥ 4 points) and r; optional r'.
+    Table {
+        z: Vec<f64>,
+        r: Vec<f64>,
+        r_prime: Option<Vec<f64>>,
+    },
+}
+
+/// Iron-path model.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Core {
+    /// R_core = r0.
+    Linear { r0: f64 },
+    /// Fröhlich–Kennelly: R_core = r0 / (1 − |φ|/phi_sat).
+    Saturating { r0: f64, phi_sat: f64 },
+    /// Inverse Jiles–Atherton core (adds the state H_c).
+    JilesAtherton(JilesAtherton),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct JilesAtherton {
+    /// l_c [m]
+    pub length: f64,
+    /// A_c [m²]
+    pub area: f64,
+    /// M_sat [A/m]
+    pub m_sat: f64,
+    /// b [T]
+    pub b: f64,
+    /// c [-], in [0, 1)
+    pub c: f64,
+    /// κ [A/m]
+    pub kappa: f64,
+    /// α [-]
+    pub alpha: f64,
+    /// ε of eq. 52 (default 1e-3)
+    pub epsilon: f64,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mechanics {
+    /// m [kg] (> 0)
+    pub mass: f64,
+    /// k_s [N/m] (≥ 0)
+    pub stiffness: f64,
+    /// c [N·s/m] (≥ 0)
+    pub damping: f64,
+    /// F0 [N], resolved: `preload`, or −k_s·rest_position.
+    pub preload: f64,
+    pub z_min: f64,
+    pub z_max: f64,
+    /// γ in [0, 1]
+    pub restitution: f64,
+    /// v_ε [m/s] (≥ 0)
+    pub bounce_threshold: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Drive {
+    /// Input u is the coil voltage; output is the coil current.
+    Voltage,
+    /// Input u is the coil current; output is the coil voltage.
+    Current,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Supply {
+    pub drive: Drive,
+    pub u_min: f64,
+    pub u_max: f64,
+}

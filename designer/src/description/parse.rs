@@ -1,0 +1,771 @@
+//! Text → [`Description`]: the TOML document is parsed with spans kept
+//! ([`toml::de::DeTable`]) and walked by hand, so that every rejection names
+//! the file, the full dotted key, its line/column and what was expected.
+//!
+//! The checks below read like the table of `shared/spec/actuator.md`: each
+//! section lists its keys with the bound and the unit a value must have.
+
+use std::ops::Range;
+use std::path::Path;
+
+use toml::de::{DeString, DeTable, DeValue};
+use toml::Spanned;
+
+use super::{
+    Coil, Core, Description, DescriptionError, Drive, Gap, JilesAtherton, Mechanics, Source, Supply,
+};
+
+type Res<T> = Result<T, DescriptionError>;
+
+const TOP_KEYS: [&str; 6] = ["name", "coil", "gap", "core", "mechanics", "supply"];
+/// Design sections of later versions: rejected with a clear message for now.
+const RESERVED: [&str; 3] = ["controller", "trajectory", "observer"];
+const GAP_MODELS: [&str; 4] = ["linear", "mclyman", "mclyman-fit", "table"];
+const CORE_MODELS: [&str; 3] = ["linear", "saturating", "jiles-atherton"];
+const DRIVES: [&str; 2] = ["voltage", "current"];
+/// Grid size of the fringing-denominator check on (0, z_max].
+const DENOMINATOR_GRID: usize = 1000;
+
+/// Reads and validates the description in `path`. An unreadable file is a
+/// [`DescriptionError`] naming the file.
+pub fn parse_file(path: &Path) -> Result<Description, DescriptionError> {
+    let file_name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| DescriptionError::io(&file_name, &e))?;
+    parse_str(&text, &file_name)
+}
+
+/// Parses and validates a description; `file_name` is only used in messages
+/// and in [`Description::source`].
+pub fn parse_str(text: &str, file_name: &str) -> Result<Description, DescriptionError> {
+    let doc = DeTable::parse(text).map_err(|e| DescriptionError::syntax(file_name, text, &e))?;
+    let ctx = Ctx {
+        file: file_name,
+        text,
+    };
+    let root = Sect {
+        ctx: &ctx,
+        name: "",
+        table: doc.get_ref(),
+        span: 0..0,
+    };
+    check_reserved(&root)?;
+    root.check_keys(&TOP_KEYS, "at the top level")?;
+    let name = parse_name(&root)?;
+    let coil = parse_coil(&root.section("coil")?)?;
+    let gap_sect = root.section("gap")?;
+    let gap = parse_gap(&gap_sect)?;
+    let core = parse_core(&root.section("core")?)?;
+    let mechanics = parse_mechanics(&root.section("mechanics")?)?;
+    let supply_sect = root.section("supply")?;
+    let supply = parse_supply(&supply_sect)?;
+    check_gap_range(&gap_sect, &gap, &mechanics)?;
+    check_drive(&supply_sect, &supply, &coil)?;
+    let source = Source {
+        file_name: file_name.to_string(),
+        text: text.to_string(),
+    };
+    Ok(Description {
+        name,
+        coil,
+        gap,
+        core,
+        mechanics,
+        supply,
+        source,
+    })
+}
+
+// ---------------------------------------------------------------- sections
+
+fn check_reserved(root: &Sect) -> Res<()> {
+    for section in RESERVED {
+        if root.table.contains_key(section) {
+            let msg = format!(
+                "section [{section}] is not supported yet by this version of reldesign \
+                 (it is reserved for the design sections of a later version); remove it"
+            );
+            return Err(root.err(section, msg, "not supported yet"));
+        }
+    }
+    Ok(())
+}
+
+fn parse_name(root: &Sect) -> Res<String> {
+    const WHAT: &str = "an identifier usable as a Rust module name ([A-Za-z_][A-Za-z0-9_-]*)";
+    let Some((_, value)) = root.entry("name") else {
+        return Err(root.missing("name", WHAT));
+    };
+    let Some(name) = value.get_ref().as_str() else {
+        let msg = format!("expected a string, {WHAT}, found {}", root.ctx.found(value));
+        return Err(root.err("name", msg, "expected a string"));
+    };
+    if let Some(why) = identifier_problem(name) {
+        let msg = format!("expected {WHAT}, found {name:?} ({why})");
+        return Err(root.err("name", msg, "not a valid identifier"));
+    }
+    Ok(name.to_string())
+}
+
+/// Why `name` cannot be used as a module/type name, if it cannot.
+fn identifier_problem(name: &str) -> Option<&'static str> {
+    let mut chars = name.chars();
+    let Some(first) = chars.next() else {
+        return Some("it is empty");
+    };
+    if !(first.is_ascii_alphabetic() || first == '_') {
+        return Some("it must start with a letter or '_'");
+    }
+    if !chars.all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+        return Some("only letters, digits, '_' and '-' are allowed");
+    }
+    let ident = name.replace('-', "_");
+    if ident.chars().all(|c| c == '_') {
+        return Some("it needs a letter or digit");
+    }
+    if RUST_KEYWORDS.contains(&ident.as_str()) {
+        return Some("it is a Rust keyword");
+    }
+    None
+}
+
+const RUST_KEYWORDS: [&str; 51] = [
+    "as", "break", "const", "continue", "crate", "else", "enum", "extern", "false", "fn", "for",
+    "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub", "ref", "return",
+    "self", "Self", "static", "struct", "super", "trait", "true", "type", "unsafe", "use", "where",
+    "while", "async", "await", "dyn", "abstract", "become", "box", "do", "final", "macro",
+    "override", "priv", "typeof", "unsized", "virtual", "yield", "try",
+];
+
+fn parse_coil(s: &Sect) -> Res<Coil> {
+    s.check_keys(
+        &["turns", "resistance", "eddy", "resistance_drift"],
+        "in [coil]",
+    )?;
+    Ok(Coil {
+        turns: s.num("turns", Bound::Positive, "turns")?,
+        resistance: s.num("resistance", Bound::Positive, "Ω")?,
+        eddy: s.num("eddy", Bound::NonNegative, "A/V")?,
+        resistance_drift: s.num_or("resistance_drift", Bound::Any, "Ω/s", 0.0)?,
+    })
+}
+
+fn parse_gap(s: &Sect) -> Res<Gap> {
+    let model = s.choice("model", "gap model", &GAP_MODELS)?;
+    let context = format!("in [gap] with model \"{model}\"");
+    let gap = match model {
+        "linear" => {
+            s.check_keys(&["model", "slope", "offset"], &context)?;
+            Gap::Linear {
+                slope: s.num("slope", Bound::Positive, "H⁻¹/m")?,
+                offset: s.num_or("offset", Bound::NonNegative, "H⁻¹", 0.0)?,
+            }
+        }
+        "mclyman" => {
+            s.check_keys(&["model", "area", "winding_length"], &context)?;
+            Gap::McLyman {
+                area: s.num("area", Bound::Positive, "m²")?,
+                winding_length: s.num("winding_length", Bound::Positive, "m")?,
+            }
+        }
+        "mclyman-fit" => {
+            s.check_keys(&["model", "r0", "r0_prime", "k1", "k2"], &context)?;
+            Gap::McLymanFit {
+                r0: s.num("r0", Bound::NonNegative, "H⁻¹")?,
+                r0_prime: s.num("r0_prime", Bound::Positive, "H⁻¹/m")?,
+                k1: s.num("k1", Bound::NonNegative, "1/m")?,
+                k2: s.num("k2", Bound::Positive, "m")?,
+            }
+        }
+        _ => {
+            s.check_keys(&["model", "z", "r", "r_prime"], &context)?;
+            parse_table(s)?
+        }
+    };
+    Ok(gap)
+}
+
+fn parse_table(s: &Sect) -> Res<Gap> {
+    let z = s.array("z", Bound::Any, "m")?;
+    let r = s.array("r", Bound::NonNegative, "H⁻¹")?;
+    let r_prime = s.opt_array("r_prime", Bound::Positive, "H⁻¹/m")?;
+    if z.len() < 4 {
+        let msg = format!("expected at least 4 points, found {}", z.len());
+        return Err(s.err("z", msg, "too few points"));
+    }
+    s.same_length("r", &r, z.len())?;
+    if let Some(rp) = &r_prime {
+        s.same_length("r_prime", rp, z.len())?;
+    }
+    s.strictly_increasing("z", &z, "")?;
+    let why = " (R_gap' > 0: the magnetic force must pull towards z_min)";
+    s.strictly_increasing("r", &r, why)?;
+    Ok(Gap::Table { z, r, r_prime })
+}
+
+fn parse_core(s: &Sect) -> Res<Core> {
+    let model = s.choice("model", "core model", &CORE_MODELS)?;
+    let context = format!("in [core] with model \"{model}\"");
+    let core = match model {
+        "linear" => {
+            s.check_keys(&["model", "r0"], &context)?;
+            Core::Linear {
+                r0: s.num("r0", Bound::Positive, "H⁻¹")?,
+            }
+        }
+        "saturating" => {
+            s.check_keys(&["model", "r0", "phi_sat"], &context)?;
+            Core::Saturating {
+                r0: s.num("r0", Bound::Positive, "H⁻¹")?,
+                phi_sat: s.num("phi_sat", Bound::Positive, "Wb")?,
+            }
+        }
+        _ => {
+            let keys = [
+                "model", "length", "area", "m_sat", "b", "c", "kappa", "alpha", "epsilon",
+            ];
+            s.check_keys(&keys, &context)?;
+            Core::JilesAtherton(JilesAtherton {
+                length: s.num("length", Bound::Positive, "m")?,
+                area: s.num("area", Bound::Positive, "m²")?,
+                m_sat: s.num("m_sat", Bound::Positive, "A/m")?,
+                b: s.num("b", Bound::Positive, "T")?,
+                c: s.num("c", Bound::UnitOpen, "-")?,
+                kappa: s.num("kappa", Bound::Positive, "A/m")?,
+                alpha: s.num("alpha", Bound::NonNegative, "-")?,
+                epsilon: s.num_or("epsilon", Bound::Positive, "-", 1e-3)?,
+            })
+        }
+    };
+    Ok(core)
+}
+
+fn parse_mechanics(s: &Sect) -> Res<Mechanics> {
+    let keys = [
+        "mass",
+        "stiffness",
+        "damping",
+        "preload",
+        "rest_position",
+        "z_min",
+        "z_max",
+        "restitution",
+        "bounce_threshold",
+    ];
+    s.check_keys(&keys, "in [mechanics]")?;
+    let mass = s.num("mass", Bound::Positive, "kg")?;
+    let stiffness = s.num("stiffness", Bound::NonNegative, "N/m")?;
+    let damping = s.num("damping", Bound::NonNegative, "N·s/m")?;
+    let preload = resolve_preload(s, stiffness)?;
+    let z_min = s.num("z_min", Bound::NonNegative, "m")?;
+    let z_max = s.num("z_max", Bound::Above("z_min", z_min), "m")?;
+    Ok(Mechanics {
+        mass,
+        stiffness,
+        damping,
+        preload,
+        z_min,
+        z_max,
+        restitution: s.num("restitution", Bound::Unit, "-")?,
+        bounce_threshold: s.num("bounce_threshold", Bound::NonNegative, "m/s")?,
+    })
+}
+
+/// F0: `preload`, or −k_s·`rest_position`; exactly one of them.
+fn resolve_preload(s: &Sect, stiffness: f64) -> Res<f64> {
+    let preload = s.opt_num("preload", Bound::Any, "N")?;
+    let rest = s.opt_num("rest_position", Bound::Any, "m")?;
+    match (preload, rest) {
+        (Some(f0), None) => Ok(f0),
+        (None, Some(z_s)) => Ok(-stiffness * z_s),
+        (Some(_), Some(_)) => Err(s.err(
+            "rest_position",
+            "give either mechanics.preload or mechanics.rest_position, not both \
+             (F0 = preload, or F0 = −stiffness·rest_position)",
+            "conflicts with `preload`",
+        )),
+        (None, None) => Err(s.missing(
+            "preload",
+            "exactly one of mechanics.preload [N] or mechanics.rest_position [m] \
+             (F0 = preload, or F0 = −stiffness·rest_position)",
+        )),
+    }
+}
+
+fn parse_supply(s: &Sect) -> Res<Supply> {
+    s.check_keys(&["drive", "u_min", "u_max"], "in [supply]")?;
+    let drive = match s.choice("drive", "drive", &DRIVES)? {
+        "voltage" => Drive::Voltage,
+        _ => Drive::Current,
+    };
+    let unit = if drive == Drive::Voltage { "V" } else { "A" };
+    let u_min = s.num("u_min", Bound::Any, unit)?;
+    let u_max = s.num("u_max", Bound::Above("u_min", u_min), unit)?;
+    Ok(Supply {
+        drive,
+        u_min,
+        u_max,
+    })
+}
+
+// ------------------------------------------------------ cross-section checks
+
+fn check_gap_range(s: &Sect, gap: &Gap, m: &Mechanics) -> Res<()> {
+    match gap {
+        Gap::Linear { .. } => Ok(()),
+        Gap::McLyman {
+            area,
+            winding_length,
+        } => {
+            let sqrt_a = area.sqrt();
+            let f = |z: f64| 1.0 + z / sqrt_a * (2.0 * winding_length / z).ln();
+            check_denominator(s, "winding_length", "1 + z/√A·ln(2·l_w/z)", m.z_max, f)
+        }
+        Gap::McLymanFit { k1, k2, .. } => {
+            let f = |z: f64| 1.0 + k1 * z * (k2 / z).ln();
+            check_denominator(s, "k2", "1 + k1·z·ln(k2/z)", m.z_max, f)
+        }
+        Gap::Table { z, .. } => check_coverage(s, z, m),
+    }
+}
+
+/// The fringing denominator must stay > 0 on (0, z_max]. It is concave in z
+/// with limit 1 at 0⁺, so a uniform grid that ends at z_max finds any failure.
+fn check_denominator(
+    s: &Sect,
+    key: &str,
+    formula: &str,
+    z_max: f64,
+    f: impl Fn(f64) -> f64,
+) -> Res<()> {
+    for k in 1..=DENOMINATOR_GRID {
+        let z = z_max * k as f64 / DENOMINATOR_GRID as f64;
+        let d = f(z);
+        if d.is_nan() || d <= 0.0 {
+            let msg = format!(
+                "the gap denominator {formula} must stay > 0 on (0, z_max = {z_max:e} m], \
+                 but it is {d:.4} at z = {z:.4e} m (R_gap would be singular or negative)"
+            );
+            return Err(s.err(key, msg, "makes the gap denominator <= 0"));
+        }
+    }
+    Ok(())
+}
+
+fn check_coverage(s: &Sect, z: &[f64], m: &Mechanics) -> Res<()> {
+    let last = z.len() - 1;
+    if z[0] > m.z_min {
+        let msg = format!(
+            "expected a number <= z_min = {} [m] (the table must cover [z_min, z_max]), found {}",
+            m.z_min, z[0]
+        );
+        return Err(s.elem_err("z", 0, msg, "table starts above z_min"));
+    }
+    if z[last] < m.z_max {
+        let msg = format!(
+            "expected a number >= z_max = {} [m] (the table must cover [z_min, z_max]), found {}",
+            m.z_max, z[last]
+        );
+        return Err(s.elem_err("z", last, msg, "table ends below z_max"));
+    }
+    Ok(())
+}
+
+fn check_drive(s: &Sect, supply: &Supply, coil: &Coil) -> Res<()> {
+    if supply.drive == Drive::Current && coil.eddy <= 0.0 {
+        let msg = "drive \"current\" requires coil.eddy > 0: with k_e = 0 the flux is an \
+                   algebraic function of the current, not a state, so a current-driven model \
+                   has no flux dynamics; use drive = \"voltage\" or give coil.eddy > 0";
+        return Err(s.err("drive", msg, "needs coil.eddy > 0"));
+    }
+    Ok(())
+}
+
+// ------------------------------------------------------------ the machinery
+
+/// What a number must satisfy; its text is the "expected …" of messages.
+#[derive(Clone, Copy)]
+enum Bound {
+    Any,
+    Positive,
+    NonNegative,
+    /// In [0, 1].
+    Unit,
+    /// In [0, 1).
+    UnitOpen,
+    /// Strictly above another key's value.
+    Above(&'static str, f64),
+}
+
+impl Bound {
+    fn admits(self, x: f64) -> bool {
+        match self {
+            Bound::Any => true,
+            Bound::Positive => x > 0.0,
+            Bound::NonNegative => x >= 0.0,
+            Bound::Unit => (0.0..=1.0).contains(&x),
+            Bound::UnitOpen => (0.0..1.0).contains(&x),
+            Bound::Above(_, lower) => x > lower,
+        }
+    }
+
+    fn describe(self) -> String {
+        match self {
+            Bound::Any => "a number".into(),
+            Bound::Positive => "a number > 0".into(),
+            Bound::NonNegative => "a number >= 0".into(),
+            Bound::Unit => "a number in [0, 1]".into(),
+            Bound::UnitOpen => "a number in [0, 1)".into(),
+            Bound::Above(other, lower) => format!("a number > {other} (= {lower})"),
+        }
+    }
+}
+
+fn expected(bound: Bound, unit: &str) -> String {
+    format!("expected {} [{unit}]", bound.describe())
+}
+
+struct Ctx<'a> {
+    file: &'a str,
+    text: &'a str,
+}
+
+impl Ctx<'_> {
+    fn err(
+        &self,
+        key: String,
+        span: Range<usize>,
+        msg: impl Into<String>,
+        label: &str,
+    ) -> DescriptionError {
+        DescriptionError::at(self.file, self.text, key, span, msg, label)
+    }
+
+    /// How a value reads in a message: numbers as written, others by type.
+    fn found(&self, value: &Spanned<DeValue>) -> String {
+        match value.get_ref() {
+            DeValue::Integer(_) | DeValue::Float(_) => self
+                .text
+                .get(value.span())
+                .unwrap_or("?")
+                .trim()
+                .to_string(),
+            DeValue::String(s) => format!("the string {s:?}"),
+            DeValue::Boolean(b) => format!("the boolean {b}"),
+            DeValue::Datetime(d) => format!("the datetime {d}"),
+            DeValue::Array(_) => "an array".into(),
+            DeValue::Table(_) => "a table".into(),
+        }
+    }
+
+    /// A finite number within `bound` (integers accepted), or an error about
+    /// `key` at `span`.
+    fn number(
+        &self,
+        key: String,
+        span: Range<usize>,
+        value: &Spanned<DeValue>,
+        bound: Bound,
+        unit: &str,
+    ) -> Res<f64> {
+        let found = self.found(value);
+        let expect = expected(bound, unit);
+        let label = format!("expected {}", bound.describe());
+        match as_number(value.get_ref()) {
+            None => Err(self.err(key, span, format!("{expect}, found {found}"), &label)),
+            Some(x) if !x.is_finite() => {
+                let msg = format!("{expect}, found {found} (NaN and infinities are not allowed)");
+                Err(self.err(key, span, msg, "not a finite number"))
+            }
+            Some(x) if !bound.admits(x) => {
+                Err(self.err(key, span, format!("{expect}, found {found}"), &label))
+            }
+            Some(x) => Ok(x),
+        }
+    }
+}
+
+fn as_number(value: &DeValue) -> Option<f64> {
+    match value {
+        DeValue::Integer(i) => match i64::from_str_radix(i.as_str(), i.radix()) {
+            Ok(n) => Some(n as f64),
+            Err(_) if i.radix() == 10 => i.as_str().parse().ok(),
+            Err(_) => u64::from_str_radix(i.as_str(), i.radix())
+                .ok()
+                .map(|n| n as f64),
+        },
+        DeValue::Float(f) => f.as_str().parse().ok(),
+        _ => None,
+    }
+}
+
+type Entry<'a> = (&'a Spanned<DeString<'a>>, &'a Spanned<DeValue<'a>>);
+
+/// A table of the document (the root or a section) and where it is.
+struct Sect<'a> {
+    ctx: &'a Ctx<'a>,
+    /// "" for the root.
+    name: &'a str,
+    table: &'a DeTable<'a>,
+    /// The section header (or inline table); 0..0 for the root.
+    span: Range<usize>,
+}
+
+impl<'a> Sect<'a> {
+    fn full_key(&self, key: &str) -> String {
+        if self.name.is_empty() {
+            key.to_string()
+        } else {
+            format!("{}.{key}", self.name)
+        }
+    }
+
+    fn entry(&self, key: &str) -> Option<Entry<'a>> {
+        self.table.get_key_value(key)
+    }
+
+    /// The key and, when on the same line, its value.
+    fn key_span(&self, key: &str) -> Range<usize> {
+        let Some((k, v)) = self.entry(key) else {
+            return self.span.clone();
+        };
+        let (k, v) = (k.span(), v.span());
+        let (start, end) = (k.start.min(v.start), k.end.max(v.end));
+        match self.ctx.text.get(start..end) {
+            Some(t) if !t.contains('\n') => start..end,
+            _ => k,
+        }
+    }
+
+    fn err(&self, key: &str, msg: impl Into<String>, label: &str) -> DescriptionError {
+        self.ctx
+            .err(self.full_key(key), self.key_span(key), msg, label)
+    }
+
+    fn elem_err(
+        &self,
+        key: &str,
+        index: usize,
+        msg: impl Into<String>,
+        label: &str,
+    ) -> DescriptionError {
+        let span = self
+            .entry(key)
+            .and_then(|(_, v)| v.get_ref().as_array()?.get(index).map(|e| e.span()))
+            .unwrap_or_else(|| self.key_span(key));
+        self.ctx
+            .err(format!("{}[{index}]", self.full_key(key)), span, msg, label)
+    }
+
+    fn missing(&self, key: &str, what: &str) -> DescriptionError {
+        let place = if self.name.is_empty() {
+            "at the top level".to_string()
+        } else {
+            format!("in section [{}]", self.name)
+        };
+        let msg = format!("missing required key {place}: expected {what}");
+        self.ctx.err(
+            self.full_key(key),
+            self.span.clone(),
+            msg,
+            &format!("`{key}` is missing"),
+        )
+    }
+
+    /// The required sub-table `name` of the root.
+    fn section(&self, name: &'a str) -> Res<Sect<'a>> {
+        let Some((_, value)) = self.entry(name) else {
+            let msg = format!(
+                "missing required section [{name}] (required sections: [coil], [gap], [core], \
+                 [mechanics], [supply])"
+            );
+            return Err(self.ctx.err(name.to_string(), 0..0, msg, "section missing"));
+        };
+        let Some(table) = value.get_ref().as_table() else {
+            let msg = format!("expected a table [{name}], found {}", self.ctx.found(value));
+            return Err(self.err(name, msg, "expected a table"));
+        };
+        Ok(Sect {
+            ctx: self.ctx,
+            name,
+            table,
+            span: value.span(),
+        })
+    }
+
+    /// Rejects keys not in `allowed`, reporting the first in document order.
+    fn check_keys(&self, allowed: &[&str], context: &str) -> Res<()> {
+        let unknown = self
+            .table
+            .iter()
+            .filter(|(k, _)| !allowed.contains(&k.get_ref().as_ref()))
+            .min_by_key(|(k, _)| k.span().start);
+        let Some((key, _)) = unknown else {
+            return Ok(());
+        };
+        let msg = format!(
+            "unknown key; allowed keys {context}: {}",
+            allowed.join(", ")
+        );
+        let full = self.full_key(key.get_ref());
+        let err = self.ctx.err(full, key.span(), msg, "unknown key");
+        match closest(key.get_ref(), allowed) {
+            Some(near) => Err(err.with_help(format!("did you mean `{near}`?"))),
+            None => Err(err),
+        }
+    }
+
+    fn opt_num(&self, key: &str, bound: Bound, unit: &str) -> Res<Option<f64>> {
+        let Some((_, value)) = self.entry(key) else {
+            return Ok(None);
+        };
+        let (full, span) = (self.full_key(key), self.key_span(key));
+        self.ctx.number(full, span, value, bound, unit).map(Some)
+    }
+
+    fn num(&self, key: &str, bound: Bound, unit: &str) -> Res<f64> {
+        let x = self.opt_num(key, bound, unit)?;
+        x.ok_or_else(|| self.missing(key, &format!("{} [{unit}]", bound.describe())))
+    }
+
+    fn num_or(&self, key: &str, bound: Bound, unit: &str, default: f64) -> Res<f64> {
+        Ok(self.opt_num(key, bound, unit)?.unwrap_or(default))
+    }
+
+    /// A required string among `allowed`.
+    fn choice(&self, key: &str, what: &str, allowed: &[&'static str]) -> Res<&'static str> {
+        let list = allowed
+            .iter()
+            .map(|a| format!("\"{a}\""))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let Some((_, value)) = self.entry(key) else {
+            return Err(self.missing(key, &format!("one of {list}")));
+        };
+        let Some(text) = value.get_ref().as_str() else {
+            let msg = format!(
+                "expected a string, one of {list}, found {}",
+                self.ctx.found(value)
+            );
+            return Err(self.err(key, msg, "expected a string"));
+        };
+        match allowed.iter().find(|a| **a == text) {
+            Some(a) => Ok(a),
+            None => {
+                let msg = format!("unknown {what} \"{text}\"; expected one of {list}");
+                Err(self.err(key, msg, &format!("unknown {what}")))
+            }
+        }
+    }
+
+    fn array(&self, key: &str, bound: Bound, unit: &str) -> Res<Vec<f64>> {
+        let what = format!("an array of numbers [{unit}]");
+        self.opt_array(key, bound, unit)?
+            .ok_or_else(|| self.missing(key, &what))
+    }
+
+    fn opt_array(&self, key: &str, bound: Bound, unit: &str) -> Res<Option<Vec<f64>>> {
+        let Some((_, value)) = self.entry(key) else {
+            return Ok(None);
+        };
+        let Some(items) = value.get_ref().as_array() else {
+            let msg = format!(
+                "expected an array of numbers [{unit}], found {}",
+                self.ctx.found(value)
+            );
+            return Err(self.err(key, msg, "expected an array"));
+        };
+        let full = self.full_key(key);
+        let numbers = items
+            .iter()
+            .enumerate()
+            .map(|(i, item)| {
+                self.ctx
+                    .number(format!("{full}[{i}]"), item.span(), item, bound, unit)
+            })
+            .collect::<Res<Vec<f64>>>()?;
+        Ok(Some(numbers))
+    }
+
+    fn same_length(&self, key: &str, values: &[f64], n: usize) -> Res<()> {
+        if values.len() == n {
+            return Ok(());
+        }
+        let msg = format!(
+            "expected {n} values (as many as {}), found {}",
+            self.full_key("z"),
+            values.len()
+        );
+        Err(self.err(key, msg, "length differs from `z`"))
+    }
+
+    fn strictly_increasing(&self, key: &str, values: &[f64], why: &str) -> Res<()> {
+        let full = self.full_key(key);
+        for i in 1..values.len() {
+            if values[i] <= values[i - 1] {
+                let msg = format!(
+                    "expected strictly increasing values{why}: {full}[{i}] = {} is not > \
+                     {full}[{}] = {}",
+                    values[i],
+                    i - 1,
+                    values[i - 1]
+                );
+                return Err(self.elem_err(key, i, msg, "not increasing"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The allowed key nearest to a misspelt one (at most 2 edits away).
+fn closest<'k>(key: &str, allowed: &[&'k str]) -> Option<&'k str> {
+    allowed
+        .iter()
+        .map(|a| (edit_distance(key, a), *a))
+        .filter(|(d, _)| *d <= 2)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, a)| a)
+}
+
+/// Levenshtein distance over characters.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let next = (diagonal + usize::from(ca != *cb))
+                .min(row[j] + 1)
+                .min(row[j + 1] + 1);
+            diagonal = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn misspelt_keys_get_a_suggestion() {
+        assert_eq!(edit_distance("resistence", "resistance"), 1);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(
+            closest("stifness", &["mass", "stiffness"]),
+            Some("stiffness")
+        );
+        assert_eq!(closest("inductance", &["turns", "resistance"]), None);
+    }
+
+    #[test]
+    fn help_is_attached_to_unknown_keys() {
+        use miette::Diagnostic;
+        let text = "name = \"v\"\nnme = 1\n";
+        let err = parse_str(text, "t.toml").unwrap_err();
+        assert_eq!(err.key(), "nme");
+        let help = err.help().map(|h| h.to_string());
+        assert_eq!(help.as_deref(), Some("did you mean `name`?"));
+    }
+}

@@ -1,0 +1,17 @@
+//! reldesign's designer: everything between an actuator description and the
+//! equations a controller, observer or simulator needs.
+//!
+//! - [`sym`]: the symbolic core (hash-consed expression DAG, simplification,
+//!   differentiation, CSE, flat-tape evaluation). Knows nothing of actuators.
+//! - [`description`]: the validated actuator description (`valve.toml`).
+//! - [`model`]: the actuator's state-space model, built symbolically.
+//! - [`record`]: recorded signals in the measured-data CSV format.
+//! - [`replay`]: an input replayed through the hybrid model (`simulate`).
+//! - [`sim`]: the hybrid-automaton simulator (knows nothing of magnetics).
+
+pub mod description;
+pub mod model;
+pub mod record;
+pub mod replay;
+pub mod sim;
+pub mod sym;

@@ -1,0 +1,334 @@
+//! The actuator description: rejections as data, and the bundled examples.
+//!
+//! Every `tests/data/bad/NAME.toml` is a broken description whose first line
+//! is `# expect: FRAGMENT | FRAGMENT …`: parsing it must fail, and the
+//! one-line message must contain the file name and every fragment.
+//! Every `examples/*.toml` must parse; a few values are spot-checked.
+
+use std::path::{Path, PathBuf};
+
+use designer::description::{parse_file, parse_str, Core, Description, Drive, Gap};
+
+fn workspace_dir(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
+}
+
+fn toml_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
+        .map(|entry| entry.expect("directory entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    files
+}
+
+/// The fragments of the `# expect:` first line.
+fn expectations(path: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(path).expect("readable test file");
+    let first = text.lines().next().unwrap_or_default();
+    let list = first
+        .strip_prefix("# expect:")
+        .unwrap_or_else(|| panic!("{}: first line must be `# expect: …`", path.display()));
+    let fragments: Vec<String> = list
+        .split(" | ")
+        .map(|f| f.trim().to_string())
+        .filter(|f| !f.is_empty())
+        .collect();
+    assert!(
+        !fragments.is_empty(),
+        "{}: no expected fragment",
+        path.display()
+    );
+    fragments
+}
+
+/// Checks one bad file; returns a description of the failure, if any.
+fn check_bad(path: &Path) -> Option<String> {
+    let name = path.file_name().unwrap().to_string_lossy().to_string();
+    let err = match parse_file(path) {
+        Ok(_) => return Some(format!("{name}: accepted, but it must be rejected")),
+        Err(err) => err,
+    };
+    let message = err.to_string();
+    let mut problems = Vec::new();
+    if message.contains('\n') {
+        problems.push("message is not one line".to_string());
+    }
+    if !message.contains(&name) {
+        problems.push("message does not name the file".to_string());
+    }
+    if err.line() == 0 || err.column() == 0 {
+        problems.push(format!(
+            "no position (line {}, column {})",
+            err.line(),
+            err.column()
+        ));
+    }
+    for fragment in expectations(path) {
+        if !message.contains(&fragment) {
+            problems.push(format!("missing fragment `{fragment}`"));
+        }
+    }
+    (!problems.is_empty()).then(|| format!("{name}: {}\n    got: {message}", problems.join("; ")))
+}
+
+#[test]
+fn every_bad_description_is_rejected_with_its_expected_message() {
+    let files = toml_files(&workspace_dir("tests/data/bad"));
+    assert!(
+        files.len() >= 24,
+        "expected at least 24 bad descriptions, found {}",
+        files.len()
+    );
+    let failures: Vec<String> = files.iter().filter_map(|p| check_bad(p)).collect();
+    assert!(
+        failures.is_empty(),
+        "{} of {} bad files:\n{}",
+        failures.len(),
+        files.len(),
+        failures.join("\n")
+    );
+}
+
+/// The text of a bundled example, for tests that edit it.
+fn example_text(name: &str) -> String {
+    std::fs::read_to_string(workspace_dir("examples").join(name)).expect("example exists")
+}
+
+fn example(name: &str) -> Description {
+    let path = workspace_dir("examples").join(name);
+    parse_file(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn assert_close(actual: f64, expected: f64, what: &str) {
+    let tolerance = 1e-12 * expected.abs().max(1e-300);
+    assert!(
+        (actual - expected).abs() <= tolerance,
+        "{what}: {actual} != {expected}"
+    );
+}
+
+#[test]
+fn every_bundled_example_parses() {
+    let files = toml_files(&workspace_dir("examples"));
+    assert!(
+        files.len() >= 5,
+        "expected at least 5 examples, found {}",
+        files.len()
+    );
+    for path in &files {
+        let description = parse_file(path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(description.source.file_name, path.display().to_string());
+        assert!(description.mechanics.z_min < description.mechanics.z_max);
+    }
+}
+
+#[test]
+fn perfect_tracking_valve_has_table_1_numbers() {
+    let d = example("perfect-tracking-valve.toml");
+    assert_eq!(d.name, "perfect_tracking_valve");
+    assert_eq!(d.coil.turns, 1200.0);
+    assert_eq!(d.coil.resistance, 75.0);
+    assert_eq!(d.coil.eddy, 1500.0);
+    assert_eq!(d.coil.resistance_drift, 0.0, "default of resistance_drift");
+    assert_eq!(
+        d.gap,
+        Gap::McLyman {
+            area: 20e-6,
+            winding_length: 15e-3
+        }
+    );
+    assert_eq!(
+        d.core,
+        Core::Saturating {
+            r0: 3e6,
+            phi_sat: 25e-6
+        }
+    );
+    assert_eq!(d.mechanics.preload, -0.75);
+    assert_eq!(d.mechanics.restitution, 0.5);
+    assert_eq!(
+        (d.supply.drive, d.supply.u_min, d.supply.u_max),
+        (Drive::Voltage, -24.0, 24.0)
+    );
+}
+
+#[test]
+fn preload_is_resolved_from_rest_position() {
+    let ja = example("jiles-atherton-valve.toml");
+    assert_close(
+        ja.mechanics.preload,
+        -55.0 * 0.015,
+        "JA valve F0 = -k_s·z_s",
+    );
+    let sm = example("sliding-mode-valve.toml");
+    assert_close(sm.mechanics.preload, -61.8 * 0.019, "sliding-mode valve F0");
+    let semera = example("semera-valve.toml");
+    assert_close(semera.mechanics.preload, -37.0 * 22.5e-3, "semera valve F0");
+}
+
+#[test]
+fn jiles_atherton_valve_uses_the_errata_reading() {
+    let d = example("jiles-atherton-valve.toml");
+    assert_eq!(
+        d.gap,
+        Gap::McLymanFit {
+            r0: 2.41e6,
+            r0_prime: 7.94e10,
+            k1: 1350.0,
+            k2: 9.95e-3
+        }
+    );
+    let Core::JilesAtherton(ja) = &d.core else {
+        panic!("expected a Jiles–Atherton core, got {:?}", d.core)
+    };
+    assert_eq!(
+        (ja.c, ja.kappa, ja.alpha, ja.epsilon),
+        (0.736, 943.0, 3.66e-3, 1e-3)
+    );
+    assert_eq!(d.coil.resistance, 50.0);
+    assert_eq!(d.mechanics.z_max, 9e-4);
+}
+
+#[test]
+fn semera_valve_has_linear_gap_and_no_eddy() {
+    let d = example("semera-valve.toml");
+    assert_eq!(
+        d.gap,
+        Gap::Linear {
+            slope: 2.7e10,
+            offset: 0.0
+        }
+    );
+    assert_close(
+        match d.core {
+            Core::Saturating { phi_sat, .. } => phi_sat,
+            ref other => panic!("expected a saturating core, got {other:?}"),
+        },
+        0.024 / 1200.0,
+        "phi_sat = lambda_sat/N",
+    );
+    assert_eq!(d.coil.eddy, 0.0);
+}
+
+#[test]
+fn table_gap_valve_reproduces_the_mclyman_formula() {
+    let d = example("table-gap-valve.toml");
+    let Gap::Table { z, r, r_prime } = &d.gap else {
+        panic!("expected a table gap, got {:?}", d.gap)
+    };
+    let r_prime = r_prime.as_ref().expect("r_prime given");
+    assert_eq!((z.len(), r.len(), r_prime.len()), (12, 12, 12));
+    let (mu0, area, l_w) = (4e-7 * std::f64::consts::PI, 20e-6_f64, 15e-3_f64);
+    assert_eq!(r[0], 0.0);
+    assert!(
+        (r_prime[0] * mu0 * area - 1.0).abs() < 1e-6,
+        "R'(0) = 1/(mu0·A)"
+    );
+    for (zi, ri) in z.iter().zip(r).skip(1) {
+        let mclyman = (zi / (mu0 * area)) / (1.0 + zi / area.sqrt() * (2.0 * l_w / zi).ln());
+        assert!(
+            (ri / mclyman - 1.0).abs() < 1e-6,
+            "R({zi}) = {ri}, formula gives {mclyman}"
+        );
+    }
+}
+
+#[test]
+fn optional_keys_take_their_defaults() {
+    let text = example_text("jiles-atherton-valve.toml").replace("epsilon = 1e-3", "");
+    let d = parse_str(&text, "ja.toml").unwrap_or_else(|e| panic!("{e}"));
+    let Core::JilesAtherton(ja) = d.core else {
+        panic!("expected a Jiles–Atherton core")
+    };
+    assert_eq!(ja.epsilon, 1e-3);
+    let text = example_text("semera-valve.toml").replace("offset = 0.0", "");
+    let d = parse_str(&text, "semera.toml").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        d.gap,
+        Gap::Linear {
+            slope: 2.7e10,
+            offset: 0.0
+        }
+    );
+}
+
+#[test]
+fn integers_are_accepted_where_floats_are_expected() {
+    let text =
+        example_text("perfect-tracking-valve.toml").replace("stiffness = 50.0", "stiffness = 50");
+    let d = parse_str(&text, "int.toml").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(d.mechanics.stiffness, 50.0);
+}
+
+#[test]
+fn error_accessors_give_key_file_and_position() {
+    let text = example_text("perfect-tracking-valve.toml").replace("mass = 2e-3 ", "mass = -1e-3");
+    let err = parse_str(&text, "valve.toml").expect_err("negative mass must be rejected");
+    let line = text.lines().position(|l| l.starts_with("mass =")).unwrap() + 1;
+    assert_eq!(
+        (err.key(), err.file_name()),
+        ("mechanics.mass", "valve.toml")
+    );
+    assert_eq!((err.line(), err.column()), (line, 1));
+    assert!(
+        err.to_string()
+            .starts_with(&format!("valve.toml:{line}:1: mechanics.mass: ")),
+        "{err}"
+    );
+    let span = err.span().expect("a span");
+    assert!(text[span].starts_with("mass = -1e-3"));
+}
+
+#[test]
+fn diagnostic_renders_file_position_and_label() {
+    use miette::{GraphicalReportHandler, GraphicalTheme};
+    let text =
+        example_text("perfect-tracking-valve.toml").replace("phi_sat = 25e-6", "phi_sat = 0");
+    let err = parse_str(&text, "valve.toml").expect_err("phi_sat = 0 must be rejected");
+    let mut out = String::new();
+    GraphicalReportHandler::new_themed(GraphicalTheme::unicode_nocolor())
+        .render_report(&mut out, &err)
+        .expect("render");
+    let line = text.lines().position(|l| l.starts_with("phi_sat")).unwrap() + 1;
+    assert!(out.contains(&format!("valve.toml:{line}:1")), "{out}");
+    assert!(out.contains("phi_sat = 0"), "{out}");
+    assert!(out.contains("expected a number > 0"), "{out}");
+}
+
+#[test]
+fn unreadable_file_is_an_error_naming_it() {
+    let path = workspace_dir("tests/data/bad/does-not-exist.toml");
+    let err = parse_file(&path).expect_err("missing file");
+    assert!(err.to_string().contains("does-not-exist.toml"), "{err}");
+    assert!(err.to_string().contains("cannot read"), "{err}");
+}
+
+#[test]
+fn unknown_key_in_an_inline_table_points_at_its_column() {
+    let coil = "[coil]\nturns = 1200\nresistance = 75.0\neddy = 1500.0\n";
+    let inline = "coil = { turns = 1200, resistance = 75.0, eddy = 1500.0, wire = 2 }\n";
+    let text = example_text("perfect-tracking-valve.toml").replace(
+        "[coil]\nturns = 1200                # N, Table 1\nresistance = 75.0           # R = 75 Ω, Table 1\neddy = 1500.0               # k_ec = 1500 A/V, Table 1\n",
+        coil,
+    );
+    assert!(
+        text.contains(coil),
+        "example layout changed: update this test"
+    );
+    let text = text
+        .replace(coil, "")
+        .replacen("\n[gap]", &format!("{inline}\n[gap]"), 1);
+    let err = parse_str(&text, "inline.toml").expect_err("unknown key");
+    assert_eq!(err.key(), "coil.wire");
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("coil = {"))
+        .unwrap()
+        + 1;
+    assert_eq!(
+        (err.line(), err.column()),
+        (line, inline.find("wire").unwrap() + 1)
+    );
+}
