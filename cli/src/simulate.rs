@@ -27,10 +27,10 @@ pub struct Args {
     #[arg(long)]
     out: Option<PathBuf>,
     /// A rectangular pulse AMPLITUDE:START:END (V or A, s, s); repeatable, 0 elsewhere
-    #[arg(long, value_parser = parse_pulse)]
+    #[arg(long, value_parser = parse_pulse, allow_hyphen_values = true)]
     pulse: Vec<(f64, f64, f64)>,
     /// A square wave HIGH:LOW:PERIOD:DUTY starting high at t = 0
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     square: Option<String>,
     /// End time of a generated input [s] (default: 5 ms after the last pulse edge)
     #[arg(long)]

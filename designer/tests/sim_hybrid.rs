@@ -138,6 +138,12 @@ fn bouncing_ball_matches_analytic_sequence_and_sticks() {
             if stuck { Mode::StuckMin } else { Mode::Free }
         );
     }
+    // Parabolic flights are integrated exactly: a few steps per flight.
+    assert!(
+        tr.stats.evaluations < 1500 && tr.stats.rejected < 10,
+        "{:?}",
+        tr.stats
+    );
     // After the sticking impact the ball rests at z_min.
     let t_stick = expected.last().unwrap().0;
     for k in 0..tr.len() {

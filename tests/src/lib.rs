@@ -1,1 +1,92 @@
-//! Shared helpers of the end-to-end tests.
+//! Shared helpers of the end-to-end tests: locating the bundled examples,
+//! loading models, deterministic pseudo-random states.
+
+use std::path::{Path, PathBuf};
+
+use designer::description::{parse_file, parse_str, Description};
+use designer::model::Model;
+
+/// The workspace root.
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Every bundled example description, sorted by file name.
+pub fn examples() -> Vec<(String, Description)> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(root().join("examples"))
+        .expect("examples/ exists")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    paths
+        .into_iter()
+        .map(|p| {
+            let d = parse_file(&p).unwrap_or_else(|e| panic!("{e}"));
+            (
+                p.file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+                d,
+            )
+        })
+        .collect()
+}
+
+/// One bundled example by file name.
+pub fn example(file: &str) -> Description {
+    parse_file(&root().join("examples").join(file)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A bundled example with some lines of its TOML text replaced.
+pub fn example_with(file: &str, replacements: &[(&str, &str)]) -> Description {
+    let mut text =
+        std::fs::read_to_string(root().join("examples").join(file)).expect("example exists");
+    for (from, to) in replacements {
+        assert!(text.contains(from), "`{from}` not found in {file}");
+        text = text.replacen(from, to, 1);
+    }
+    parse_str(&text, file).unwrap_or_else(|e| panic!("{e}"))
+}
+
+pub fn model(d: &Description) -> Model {
+    Model::build(d)
+}
+
+/// A small deterministic generator (SplitMix64) for reproducible test points.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed)
+    }
+
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// A random state inside the model's domain: z in [z_min, z_max], |φ| below
+/// saturation, H_c in a realistic range.
+pub fn random_state(d: &Description, rng: &mut Rng) -> [f64; 4] {
+    let m = &d.mechanics;
+    let phi_max = match &d.core {
+        designer::description::Core::Saturating { phi_sat, .. } => 0.9 * phi_sat,
+        _ => 2.5e-5,
+    };
+    [
+        rng.uniform(m.z_min, m.z_max),
+        rng.uniform(-2.0, 2.0),
+        rng.uniform(-phi_max, phi_max),
+        rng.uniform(-2000.0, 2000.0),
+    ]
+}

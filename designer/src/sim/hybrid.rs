@@ -230,6 +230,9 @@ impl Quadrature for NoQuadrature {
     fn integrand(&self, _: f64, _: &State, _: &State, _: f64, _: Mode, _: &mut QuadState) {}
 }
 
+/// Rollbacks per event located (see `Engine::integrate`).
+const MAX_REFINEMENTS: usize = 2;
+
 /// Simulates from `output_times[0]` to its last entry (non-decreasing),
 /// recording at every output time. See the module docs for conventions.
 pub fn simulate<P: Plant, I: Input + ?Sized>(
@@ -449,6 +452,15 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
             self.rk.restart(self.t, &self.x, &mut f, &mut dom);
         }
         self.need_init = false;
+        // Event refinement: a step that crosses a guard has stages beyond it,
+        // where the plant's field is only an extension (at a position limit, the
+        // field stops being smooth), so its dense output loses order near the
+        // crossing. When a step finds an event, roll back to the step's start and
+        // integrate with the located time as a ceiling: the event is then located
+        // on a step whose stages lie (almost) all before it. At most
+        // `MAX_REFINEMENTS` rollbacks per event keep this finite.
+        let mut ceiling = f64::INFINITY;
+        let mut refinements = 0;
         loop {
             let s = self.rk.stats();
             if s.accepted + s.rejected >= self.opts.max_steps {
@@ -457,8 +469,15 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
                     max: self.opts.max_steps,
                 });
             }
-            self.rk.step(&mut f, &mut dom, t_target)?;
+            let (t_start, x_start) = (self.rk.t(), *self.rk.x());
+            self.rk.step(&mut f, &mut dom, t_target.min(ceiling))?;
             if let Some(te) = self.find_event(piece) {
+                if refinements < MAX_REFINEMENTS && te > t_start {
+                    refinements += 1;
+                    ceiling = te;
+                    self.rk.restart(t_start, &x_start, &mut f, &mut dom);
+                    continue;
+                }
                 self.emit_dense(te, false, piece, t_target);
                 self.rk.dense(te, &mut self.x);
                 self.t = te;
@@ -466,6 +485,9 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
                 return Ok(false);
             }
             self.emit_dense(self.rk.t(), true, piece, t_target);
+            if self.rk.t() >= ceiling {
+                ceiling = f64::INFINITY;
+            }
             if self.rk.t() >= t_target {
                 self.t = t_target;
                 self.x = *self.rk.x();
