@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use designer::design::Linearization;
 use designer::model::Model;
 use miette::Report;
 use serde_json::{json, Map, Value};
@@ -25,49 +26,68 @@ pub fn run(model_path: &Path, states_path: &Path) -> Result<(), Report> {
     Ok(())
 }
 
+/// Named quantities: (name, number of values per state, expressions).
+type Quantity = (&'static str, usize, Vec<designer::sym::Id>);
+
+fn quantities(model: &mut Model) -> Vec<Quantity> {
+    let n = model.dim();
+    let jacobian: Vec<_> = model.jacobian().into_iter().flatten().collect();
+    let r_gap_dz2 = model.graph.diff(model.r_gap_dz, model.states[0]);
+    let mut q: Vec<Quantity> = vec![
+        ("f", n, model.f.clone()),
+        ("i", 1, vec![model.current]),
+        ("v_coil", 1, vec![model.voltage]),
+        ("f_mag", 1, vec![model.f_mag]),
+        ("r_gap", 1, vec![model.r_gap]),
+        ("r_gap_dz", 1, vec![model.r_gap_dz]),
+        ("r_gap_dz2", 1, vec![r_gap_dz2]),
+        ("df_dx", n * n, jacobian),
+    ];
+    // Controller quantities exist for the input-affine (non-hysteretic) models.
+    if let Ok(lin) = Linearization::derive(model) {
+        q.extend([
+            ("alpha", 1, vec![lin.alpha]),
+            ("beta", 1, vec![lin.beta]),
+            ("lf3h", 1, vec![lin.lf3h]),
+            ("lglf2h", 1, vec![lin.lglf2h]),
+            ("t", 3, lin.transform.to_vec()),
+            ("f_j", 1, vec![lin.jerk_drift]),
+            ("b_j", 1, vec![lin.jerk_gain]),
+        ]);
+    }
+    q
+}
+
 fn evaluate(model: &mut Model, p: &Points) -> Value {
     let n = model.dim();
-    let jacobian = model.jacobian();
-    let r_gap_dz2 = model.graph.diff(model.r_gap_dz, model.states[0]);
-    let mut exprs = model.f.clone();
-    exprs.extend([
-        model.current,
-        model.voltage,
-        model.f_mag,
-        model.r_gap,
-        model.r_gap_dz,
-        r_gap_dz2,
-    ]);
-    exprs.extend(jacobian.iter().flatten());
+    let quantities = quantities(model);
+    let exprs: Vec<_> = quantities
+        .iter()
+        .flat_map(|q| q.2.iter().copied())
+        .collect();
     let tape = model.compile(&exprs);
     let mut scratch = tape.scratch();
     let mut values = vec![0.0; exprs.len()];
-    let mut columns: [Vec<Value>; 8] = Default::default();
+    let mut columns: Vec<Vec<Value>> = vec![Vec::new(); quantities.len()];
     for k in 0..p.x.len() {
         let mut inputs = p.x[k].clone();
         inputs.extend([p.u[k], p.t[k]]);
         tape.eval(&inputs, &mut scratch, &mut values);
-        columns[0].push(json!(values[..n]));
-        for (j, column) in columns[1..7].iter_mut().enumerate() {
-            column.push(json!(values[n + j]));
+        let mut offset = 0;
+        for (column, (name, len, _)) in columns.iter_mut().zip(&quantities) {
+            let v = &values[offset..offset + len];
+            column.push(match (*name, len) {
+                ("df_dx", _) => json!(v.chunks(n).collect::<Vec<_>>()),
+                (_, 1) => json!(v[0]),
+                _ => json!(v),
+            });
+            offset += len;
         }
-        let jac: Vec<&[f64]> = values[n + 6..].chunks(n).collect();
-        columns[7].push(json!(jac));
     }
-    let names = [
-        "f",
-        "i",
-        "v_coil",
-        "f_mag",
-        "r_gap",
-        "r_gap_dz",
-        "r_gap_dz2",
-        "df_dx",
-    ];
-    let map: Map<String, Value> = names
+    let map: Map<String, Value> = quantities
         .iter()
         .zip(columns)
-        .map(|(k, v)| (k.to_string(), Value::Array(v.to_vec())))
+        .map(|((k, _, _), v)| (k.to_string(), Value::Array(v)))
         .collect();
     Value::Object(map)
 }

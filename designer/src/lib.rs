@@ -3,6 +3,7 @@
 //!
 //! - [`sym`]: the symbolic core (hash-consed expression DAG, simplification,
 //!   differentiation, CSE, flat-tape evaluation). Knows nothing of actuators.
+//! - [`design`]: controller derivations (Lie derivatives, feedback linearization).
 //! - [`description`]: the validated actuator description (`valve.toml`).
 //! - [`model`]: the actuator's state-space model, built symbolically.
 //! - [`record`]: recorded signals in the measured-data CSV format.
@@ -10,6 +11,7 @@
 //! - [`sim`]: the hybrid-automaton simulator (knows nothing of magnetics).
 
 pub mod description;
+pub mod design;
 pub mod model;
 pub mod record;
 pub mod replay;
