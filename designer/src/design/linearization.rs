@@ -42,6 +42,9 @@ pub struct Linearization {
     pub xi: [Id; 3],
     /// T⁻¹(ξ) (42), on D₀⁺.
     pub inverse: [Id; 3],
+    /// φ² required by ξ: (ξ₃ − a₀(ξ₁, ξ₂))/c₂(ξ₁), the radicand of T⁻¹.
+    /// (56) asks 0 < φ² < φ_sat².
+    pub flux_squared: Id,
     /// States whose zero makes L_g L_f²h vanish (relative degree lost), e.g. φ.
     pub singular_at: Vec<Id>,
 }
@@ -84,7 +87,7 @@ impl Linearization {
         // (26)
         let jerk_gain = g.neg(lglf2h);
         let xi = [g.symbol("xi1"), g.symbol("xi2"), g.symbol("xi3")];
-        let inverse = inverse_transform(g, &states, accel, xi)?;
+        let (inverse, flux_squared) = inverse_transform(g, &states, accel, xi)?;
         let singular_at = vanishing_factors(g, lglf2h, &states);
         Ok(Linearization {
             transform: [z, states[1], accel],
@@ -96,6 +99,7 @@ impl Linearization {
             jerk_gain,
             xi,
             inverse,
+            flux_squared,
             singular_at,
             system,
         })
@@ -119,13 +123,13 @@ impl Linearization {
     }
 }
 
-/// (42): x = T⁻¹(ξ) from a = a₀(z, v) + c₂(z)·φ².
+/// (42): x = T⁻¹(ξ) from a = a₀(z, v) + c₂(z)·φ², and the radicand φ².
 fn inverse_transform(
     g: &mut Graph,
     states: &[Id],
     accel: Id,
     xi: [Id; 3],
-) -> Result<[Id; 3], DesignError> {
+) -> Result<([Id; 3], Id), DesignError> {
     let (z, v, phi) = (states[0], states[1], states[2]);
     let zero = g.zero();
     let at_zero_flux = |g: &mut Graph, e: Id| {
@@ -145,5 +149,5 @@ fn inverse_transform(
     let (a0, c2) = (g.substitute(a0, &to_xi), g.substitute(c2, &to_xi));
     let num = g.sub(xi[2], a0);
     let ratio = g.div(num, c2);
-    Ok([xi[0], xi[1], g.sqrt(ratio)])
+    Ok(([xi[0], xi[1], g.sqrt(ratio)], ratio))
 }

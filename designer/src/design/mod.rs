@@ -2,10 +2,16 @@
 //!
 //! - `lie.rs`: input-affine systems, Lie derivatives, relative degree (generic);
 //! - `linearization.rs`: exact feedback linearization for y = z: α, β, T, T⁻¹,
-//!   the jerk terms.
+//!   the jerk terms;
+//! - `reference.rs`: soft-landing position references (polynomial);
+//! - `feasibility.rs`: conditions (54), (56), (57) along a reference.
 
+mod feasibility;
 mod lie;
 mod linearization;
+mod reference;
 
+pub use feasibility::{check as check_feasibility, Condition, Feasibility};
 pub use lie::{lie, vanishing_factors, AffineSystem, OutputDerivatives};
 pub use linearization::{DesignError, Linearization};
+pub use reference::{Flat, Polynomial, Reference};
