@@ -97,13 +97,25 @@ pub fn run(args: &Args) -> Result<(), Report> {
     }
     let replay = result.ok_or_else(|| fail("nothing simulated"))?;
     let csv = to_csv(&replay, model.has_field_state());
-    match &args.out {
-        Some(path) => crate::atomic::write(path, csv.as_bytes()).map_err(fail)?,
-        None => print!("{csv}"),
+    // Render everything before writing anything, then write the files
+    // together: a failure leaves every existing output untouched.
+    let svg = match &args.plot {
+        Some(path) => Some((
+            path,
+            crate::plot::svg(&replay, &description.name).map_err(fail)?,
+        )),
+        None => None,
+    };
+    let mut files: Vec<(&std::path::Path, &[u8])> = Vec::new();
+    if let Some(path) = &args.out {
+        files.push((path, csv.as_bytes()));
     }
-    if let Some(path) = &args.plot {
-        let svg = crate::plot::svg(&replay, &description.name).map_err(fail)?;
-        crate::atomic::write(path, svg.as_bytes()).map_err(fail)?;
+    if let Some((path, svg)) = &svg {
+        files.push((path, svg.as_bytes()));
+    }
+    crate::atomic::write_all(&files).map_err(fail)?;
+    if args.out.is_none() {
+        print!("{csv}");
     }
     Ok(())
 }

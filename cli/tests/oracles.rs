@@ -1,0 +1,138 @@
+//! The independent Python oracles of `tests/oracle/`, run against the real
+//! binary:
+//!
+//! - `check_eval.py RELDESIGN examples/*.toml`: `reldesign eval` against a
+//!   CasADi model (f, i, f_mag, r_gap, r_gap_dz, df_dx to 1e-10),
+//! - `check_eval.py --self-test`: the CasADi oracle against numpy, scipy and
+//!   finite differences,
+//! - `check_linearization.py RELDESIGN examples/*.toml`: the feedback
+//!   linearization quantities of `eval` (α, β, L_f³h, L_gL_f²h, T) against CasADi,
+//! - `check_simulate.py RELDESIGN`: `reldesign simulate` on the three-pulse
+//!   record against a scipy `solve_ivp` hybrid automaton (i and φ to 1e-6),
+//! - `check_simulate.py --self-test`: the scipy automaton against closed forms.
+//!
+//! They need python3 with casadi, numpy and scipy (`pip install casadi numpy
+//! scipy`; CI installs them). A missing interpreter or package is a test
+//! failure, not a skip. `RELDESIGN_PYTHON` overrides the interpreter.
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const BIN: &str = env!("CARGO_BIN_EXE_reldesign");
+const INSTALL: &str = "the oracles need python3 with casadi, numpy and scipy: \
+                       run `pip install casadi numpy scipy` (or set RELDESIGN_PYTHON \
+                       to an interpreter that has them)";
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("cli/ has a parent")
+        .to_path_buf()
+}
+
+fn python() -> OsString {
+    std::env::var_os("RELDESIGN_PYTHON").unwrap_or_else(|| "python3".into())
+}
+
+/// Fails (with the install hint) unless python3 can import the oracles' packages.
+fn require_python() {
+    let py = python();
+    let out = Command::new(&py)
+        .args(["-c", "import casadi, numpy, scipy"])
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {py:?}: {e}\n{INSTALL}"));
+    assert!(
+        out.status.success(),
+        "{py:?} cannot import the oracle's packages:\n{}\n{INSTALL}",
+        String::from_utf8_lossy(&out.stderr).trim()
+    );
+}
+
+/// Runs `python3 tests/oracle/SCRIPT ARGS…` from the workspace root; asserts
+/// exit status 0 and that stdout ends with `verdict`. Prints everything on failure.
+fn oracle(script: &str, args: &[OsString], verdict: &str) {
+    require_python();
+    let root = root();
+    let out = Command::new(python())
+        .arg(root.join("tests/oracle").join(script))
+        .args(args)
+        .current_dir(&root)
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {script}: {e}\n{INSTALL}"));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let report = format!(
+        "`{script} {}` exited with {:?}\n--- stdout ---\n{stdout}\n--- stderr ---\n{stderr}",
+        args.iter()
+            .map(|a| a.to_string_lossy())
+            .collect::<Vec<_>>()
+            .join(" "),
+        out.status.code()
+    );
+    if stderr.contains("ModuleNotFoundError") {
+        panic!("{report}\n{INSTALL}");
+    }
+    assert!(out.status.success(), "{report}");
+    assert!(
+        stdout.trim_end().ends_with(verdict),
+        "expected the verdict `{verdict}`\n{report}"
+    );
+    // Shown with `cargo test -- --nocapture`.
+    println!("{report}");
+}
+
+fn examples() -> Vec<OsString> {
+    let dir = root().join("examples");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
+        .map(|e| e.expect("directory entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    files.sort();
+    assert!(
+        files.len() >= 5,
+        "expected the five examples in {}",
+        dir.display()
+    );
+    // Relative to the workspace root, as in the documented command line.
+    files
+        .iter()
+        .map(|p| p.strip_prefix(root()).unwrap().as_os_str().to_owned())
+        .collect()
+}
+
+#[test]
+fn eval_agrees_with_the_casadi_oracle_on_every_example() {
+    let mut args: Vec<OsString> = vec![BIN.into()];
+    args.extend(examples());
+    oracle("check_eval.py", &args, "check_eval: OK");
+}
+
+#[test]
+fn linearization_agrees_with_the_casadi_oracle_on_every_example() {
+    let mut args: Vec<OsString> = vec![BIN.into()];
+    args.extend(examples());
+    oracle("check_linearization.py", &args, "check_linearization: OK");
+}
+
+#[test]
+fn casadi_oracle_self_test() {
+    oracle("check_eval.py", &["--self-test".into()], "self-test: OK");
+}
+
+#[test]
+fn simulate_agrees_with_the_scipy_automaton() {
+    oracle("check_simulate.py", &[BIN.into()], "check_simulate: OK");
+}
+
+#[test]
+fn scipy_automaton_self_test() {
+    oracle(
+        "check_simulate.py",
+        &["--self-test".into()],
+        "self-test: OK",
+    );
+}
