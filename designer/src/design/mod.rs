@@ -6,11 +6,16 @@
 //! - `reference.rs`: soft-landing position references (polynomial);
 //! - `feasibility.rs`: conditions (54), (56), (57) along a reference.
 
+mod bvp;
 mod feasibility;
 mod lie;
 mod linearization;
 mod reference;
 
+pub use bvp::{
+    jacobian_discrepancy, solve_bvp, solve_collocation, BvpError, BvpOptions, BvpProblem,
+    BvpSolution,
+};
 pub use feasibility::{check as check_feasibility, Condition, Feasibility};
 pub use lie::{lie, vanishing_factors, AffineSystem, OutputDerivatives};
 pub use linearization::{DesignError, Linearization};
