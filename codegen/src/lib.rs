@@ -1,5 +1,35 @@
 //! Code generation: turns designed laws (symbolic expressions from the
 //! designer) into formatted, deterministic, `no_std`, panic-free Rust.
 //!
-//! Populated by the soft-landing pipeline (issue 3); the foundation only
-//! fixes its place in the workspace (see ARCHITECTURE.md).
+//! The foundation is the expression emitter: [`emit_params`] writes the
+//! parameters as named consts (one per line, values in shortest round-trip
+//! form), [`emit_function`] writes a set of named outputs as one plain `fn`
+//! over `f32` or `f64` scalars returning a struct. Parameters stay symbolic
+//! (changing one value changes one line), shared subexpressions become `let`s
+//! in the deterministic CSE order, math goes through
+//! `reldesign_runtime::math::Real` (libm, no `std`), and nothing emitted
+//! allocates, indexes, unwraps or casts.
+//!
+//! | module | concept |
+//! | --- | --- |
+//! | `emit.rs` | the public emitters: [`FunctionSpec`], [`emit_params`], [`emit_function`] |
+//! | `plan.rs` | which nodes become `let`s, in which order, under which names |
+//! | `lower.rs` | one expression → Rust tokens (subtractions, divisions, powers, `if`) |
+//! | `names.rs` | name validation, parameter const names, readable temporaries |
+//! | `float.rs` | [`Float`] and shortest round-trip literals |
+//! | `format.rs` | `prettyplease` formatting and `//` comments |
+//! | `error.rs` | [`EmitError`] |
+
+mod emit;
+mod error;
+mod float;
+mod format;
+mod lower;
+mod names;
+mod plan;
+
+pub use emit::{emit_function, emit_params, function_tokens, params_tokens, FunctionSpec, Param};
+pub use error::EmitError;
+pub use float::Float;
+pub use format::format_items;
+pub use names::const_name;

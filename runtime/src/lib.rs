@@ -6,6 +6,119 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+/// Scalar math for generated code, through `libm` (no `std`).
+///
+/// Generated functions call these with the trait path, e.g.
+/// `Real::sqrt(x)`, `Real::powi(x, 4)`, so the same expressions compile for
+/// `f32` and `f64` without generics and without relying on the (std-only)
+/// inherent float methods. Every function is total: no panics, NaN in → NaN
+/// out (`min`/`max` return the other operand, like `f64::min`).
+pub mod math {
+    /// The floating-point operations emitted expressions use.
+    pub trait Real: Copy {
+        /// √x (NaN for x < 0).
+        fn sqrt(x: Self) -> Self;
+        /// eˣ.
+        fn exp(x: Self) -> Self;
+        /// Natural logarithm.
+        fn ln(x: Self) -> Self;
+        /// Hyperbolic tangent.
+        fn tanh(x: Self) -> Self;
+        /// Hyperbolic cotangent, 1/tanh x.
+        fn coth(x: Self) -> Self;
+        /// xʸ for a real exponent.
+        fn powf(x: Self, y: Self) -> Self;
+        /// xⁿ by binary exponentiation (the algorithm of `f64::powi`).
+        fn powi(x: Self, n: i32) -> Self;
+        /// |x|.
+        fn abs(x: Self) -> Self;
+        /// Sign with sign(±0) = 0 and sign(NaN) = NaN.
+        fn signum0(x: Self) -> Self;
+        /// The smaller operand; a NaN operand yields the other one.
+        fn min(a: Self, b: Self) -> Self;
+        /// The larger operand; a NaN operand yields the other one.
+        fn max(a: Self, b: Self) -> Self;
+    }
+
+    macro_rules! real_impl {
+        ($t:ty, $sqrt:ident, $exp:ident, $ln:ident, $tanh:ident, $pow:ident, $abs:ident, $min:ident, $max:ident) => {
+            impl Real for $t {
+                #[inline]
+                fn sqrt(x: $t) -> $t {
+                    libm::$sqrt(x)
+                }
+                #[inline]
+                fn exp(x: $t) -> $t {
+                    libm::$exp(x)
+                }
+                #[inline]
+                fn ln(x: $t) -> $t {
+                    libm::$ln(x)
+                }
+                #[inline]
+                fn tanh(x: $t) -> $t {
+                    libm::$tanh(x)
+                }
+                #[inline]
+                fn coth(x: $t) -> $t {
+                    1.0 / libm::$tanh(x)
+                }
+                #[inline]
+                fn powf(x: $t, y: $t) -> $t {
+                    libm::$pow(x, y)
+                }
+                #[inline]
+                fn powi(x: $t, n: i32) -> $t {
+                    let mut base = x;
+                    let mut e = n.unsigned_abs();
+                    let mut acc: $t = 1.0;
+                    loop {
+                        if e & 1 == 1 {
+                            acc *= base;
+                        }
+                        e >>= 1;
+                        if e == 0 {
+                            break;
+                        }
+                        base *= base;
+                    }
+                    if n < 0 {
+                        1.0 / acc
+                    } else {
+                        acc
+                    }
+                }
+                #[inline]
+                fn abs(x: $t) -> $t {
+                    libm::$abs(x)
+                }
+                #[inline]
+                fn signum0(x: $t) -> $t {
+                    if x > 0.0 {
+                        1.0
+                    } else if x < 0.0 {
+                        -1.0
+                    } else {
+                        // ±0 → 0, NaN → NaN
+                        x * 0.0
+                    }
+                }
+                #[inline]
+                fn min(a: $t, b: $t) -> $t {
+                    libm::$min(a, b)
+                }
+                #[inline]
+                fn max(a: $t, b: $t) -> $t {
+                    libm::$max(a, b)
+                }
+            }
+        };
+    }
+
+    real_impl!(f64, sqrt, exp, log, tanh, pow, fabs, fmin, fmax);
+    real_impl!(f32, sqrtf, expf, logf, tanhf, powf, fabsf, fminf, fmaxf);
+}
+
 /// Clamps `u` to `[lo, hi]`; a NaN input maps to `lo`'s side of zero-safe
 /// behaviour: it returns the bound closest to zero, so a numerical failure
 /// never commands full voltage.
@@ -48,5 +161,27 @@ mod tests {
         assert_eq!(saturate(f64::NAN, 1.0, 24.0), 1.0);
         assert_eq!(saturate(f64::NAN, -24.0, -1.0), -1.0);
         assert_eq!(saturate_f32(f32::NAN, -24.0, 24.0), 0.0);
+    }
+
+    #[test]
+    fn math_is_total_and_matches_the_definitions() {
+        use math::Real;
+        assert_eq!(<f64 as Real>::signum0(0.0), 0.0);
+        assert_eq!(<f64 as Real>::signum0(-0.0), 0.0);
+        assert_eq!(<f64 as Real>::signum0(-3.0), -1.0);
+        assert_eq!(<f32 as Real>::signum0(2.0), 1.0);
+        assert!(<f64 as Real>::signum0(f64::NAN).is_nan());
+        assert_eq!(<f64 as Real>::powi(2.0, 10), 1024.0);
+        assert_eq!(<f64 as Real>::powi(2.0, -2), 0.25);
+        assert_eq!(<f64 as Real>::powi(3.0, 0), 1.0);
+        assert_eq!(<f64 as Real>::powi(1.0, i32::MIN), 1.0);
+        assert_eq!(<f32 as Real>::powi(1.5, 3), 3.375);
+        assert_eq!(<f64 as Real>::min(f64::NAN, 2.0), 2.0);
+        assert_eq!(<f64 as Real>::max(1.0, 2.0), 2.0);
+        assert_eq!(<f64 as Real>::sqrt(2.25), 1.5);
+        assert!((<f64 as Real>::coth(0.5) - 1.0 / 0.5f64.tanh()).abs() < 1e-15);
+        assert!((<f64 as Real>::ln(<f64 as Real>::exp(0.3)) - 0.3).abs() < 1e-15);
+        assert!((<f64 as Real>::powf(2.0, 0.5) - 2f64.sqrt()).abs() < 1e-15);
+        assert!((<f32 as Real>::tanh(0.5) - 0.5f32.tanh()).abs() < 1e-6);
     }
 }

@@ -1,0 +1,233 @@
+//! The public emitters: a parameter block and a function over named outputs.
+
+use std::collections::HashMap;
+
+use designer::sym::{Graph, Id};
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use crate::error::EmitError;
+use crate::float::Float;
+use crate::format::{comment_lets, format_items};
+use crate::lower::Lowerer;
+use crate::names::{camel, const_name, ident, Namer};
+use crate::plan::{plan, PlanRequest};
+
+/// One parameter: symbol name, symbol node, value (e.g. from
+/// `model.params.iter()`).
+pub type Param<'a> = (&'a str, Id, f64);
+
+/// What to emit as one function.
+#[derive(Debug, Clone)]
+pub struct FunctionSpec<'a> {
+    /// Function name (lower snake case); the output struct is its UpperCamel
+    /// form + `Output`.
+    pub name: &'a str,
+    /// Doc comment of the function (may span lines).
+    pub doc: &'a str,
+    /// (Rust argument name, symbol), in signature order.
+    pub inputs: Vec<(&'a str, Id)>,
+    /// (field name, expression, doc such as "(32) α(x)"), in field order.
+    pub outputs: Vec<(&'a str, Id, &'a str)>,
+    /// Subexpressions the caller names: each reachable one becomes
+    /// `let name = …;` and is referenced by that name.
+    pub named: Vec<(&'a str, Id)>,
+    pub float: Float,
+}
+
+/// `pub const NAME: f64 = value;` per parameter, in the given order, each
+/// value in shortest round-trip form (one parameter change = one changed
+/// line). A parameter whose const name differs from its symbol gets the
+/// symbol as a doc line (`/// \`k_e\``).
+pub fn emit_params(graph: &Graph, params: &[Param], float: Float) -> Result<String, EmitError> {
+    format_items(params_tokens(graph, params, float)?)
+}
+
+/// Tokens of [`emit_params`] (to assemble larger files).
+pub fn params_tokens(
+    graph: &Graph,
+    params: &[Param],
+    float: Float,
+) -> Result<TokenStream, EmitError> {
+    const_names(graph, params)?;
+    let ty = float.ty();
+    let mut items = TokenStream::new();
+    for &(name, _, value) in params {
+        let cname = ident(&const_name(name)?);
+        let lit = float
+            .unsuffixed_signed(value)
+            .ok_or_else(|| EmitError::NonFinite {
+                name: name.to_owned(),
+                value: format!("{value:?}"),
+                float: float.name(),
+            })?;
+        if cname != name {
+            let doc = format!(" `{name}`");
+            items.extend(quote!(#[doc = #doc]));
+        }
+        items.extend(quote!(pub const #cname: #ty = #lit;));
+    }
+    Ok(items)
+}
+
+/// parameter symbol → const name; checks symbols and uniqueness.
+fn const_names(graph: &Graph, params: &[Param]) -> Result<HashMap<Id, String>, EmitError> {
+    let mut by_id = HashMap::new();
+    let mut seen: Vec<String> = Vec::new();
+    for &(name, id, _) in params {
+        if graph.name_of(id).is_none() {
+            return Err(EmitError::NotASymbol(name.to_owned()));
+        }
+        let c = const_name(name)?;
+        if seen.contains(&c) {
+            return Err(EmitError::DuplicateName(c));
+        }
+        seen.push(c.clone());
+        by_id.insert(id, c);
+    }
+    Ok(by_id)
+}
+
+/// The formatted function (preceded by its output struct): parameters are
+/// referenced as the consts of [`emit_params`] (which must be in scope),
+/// math goes through `reldesign_runtime::math::Real`, shared subexpressions
+/// become `let`s in the deterministic CSE order, and every output's `let`
+/// carries its doc as a `//` comment.
+pub fn emit_function(
+    graph: &Graph,
+    spec: &FunctionSpec,
+    params: &[Param],
+) -> Result<String, EmitError> {
+    let tokens = function_tokens(graph, spec, params)?;
+    let text = format_items(tokens)?;
+    let comments: Vec<(&str, &str)> = spec.outputs.iter().map(|&(n, _, d)| (n, d)).collect();
+    Ok(comment_lets(&text, spec.name, &comments))
+}
+
+/// Tokens of [`emit_function`], without the `//` comments (which are not tokens).
+pub fn function_tokens(
+    graph: &Graph,
+    spec: &FunctionSpec,
+    params: &[Param],
+) -> Result<TokenStream, EmitError> {
+    crate::names::check_local(spec.name)?;
+    let const_by_id = const_names(graph, params)?;
+    let mut namer = Namer::default();
+    for &(name, _) in &spec.inputs {
+        namer.reserve(name)?;
+    }
+    for &(name, _, _) in &spec.outputs {
+        namer.reserve(name)?;
+    }
+    for &(name, _) in &spec.named {
+        namer.reserve(name)?;
+    }
+    let inputs: Vec<(String, Id)> = spec
+        .inputs
+        .iter()
+        .map(|&(n, id)| (n.to_owned(), id))
+        .collect();
+    let outputs: Vec<(String, Id)> = spec
+        .outputs
+        .iter()
+        .map(|&(n, id, _)| (n.to_owned(), id))
+        .collect();
+    let named: Vec<(String, Id)> = spec
+        .named
+        .iter()
+        .map(|&(n, id)| (n.to_owned(), id))
+        .collect();
+    let request = PlanRequest {
+        inputs: &inputs,
+        params: &const_by_id,
+        outputs: &outputs,
+        named: &named,
+    };
+    let plan = plan(graph, &request, &mut namer)?;
+
+    let mut lower = Lowerer {
+        graph,
+        bound: &plan.bound,
+        float: spec.float,
+        uses_real: false,
+    };
+    let mut body = TokenStream::new();
+    for b in &plan.lets {
+        let name = ident(&b.name);
+        let rhs = lower.definition(b.id)?;
+        body.extend(quote!(let #name = #rhs;));
+    }
+    for (name, id) in &outputs {
+        if plan.bound.get(id) == Some(name) {
+            continue; // bound above under the output's own name
+        }
+        let rhs = lower.operand(*id)?;
+        let name = ident(name);
+        body.extend(quote!(let #name = #rhs;));
+    }
+    let prelude = if lower.uses_real {
+        quote!(
+            use reldesign_runtime::math::Real;
+        )
+    } else {
+        quote!()
+    };
+
+    let ty = spec.float.ty();
+    let out_ty = ident(&format!("{}Output", camel(spec.name)));
+    let fn_name = ident(spec.name);
+    let args = inputs.iter().zip(&plan.input_used).map(|((n, _), &used)| {
+        let n = if used {
+            ident(n)
+        } else {
+            ident(&format!("_{n}"))
+        };
+        quote!(#n: #ty)
+    });
+    let fields = spec.outputs.iter().map(|&(n, _, doc)| {
+        let n = ident(n);
+        let docs = doc_attrs(doc);
+        quote!(#docs pub #n: #ty)
+    });
+    let field_names = outputs.iter().map(|(n, _)| ident(n));
+    let fn_doc = doc_attrs(spec.doc);
+    let struct_doc = format!(" Outputs of [`{}`].", spec.name);
+    let allow = if inputs.len() > 7 {
+        quote!(#[allow(clippy::too_many_arguments)])
+    } else {
+        quote!()
+    };
+    Ok(quote! {
+        #[doc = #struct_doc]
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct #out_ty {
+            #(#fields,)*
+        }
+
+        #fn_doc
+        #[must_use]
+        #allow
+        pub fn #fn_name(#(#args),*) -> #out_ty {
+            #prelude
+            #body
+            #out_ty { #(#field_names),* }
+        }
+    })
+}
+
+/// `#[doc = " line"]` per line (an empty text gives none).
+fn doc_attrs(text: &str) -> TokenStream {
+    let mut out = TokenStream::new();
+    if text.is_empty() {
+        return out;
+    }
+    for line in text.lines() {
+        let line = if line.is_empty() {
+            String::new()
+        } else {
+            format!(" {line}")
+        };
+        out.extend(quote!(#[doc = #line]));
+    }
+    out
+}

@@ -1,0 +1,49 @@
+//! Formatting of emitted tokens (`syn` + `prettyplease`, deterministic and
+//! independent of any installed rustfmt) and the `//` comments that tokens
+//! cannot carry.
+
+use proc_macro2::TokenStream;
+
+use crate::error::EmitError;
+
+/// Formats items as a Rust file body.
+pub fn format_items(tokens: TokenStream) -> Result<String, EmitError> {
+    let file: syn::File = syn::parse2(tokens).map_err(|e| EmitError::Syntax(e.to_string()))?;
+    Ok(prettyplease::unparse(&file))
+}
+
+/// Puts `// doc` above the first `let name = ` of function `function`, for
+/// each (name, doc).
+pub(crate) fn comment_lets(text: &str, function: &str, comments: &[(&str, &str)]) -> String {
+    let header = format!("fn {function}(");
+    let mut out = String::with_capacity(text.len() + 64 * comments.len());
+    let mut in_function = false;
+    let mut pending: Vec<(&str, &str)> = comments
+        .iter()
+        .copied()
+        .filter(|c| !c.1.is_empty())
+        .collect();
+    for line in text.split_inclusive('\n') {
+        let trimmed = line.trim_start();
+        if trimmed.starts_with("pub fn ") || trimmed.starts_with("fn ") {
+            in_function = trimmed.contains(&header);
+        }
+        if in_function {
+            if let Some(k) = pending
+                .iter()
+                .position(|(name, _)| trimmed.starts_with(&format!("let {name} = ")))
+            {
+                let (_, doc) = pending.remove(k);
+                let indent = &line[..line.len() - trimmed.len()];
+                for d in doc.lines() {
+                    out.push_str(indent);
+                    out.push_str("// ");
+                    out.push_str(d);
+                    out.push('\n');
+                }
+            }
+        }
+        out.push_str(line);
+    }
+    out
+}
