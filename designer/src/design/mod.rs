@@ -10,6 +10,7 @@ mod bvp;
 mod feasibility;
 mod lie;
 mod linearization;
+mod optimal;
 mod reference;
 
 pub use bvp::{
@@ -19,4 +20,8 @@ pub use bvp::{
 pub use feasibility::{check as check_feasibility, Condition, Feasibility};
 pub use lie::{lie, vanishing_factors, AffineSystem, OutputDerivatives};
 pub use linearization::{DesignError, Linearization};
+pub use optimal::{
+    energy_optimal, CostateGuess, HamiltonianSystem, OptimalError, OptimalSpec, OptimalTrajectory,
+    Switch,
+};
 pub use reference::{Flat, Polynomial, Reference};
