@@ -4,7 +4,9 @@
 //! - `linearization.rs`: exact feedback linearization for y = z: α, β, T, T⁻¹,
 //!   the jerk terms;
 //! - `reference.rs`: soft-landing position references (polynomial);
-//! - `feasibility.rs`: conditions (54), (56), (57) along a reference.
+//! - `feasibility.rs`: conditions (54), (56), (57) along a reference;
+//! - `bvp.rs`: a collocation two-point BVP solver (generic);
+//! - `optimal.rs`: the energy-optimal reference (Pontryagin, eqs. 58–66).
 
 mod bvp;
 mod feasibility;
