@@ -147,23 +147,54 @@ fn polynomial_references_of_the_paper_valve_are_checked_for_feasibility() {
     let mut m = model("perfect-tracking-valve.toml");
     let lin = Linearization::derive(&mut m).unwrap();
     let (z_min, z_max) = (m.description.mechanics.z_min, m.description.mechanics.z_max);
-    let closing = Polynomial { z0: z_max, zf: z_min, t0: 1e-3, tf: 6e-3 };
-    let opening = Polynomial { z0: z_min, zf: z_max, t0: 1e-3, tf: 6e-3 };
+    let closing = Polynomial {
+        z0: z_max,
+        zf: z_min,
+        t0: 1e-3,
+        tf: 6e-3,
+    };
+    let opening = Polynomial {
+        z0: z_min,
+        zf: z_max,
+        t0: 1e-3,
+        tf: 6e-3,
+    };
     // The polynomial closing of the paper's valve needs slightly more than
     // 24 V right after take-off (the polynomial's jerk peaks at t₀: compare the
     // saturation of Fig. 5); the opening stays within ±24 V.
     let report = check_feasibility(&mut m, &lin, &closing, (-24.0, 24.0), 2000);
     let u_max = &report.conditions[4];
     let (start, end) = u_max.violated.expect("closing saturates");
-    assert!(start < 1.01e-3 && end < 1.5e-3 && (24.0..26.0).contains(&u_max.worst_value), "{}", report.report());
-    assert_eq!(report.conditions.iter().filter(|c| c.violated.is_some()).count(), 1, "{}", report.report());
+    assert!(
+        start < 1.01e-3 && end < 1.5e-3 && (24.0..26.0).contains(&u_max.worst_value),
+        "{}",
+        report.report()
+    );
+    assert_eq!(
+        report
+            .conditions
+            .iter()
+            .filter(|c| c.violated.is_some())
+            .count(),
+        1,
+        "{}",
+        report.report()
+    );
     let report = check_feasibility(&mut m, &lin, &opening, (-24.0, 24.0), 2000);
     assert!(report.is_feasible(), "{}", report.report());
     assert!(report.min_flux > 0.0 && report.max_input < 24.0 && report.min_input > -24.0);
     // A much faster motion cannot be tracked within ±24 V: (54) must fail and say where.
-    let fast = Polynomial { z0: z_max, zf: z_min, t0: 1e-3, tf: 1.5e-3 };
+    let fast = Polynomial {
+        z0: z_max,
+        zf: z_min,
+        t0: 1e-3,
+        tf: 1.5e-3,
+    };
     let report = check_feasibility(&mut m, &lin, &fast, (-24.0, 24.0), 2000);
     assert!(!report.is_feasible());
     let text = report.report();
-    assert!(text.contains("FAIL  (54)") && text.contains("longer motion"), "{text}");
+    assert!(
+        text.contains("FAIL  (54)") && text.contains("longer motion"),
+        "{text}"
+    );
 }

@@ -93,7 +93,13 @@ struct Tracker {
 impl Tracker {
     fn new(name: &'static str, bound: f64, sense: f64) -> Tracker {
         Tracker {
-            condition: Condition { name, violated: None, worst_t: f64::NAN, worst_value: f64::NAN, bound },
+            condition: Condition {
+                name,
+                violated: None,
+                worst_t: f64::NAN,
+                worst_value: f64::NAN,
+                bound,
+            },
             sense,
             worst_margin: f64::NEG_INFINITY,
         }
@@ -101,7 +107,11 @@ impl Tracker {
 
     fn observe(&mut self, t: f64, value: f64) {
         let excess = self.sense * (value - self.condition.bound);
-        let excess = if excess.is_nan() { f64::INFINITY } else { excess };
+        let excess = if excess.is_nan() {
+            f64::INFINITY
+        } else {
+            excess
+        };
         if excess > self.worst_margin {
             self.worst_margin = excess;
             self.condition.worst_t = t;
@@ -115,9 +125,16 @@ impl Tracker {
 }
 
 /// Evaluates (54), (56), (57) on `samples` + 1 instants of the motion.
-pub fn check(model: &mut Model, lin: &Linearization, reference: &dyn Reference, u_bounds: (f64, f64), samples: usize) -> Feasibility {
+pub fn check(
+    model: &mut Model,
+    lin: &Linearization,
+    reference: &dyn Reference,
+    u_bounds: (f64, f64),
+    samples: usize,
+) -> Feasibility {
     let flux2 = model.bind_params(&[lin.flux_squared]);
-    let flux_tape = Tape::compile(&model.graph, &lin.xi, &flux2).expect("φ² depends on ξ and parameters only");
+    let flux_tape =
+        Tape::compile(&model.graph, &lin.xi, &flux2).expect("φ² depends on ξ and parameters only");
     let law = model.compile(&[lin.alpha, lin.beta]);
     let mech = &model.description.mechanics;
     let phi_sat = match model.description.core {
@@ -126,12 +143,19 @@ pub fn check(model: &mut Model, lin: &Linearization, reference: &dyn Reference, 
     };
     let mut z_low = Tracker::new("(57) z_r ≥ z_min", mech.z_min, -1.0);
     let mut z_high = Tracker::new("(57) z_r ≤ z_max", mech.z_max, 1.0);
-    let mut attract = Tracker::new("(56) φ_r² > 0 (the magnetic force only attracts)", 0.0, -1.0);
+    let mut attract = Tracker::new(
+        "(56) φ_r² > 0 (the magnetic force only attracts)",
+        0.0,
+        -1.0,
+    );
     let mut saturation = Tracker::new("(56) φ_r² < φ_sat²", phi_sat * phi_sat, 1.0);
     let mut u_high = Tracker::new("(54) α + β·z⁽³⁾ ≤ u_max", u_bounds.1, 1.0);
     let mut u_low = Tracker::new("(54) α + β·z⁽³⁾ ≥ u_min", u_bounds.0, -1.0);
     let (t0, tf) = reference.motion();
-    let (mut flux_range, mut input_range) = ((f64::INFINITY, f64::NEG_INFINITY), (f64::INFINITY, f64::NEG_INFINITY));
+    let (mut flux_range, mut input_range) = (
+        (f64::INFINITY, f64::NEG_INFINITY),
+        (f64::INFINITY, f64::NEG_INFINITY),
+    );
     let (mut fs, mut ls) = (flux_tape.scratch(), law.scratch());
     for k in 0..=samples {
         let t = t0 + (tf - t0) * k as f64 / samples as f64;
@@ -154,7 +178,10 @@ pub fn check(model: &mut Model, lin: &Linearization, reference: &dyn Reference, 
         }
     }
     Feasibility {
-        conditions: [z_low, z_high, attract, saturation, u_high, u_low].into_iter().map(|t| t.condition).collect(),
+        conditions: [z_low, z_high, attract, saturation, u_high, u_low]
+            .into_iter()
+            .map(|t| t.condition)
+            .collect(),
         max_input: input_range.1,
         min_input: input_range.0,
         min_flux: flux_range.0,

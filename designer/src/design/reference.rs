@@ -61,7 +61,12 @@ mod tests {
 
     #[test]
     fn polynomial_meets_soft_landing_conditions_and_differentiates_consistently() {
-        let p = Polynomial { z0: 1e-3, zf: 0.0, t0: 1e-3, tf: 6e-3 };
+        let p = Polynomial {
+            z0: 1e-3,
+            zf: 0.0,
+            t0: 1e-3,
+            tf: 6e-3,
+        };
         for t in [p.t0, p.tf] {
             let f = p.at(t);
             assert_eq!((f.v, f.a), (0.0, 0.0));
