@@ -21,6 +21,10 @@ pub struct Description {
     pub core: Core,
     pub mechanics: Mechanics,
     pub supply: Supply,
+    /// `[trajectory]`: the soft-landing references to design (optional).
+    pub trajectory: Option<Trajectory>,
+    /// `[controller]`: the control law to design and emit (optional).
+    pub controller: Option<Controller>,
     /// Where the description came from (file name as given, full text).
     pub source: Source,
 }
@@ -127,4 +131,71 @@ pub struct Supply {
     pub drive: Drive,
     pub u_min: f64,
     pub u_max: f64,
+}
+
+/// A switching operation: which way the armature moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Operation {
+    /// z_max → z_min
+    Closing,
+    /// z_min → z_max
+    Opening,
+}
+
+/// Shape of the motion z_m(t) on [takeoff, landing].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Shape {
+    /// 5th-degree polynomial (perfect-tracking-soft-landing eqs. 52–53).
+    Polynomial,
+    /// Minimum ∫u² dt with |u| ≤ u_bound (eqs. 58–66).
+    EnergyOptimal,
+}
+
+/// `[trajectory]`: times are measured from the start of each operation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trajectory {
+    /// One or both operations, each designed separately (no duplicates).
+    pub operations: Vec<Operation>,
+    /// t₀ [s]: end of the pre-movement stage, start of the motion (> 0).
+    pub takeoff: f64,
+    /// t_f [s]: end of the motion (> takeoff).
+    pub landing: f64,
+    pub shape: Shape,
+    /// Input bound used to design the trajectory [V or A] (> 0, at most the
+    /// supply limits' magnitude), leaving the rest to the feedback.
+    pub u_bound: f64,
+}
+
+/// How the gains K of the tracking law (48) are given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Gains {
+    /// 5 % settling time [s] of the error dynamics with a triple real pole.
+    SettlingTime(f64),
+    /// The three closed-loop poles [1/s] (real parts < 0; real poles).
+    Poles([f64; 3]),
+}
+
+/// Floating-point type of the emitted code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum FloatType {
+    F32,
+    F64,
+}
+
+/// `[controller]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Controller {
+    /// Only "feedback-linearization" (eq. 50) for now.
+    pub law: Law,
+    pub gains: Gains,
+    /// T_s [s] (> 0): the controller runs every sample period.
+    pub sample_period: f64,
+    /// Emitted variants, sorted, no duplicates (default: both).
+    pub floats: Vec<FloatType>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Law {
+    /// u = α + β·(K·(ξ_r − T(x)) + z_r⁽³⁾), perfect-tracking-soft-landing (50).
+    FeedbackLinearization,
 }

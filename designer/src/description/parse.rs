@@ -71,6 +71,8 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         core,
         mechanics,
         supply,
+        trajectory: None,
+        controller: None,
         source,
     })
 }

@@ -6,7 +6,8 @@
 //! - `reference.rs`: soft-landing position references (polynomial);
 //! - `feasibility.rs`: conditions (54), (56), (57) along a reference;
 //! - `bvp.rs`: a collocation two-point BVP solver (generic);
-//! - `optimal.rs`: the energy-optimal reference (Pontryagin, eqs. 58–66).
+//! - `optimal.rs`: the energy-optimal reference (Pontryagin, eqs. 58–66);
+//! - `segments.rs`: a reference as a compact table of polynomial segments.
 
 mod bvp;
 mod feasibility;
@@ -14,6 +15,7 @@ mod lie;
 mod linearization;
 mod optimal;
 mod reference;
+mod segments;
 
 pub use bvp::{
     jacobian_discrepancy, solve_bvp, solve_collocation, BvpError, BvpOptions, BvpProblem,
@@ -27,3 +29,4 @@ pub use optimal::{
     Switch,
 };
 pub use reference::{Flat, Polynomial, Reference};
+pub use segments::{Segment, Segments};
