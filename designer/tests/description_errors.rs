@@ -7,7 +7,10 @@
 
 use std::path::{Path, PathBuf};
 
-use designer::description::{parse_file, parse_str, Core, Description, Drive, Gap};
+use designer::description::{
+    parse_file, parse_str, Controller, Core, Description, Drive, FloatType, Gains, Gap, Law,
+    Operation, Shape, Trajectory,
+};
 
 fn workspace_dir(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
@@ -331,4 +334,210 @@ fn unknown_key_in_an_inline_table_points_at_its_column() {
         (err.line(), err.column()),
         (line, inline.find("wire").unwrap() + 1)
     );
+}
+
+// ------------------------------------------------- [trajectory], [controller]
+
+/// The paper's design (perfect-tracking-soft-landing §4–5).
+const TRAJECTORY: &str = r#"
+[trajectory]
+operations = ["closing", "opening"]
+takeoff = 1e-3
+landing = 6e-3
+shape = "energy-optimal"
+u_bound = 20.0
+"#;
+
+const CONTROLLER: &str = r#"
+[controller]
+law = "feedback-linearization"
+settling_time = 1e-3
+sample_period = 1e-5
+"#;
+
+/// `example` with `sections` appended, parsed.
+fn with_sections(example: &str, sections: &str) -> Description {
+    let text = example_text(example) + sections;
+    parse_str(&text, "design.toml").unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn bundled_examples_have_no_design_sections() {
+    for path in toml_files(&workspace_dir("examples")) {
+        let d = parse_file(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            (d.trajectory, d.controller),
+            (None, None),
+            "{}",
+            path.display()
+        );
+    }
+}
+
+#[test]
+fn both_sections_parse_into_the_expected_values() {
+    let d = with_sections(
+        "perfect-tracking-valve.toml",
+        &format!("{TRAJECTORY}{CONTROLLER}"),
+    );
+    assert_eq!(
+        d.trajectory,
+        Some(Trajectory {
+            operations: vec![Operation::Closing, Operation::Opening],
+            takeoff: 1e-3,
+            landing: 6e-3,
+            shape: Shape::EnergyOptimal,
+            u_bound: 20.0,
+        })
+    );
+    assert_eq!(
+        d.controller,
+        Some(Controller {
+            law: Law::FeedbackLinearization,
+            gains: Gains::SettlingTime(1e-3),
+            sample_period: 1e-5,
+            floats: vec![FloatType::F32, FloatType::F64],
+        }),
+        "float defaults to both"
+    );
+}
+
+#[test]
+fn sections_may_come_in_any_order_and_before_the_physics() {
+    let text = format!("{CONTROLLER}{TRAJECTORY}",);
+    let example = example_text("perfect-tracking-valve.toml");
+    let (head, physics) = example.split_at(example.find("\n[coil]").unwrap());
+    let d = parse_str(&format!("{head}\n{text}{physics}"), "order.toml")
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(d.trajectory.is_some() && d.controller.is_some());
+}
+
+#[test]
+fn trajectory_alone_is_allowed_and_keeps_the_operation_order() {
+    let traj = TRAJECTORY
+        .replace(r#"["closing", "opening"]"#, r#"["opening", "closing"]"#)
+        .replace(r#""energy-optimal""#, r#""polynomial""#);
+    let d = with_sections("perfect-tracking-valve.toml", &traj);
+    let t = d.trajectory.expect("trajectory");
+    assert_eq!(t.operations, [Operation::Opening, Operation::Closing]);
+    assert_eq!(t.shape, Shape::Polynomial);
+    assert_eq!(d.controller, None);
+    let single = TRAJECTORY.replace(r#"["closing", "opening"]"#, r#"["opening"]"#);
+    let d = with_sections("perfect-tracking-valve.toml", &single);
+    assert_eq!(d.trajectory.unwrap().operations, [Operation::Opening]);
+}
+
+#[test]
+fn poles_are_an_alternative_to_the_settling_time() {
+    let poles = CONTROLLER.replace(
+        "settling_time = 1e-3",
+        "poles = [-6296, -5000.5, -7000.0]  # integers accepted",
+    );
+    let d = with_sections(
+        "perfect-tracking-valve.toml",
+        &format!("{TRAJECTORY}{poles}"),
+    );
+    assert_eq!(
+        d.controller.unwrap().gains,
+        Gains::Poles([-6296.0, -5000.5, -7000.0]),
+        "kept in the order given"
+    );
+}
+
+#[test]
+fn float_types_are_stored_sorted() {
+    for (given, stored) in [
+        (r#"["f64", "f32"]"#, vec![FloatType::F32, FloatType::F64]),
+        (r#"["f32", "f64"]"#, vec![FloatType::F32, FloatType::F64]),
+        (r#"["f64"]"#, vec![FloatType::F64]),
+        (r#"["f32"]"#, vec![FloatType::F32]),
+    ] {
+        let controller = format!("{CONTROLLER}float = {given}\n");
+        let d = with_sections(
+            "perfect-tracking-valve.toml",
+            &format!("{TRAJECTORY}{controller}"),
+        );
+        assert_eq!(d.controller.unwrap().floats, stored, "float = {given}");
+    }
+}
+
+#[test]
+fn u_bound_may_reach_u_max_and_the_sample_period_its_limit() {
+    let traj = TRAJECTORY.replace("u_bound = 20.0", "u_bound = 24");
+    let controller = CONTROLLER.replace("sample_period = 1e-5", "sample_period = 5e-4");
+    let d = with_sections(
+        "perfect-tracking-valve.toml",
+        &format!("{traj}{controller}"),
+    );
+    assert_eq!(d.trajectory.unwrap().u_bound, 24.0);
+    assert_eq!(d.controller.unwrap().sample_period, 5e-4);
+}
+
+#[test]
+fn a_unipolar_supply_accepts_a_bound_above_u_min() {
+    let text = example_text("perfect-tracking-valve.toml").replace("u_min = -24.0", "u_min = 0.0");
+    let d = parse_str(&format!("{text}{TRAJECTORY}{CONTROLLER}"), "unipolar.toml")
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(d.trajectory.unwrap().u_bound, 20.0);
+}
+
+#[test]
+fn jiles_atherton_core_takes_no_design_sections() {
+    let text = example_text("jiles-atherton-valve.toml") + TRAJECTORY;
+    let err = parse_str(&text, "ja.toml").expect_err("JA + trajectory");
+    assert_eq!(err.key(), "core.model");
+    assert!(err.message().contains("T⁻¹") && err.message().contains("input-affine"), "{err}");
+    let text = example_text("jiles-atherton-valve.toml") + TRAJECTORY + CONTROLLER;
+    let err = parse_str(&text, "ja.toml").expect_err("JA + controller");
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("model = \"jiles-atherton\""))
+        .unwrap()
+        + 1;
+    assert_eq!(
+        (err.key(), err.line(), err.column()),
+        ("core.model", line, 1)
+    );
+    assert!(err.message().contains("input-affine"), "{err}");
+}
+
+#[test]
+fn design_errors_point_at_their_key() {
+    let controller = CONTROLLER.replace("sample_period = 1e-5", "sample_period = 2e-3");
+    let text = example_text("perfect-tracking-valve.toml") + TRAJECTORY + &controller;
+    let err = parse_str(&text, "ts.toml").expect_err("sample period too long");
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("sample_period"))
+        .unwrap()
+        + 1;
+    assert_eq!(
+        (err.key(), err.line(), err.column()),
+        ("controller.sample_period", line, 1)
+    );
+    assert!(text[err.span().unwrap()].starts_with("sample_period = 2e-3"));
+
+    let traj = TRAJECTORY.replace(r#"["closing", "opening"]"#, r#"["closing", "closing"]"#);
+    let text = example_text("perfect-tracking-valve.toml") + &traj;
+    let err = parse_str(&text, "dup.toml").expect_err("duplicate operation");
+    let row = text
+        .lines()
+        .position(|l| l.starts_with("operations"))
+        .unwrap();
+    let col = text.lines().nth(row).unwrap().rfind("\"closing\"").unwrap() + 1;
+    assert_eq!(
+        (err.key(), err.line(), err.column()),
+        ("trajectory.operations[1]", row + 1, col)
+    );
+}
+
+#[test]
+fn misspelt_design_keys_get_a_suggestion() {
+    use miette::Diagnostic;
+    let controller = CONTROLLER.replace("settling_time", "setling_time");
+    let text = example_text("perfect-tracking-valve.toml") + TRAJECTORY + &controller;
+    let err = parse_str(&text, "typo.toml").expect_err("unknown key");
+    assert_eq!(err.key(), "controller.setling_time");
+    let help = err.help().map(|h| h.to_string());
+    assert_eq!(help.as_deref(), Some("did you mean `settling_time`?"));
 }

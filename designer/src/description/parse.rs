@@ -12,17 +12,35 @@ use toml::de::{DeString, DeTable, DeValue};
 use toml::Spanned;
 
 use super::{
-    Coil, Core, Description, DescriptionError, Drive, Gap, JilesAtherton, Mechanics, Source, Supply,
+    Coil, Controller, Core, Description, DescriptionError, Drive, FloatType, Gains, Gap,
+    JilesAtherton, Law, Mechanics, Operation, Shape, Source, Supply, Trajectory,
 };
 
 type Res<T> = Result<T, DescriptionError>;
 
-const TOP_KEYS: [&str; 6] = ["name", "coil", "gap", "core", "mechanics", "supply"];
+const TOP_KEYS: [&str; 8] = [
+    "name",
+    "coil",
+    "gap",
+    "core",
+    "mechanics",
+    "supply",
+    "trajectory",
+    "controller",
+];
 /// Design sections of later versions: rejected with a clear message for now.
-const RESERVED: [&str; 3] = ["controller", "trajectory", "observer"];
+const RESERVED: [&str; 1] = ["observer"];
 const GAP_MODELS: [&str; 4] = ["linear", "mclyman", "mclyman-fit", "table"];
 const CORE_MODELS: [&str; 3] = ["linear", "saturating", "jiles-atherton"];
 const DRIVES: [&str; 2] = ["voltage", "current"];
+const TRAJECTORY_KEYS: [&str; 5] = ["operations", "takeoff", "landing", "shape", "u_bound"];
+const OPERATIONS: [&str; 2] = ["closing", "opening"];
+const SHAPES: [&str; 2] = ["energy-optimal", "polynomial"];
+const CONTROLLER_KEYS: [&str; 5] = ["law", "settling_time", "poles", "sample_period", "float"];
+const LAWS: [&str; 1] = ["feedback-linearization"];
+const FLOATS: [&str; 2] = ["f32", "f64"];
+/// The motion [takeoff, landing] must last at least this many sample periods.
+const MIN_SAMPLES_PER_MOTION: f64 = 10.0;
 /// Grid size of the fringing-denominator check on (0, z_max].
 const DENOMINATOR_GRID: usize = 1000;
 
@@ -54,12 +72,31 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
     let coil = parse_coil(&root.section("coil")?)?;
     let gap_sect = root.section("gap")?;
     let gap = parse_gap(&gap_sect)?;
-    let core = parse_core(&root.section("core")?)?;
+    let core_sect = root.section("core")?;
+    let core = parse_core(&core_sect)?;
     let mechanics = parse_mechanics(&root.section("mechanics")?)?;
     let supply_sect = root.section("supply")?;
     let supply = parse_supply(&supply_sect)?;
     check_gap_range(&gap_sect, &gap, &mechanics)?;
     check_drive(&supply_sect, &supply, &coil)?;
+    let trajectory_sect = root.opt_section("trajectory")?;
+    let trajectory = trajectory_sect
+        .as_ref()
+        .map(|s| parse_trajectory(s, &supply))
+        .transpose()?;
+    if let (Some(_), Core::JilesAtherton(_)) = (&trajectory, &core) {
+        let msg = "a [trajectory] is designed through the feedback-linearizing coordinates \
+                   (x = T⁻¹(ξ), perfect-tracking-soft-landing eqs. 41–42), which need an \
+                   input-affine model, but the \"jiles-atherton\" core is not: its branch \
+                   δ = sign(dφ/dt) depends on the input u; design on a \"saturating\" or \
+                   \"linear\" core model of the same actuator";
+        return Err(core_sect.err("model", msg, "not input-affine"));
+    }
+    let controller_sect = root.opt_section("controller")?;
+    let controller = controller_sect.as_ref().map(parse_controller).transpose()?;
+    if let (Some(s), Some(c)) = (&controller_sect, &controller) {
+        check_controller(&root, s, c, trajectory.as_ref(), &core_sect, &core)?;
+    }
     let source = Source {
         file_name: file_name.to_string(),
         text: text.to_string(),
@@ -71,8 +108,8 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         core,
         mechanics,
         supply,
-        trajectory: None,
-        controller: None,
+        trajectory,
+        controller,
         source,
     })
 }
@@ -309,7 +346,175 @@ fn parse_supply(s: &Sect) -> Res<Supply> {
     })
 }
 
+fn parse_trajectory(s: &Sect, supply: &Supply) -> Res<Trajectory> {
+    s.check_keys(&TRAJECTORY_KEYS, "in [trajectory]")?;
+    let operations = s
+        .names(
+            "operations",
+            "operation",
+            &OPERATIONS,
+            "at least one operation",
+        )?
+        .ok_or_else(|| {
+            s.missing(
+                "operations",
+                "a non-empty array of \"closing\", \"opening\"",
+            )
+        })?
+        .into_iter()
+        .map(|op| match op {
+            "closing" => Operation::Closing,
+            _ => Operation::Opening,
+        })
+        .collect();
+    let takeoff = s.num("takeoff", Bound::Positive, "s")?;
+    let landing = s.num("landing", Bound::Above("takeoff", takeoff), "s")?;
+    let shape = match s.choice("shape", "trajectory shape", &SHAPES)? {
+        "energy-optimal" => Shape::EnergyOptimal,
+        _ => Shape::Polynomial,
+    };
+    let unit = if supply.drive == Drive::Voltage {
+        "V"
+    } else {
+        "A"
+    };
+    let u_bound = s.num("u_bound", Bound::Positive, unit)?;
+    check_u_bound(s, u_bound, supply, unit)?;
+    Ok(Trajectory {
+        operations,
+        takeoff,
+        landing,
+        shape,
+        u_bound,
+    })
+}
+
+fn parse_controller(s: &Sect) -> Res<Controller> {
+    s.check_keys(&CONTROLLER_KEYS, "in [controller]")?;
+    s.choice("law", "control law", &LAWS)?;
+    let law = Law::FeedbackLinearization; // the only entry of LAWS
+    let gains = parse_gains(s)?;
+    let sample_period = s.num("sample_period", Bound::Positive, "s")?;
+    let mut floats: Vec<FloatType> = s
+        .names("float", "float type", &FLOATS, "at least one float type")?
+        .unwrap_or(FLOATS.to_vec())
+        .into_iter()
+        .map(|f| match f {
+            "f32" => FloatType::F32,
+            _ => FloatType::F64,
+        })
+        .collect();
+    floats.sort();
+    Ok(Controller {
+        law,
+        gains,
+        sample_period,
+        floats,
+    })
+}
+
+/// K of eq. 48: exactly one of `settling_time` and `poles`.
+fn parse_gains(s: &Sect) -> Res<Gains> {
+    let settling = s.opt_num("settling_time", Bound::Positive, "s")?;
+    let poles = s.opt_array("poles", Bound::Negative, "1/s")?;
+    match (settling, poles) {
+        (Some(t), None) => Ok(Gains::SettlingTime(t)),
+        (None, Some(p)) => match <[f64; 3]>::try_from(p.as_slice()) {
+            Ok(poles) => Ok(Gains::Poles(poles)),
+            Err(_) => {
+                let msg = format!(
+                    "expected exactly 3 real closed-loop poles [1/s] (the error dynamics of \
+                     z, v, a is of order 3), found {}",
+                    p.len()
+                );
+                Err(s.err("poles", msg, "needs 3 poles"))
+            }
+        },
+        (Some(_), Some(_)) => Err(s.err(
+            "poles",
+            "give either controller.settling_time or controller.poles, not both \
+             (both define the gains K)",
+            "conflicts with `settling_time`",
+        )),
+        (None, None) => Err(s.missing(
+            "settling_time",
+            "exactly one of controller.settling_time [s] (5 % settling time of a triple \
+             real pole) or controller.poles = [p1, p2, p3] [1/s] (each < 0)",
+        )),
+    }
+}
+
 // ------------------------------------------------------ cross-section checks
+
+/// The trajectory is designed with inputs in [max(u_min, −u_bound), u_bound]:
+/// that interval must lie within the supply and contain positive inputs
+/// (closing needs them), i.e. max(0, u_min) < u_bound ≤ u_max.
+fn check_u_bound(s: &Sect, u_bound: f64, supply: &Supply, unit: &str) -> Res<()> {
+    let (u_min, u_max) = (supply.u_min, supply.u_max);
+    let lower = u_min.max(0.0);
+    if u_bound > lower && u_bound <= u_max {
+        return Ok(());
+    }
+    let found = s
+        .entry("u_bound")
+        .map_or_else(|| u_bound.to_string(), |(_, v)| s.ctx.found(v));
+    let design = "the trajectory is designed with inputs in [max(u_min, -u_bound), u_bound], \
+                  which must lie within the supply and include positive inputs (closing needs \
+                  them)";
+    let msg = if u_max <= 0.0 {
+        format!(
+            "found {found}, but no u_bound can work: supply.u_max = {u_max} gives no positive \
+             input; {design}"
+        )
+    } else if u_bound > u_max {
+        format!(
+            "expected a number in ({lower}, supply.u_max = {u_max}] [{unit}], found {found}: \
+             it exceeds supply.u_max; {design}, leaving the rest to the feedback"
+        )
+    } else {
+        format!(
+            "expected a number in (supply.u_min = {u_min}, {u_max}] [{unit}], found {found}: \
+             with u_bound <= supply.u_min no input is left to design with; {design}"
+        )
+    };
+    Err(s.err("u_bound", msg, "outside the supply"))
+}
+
+fn check_controller(
+    root: &Sect,
+    s: &Sect,
+    c: &Controller,
+    trajectory: Option<&Trajectory>,
+    core_sect: &Sect,
+    core: &Core,
+) -> Res<()> {
+    let Some(t) = trajectory else {
+        let msg = "section [controller] requires a [trajectory] section: the controller tracks \
+                   a reference trajectory, so give [trajectory] (operations, takeoff, landing, \
+                   shape, u_bound)";
+        return Err(root.err("controller", msg, "needs [trajectory]"));
+    };
+    if let Core::JilesAtherton(_) = core {
+        let msg = "the controller law \"feedback-linearization\" requires an input-affine \
+                   model, but the \"jiles-atherton\" core is not: its branch \
+                   δ = sign(dφ/dt) depends on the input u; design on a \"saturating\" or \
+                   \"linear\" core model of the same actuator";
+        return Err(core_sect.err("model", msg, "not input-affine"));
+    }
+    let limit = (t.landing - t.takeoff) / MIN_SAMPLES_PER_MOTION;
+    if c.sample_period > limit {
+        let found = s
+            .entry("sample_period")
+            .map_or_else(|| c.sample_period.to_string(), |(_, v)| s.ctx.found(v));
+        let msg = format!(
+            "expected a number <= (trajectory.landing - trajectory.takeoff)/10 = {limit:e} [s], \
+             found {found}: the motion must span at least 10 sample periods for the sampled \
+             controller to track it"
+        );
+        return Err(s.err("sample_period", msg, "too long for the motion"));
+    }
+    Ok(())
+}
 
 fn check_gap_range(s: &Sect, gap: &Gap, m: &Mechanics) -> Res<()> {
     match gap {
@@ -389,6 +594,7 @@ fn check_drive(s: &Sect, supply: &Supply, coil: &Coil) -> Res<()> {
 enum Bound {
     Any,
     Positive,
+    Negative,
     NonNegative,
     /// In [0, 1].
     Unit,
@@ -403,6 +609,7 @@ impl Bound {
         match self {
             Bound::Any => true,
             Bound::Positive => x > 0.0,
+            Bound::Negative => x < 0.0,
             Bound::NonNegative => x >= 0.0,
             Bound::Unit => (0.0..=1.0).contains(&x),
             Bound::UnitOpen => (0.0..1.0).contains(&x),
@@ -414,6 +621,7 @@ impl Bound {
         match self {
             Bound::Any => "a number".into(),
             Bound::Positive => "a number > 0".into(),
+            Bound::Negative => "a number < 0".into(),
             Bound::NonNegative => "a number >= 0".into(),
             Bound::Unit => "a number in [0, 1]".into(),
             Bound::UnitOpen => "a number in [0, 1)".into(),
@@ -594,6 +802,68 @@ impl<'a> Sect<'a> {
         })
     }
 
+    /// The optional sub-table `name` of the root.
+    fn opt_section(&self, name: &'a str) -> Res<Option<Sect<'a>>> {
+        if self.entry(name).is_none() {
+            return Ok(None);
+        }
+        self.section(name).map(Some)
+    }
+
+    /// An optional, non-empty array of distinct strings among `allowed`, in
+    /// the order given.
+    fn names(
+        &self,
+        key: &str,
+        what: &str,
+        allowed: &[&'static str],
+        at_least: &str,
+    ) -> Res<Option<Vec<&'static str>>> {
+        let Some((_, value)) = self.entry(key) else {
+            return Ok(None);
+        };
+        let list = quoted_list(allowed);
+        let Some(items) = value.get_ref().as_array() else {
+            let msg = format!(
+                "expected an array of strings among {list}, found {}",
+                self.ctx.found(value)
+            );
+            return Err(self.err(key, msg, "expected an array"));
+        };
+        if items.is_empty() {
+            let msg = format!("expected a non-empty array ({at_least}) among {list}, found []");
+            return Err(self.err(key, msg, "empty"));
+        }
+        let full = self.full_key(key);
+        let mut out: Vec<&'static str> = Vec::with_capacity(items.len());
+        for (i, item) in items.iter().enumerate() {
+            let elem = |msg: String, label: &str| {
+                self.ctx
+                    .err(format!("{full}[{i}]"), item.span(), msg, label)
+            };
+            let Some(text) = item.get_ref().as_str() else {
+                let msg = format!(
+                    "expected a string, one of {list}, found {}",
+                    self.ctx.found(item)
+                );
+                return Err(elem(msg, "expected a string"));
+            };
+            let Some(name) = allowed.iter().find(|a| **a == text) else {
+                let msg = format!("unknown {what} \"{text}\"; expected one of {list}");
+                return Err(elem(msg, &format!("unknown {what}")));
+            };
+            if let Some(first) = out.iter().position(|o| o == name) {
+                let msg = format!(
+                    "duplicate {what} \"{text}\" (already given as {full}[{first}]); each may \
+                     appear once"
+                );
+                return Err(elem(msg, "duplicate"));
+            }
+            out.push(name);
+        }
+        Ok(Some(out))
+    }
+
     /// Rejects keys not in `allowed`, reporting the first in document order.
     fn check_keys(&self, allowed: &[&str], context: &str) -> Res<()> {
         let unknown = self
@@ -635,11 +905,7 @@ impl<'a> Sect<'a> {
 
     /// A required string among `allowed`.
     fn choice(&self, key: &str, what: &str, allowed: &[&'static str]) -> Res<&'static str> {
-        let list = allowed
-            .iter()
-            .map(|a| format!("\"{a}\""))
-            .collect::<Vec<_>>()
-            .join(", ");
+        let list = quoted_list(allowed);
         let Some((_, value)) = self.entry(key) else {
             return Err(self.missing(key, &format!("one of {list}")));
         };
@@ -716,6 +982,15 @@ impl<'a> Sect<'a> {
         }
         Ok(())
     }
+}
+
+/// `"a", "b", "c"`.
+fn quoted_list(allowed: &[&str]) -> String {
+    allowed
+        .iter()
+        .map(|a| format!("\"{a}\""))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The allowed key nearest to a misspelt one (at most 2 edits away).
