@@ -20,16 +20,23 @@
 //! | `format.rs` | `prettyplease` formatting and `//` comments |
 //! | `error.rs` | [`EmitError`] |
 
+mod controller;
 mod emit;
 mod error;
 mod float;
 mod format;
+mod header;
 mod lower;
 mod names;
 mod plan;
 
+pub use controller::{
+    emit_controller, gains, triple_pole_settling_product, ControllerError, ControllerInput,
+    OperationTable,
+};
 pub use emit::{emit_function, emit_params, function_tokens, params_tokens, FunctionSpec, Param};
 pub use error::EmitError;
 pub use float::Float;
 pub use format::format_items;
+pub use header::{sha256_hex, Header};
 pub use names::const_name;

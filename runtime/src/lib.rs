@@ -148,6 +148,28 @@ pub fn saturate_f32(u: f32, lo: f32, hi: f32) -> f32 {
     saturate(u as f64, lo as f64, hi as f64) as f32
 }
 
+/// One sample of the measured state of a single-coil actuator: position z
+/// [m], velocity v [m/s] and magnetic flux φ [Wb] (the state of the
+/// reluctance model; perfect-tracking-soft-landing assumes all three are
+/// measured).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Measurement<F> {
+    pub z: F,
+    pub v: F,
+    pub phi: F,
+}
+
+/// A discrete-time controller as emitted by reldesign: called once per
+/// sample period with the time `t` [s] and the measurement, it returns the
+/// input u (coil voltage or current), already saturated to the supply limits.
+///
+/// Implementations are allocation-free and panic-free; non-finite
+/// measurements give a finite, saturated input.
+pub trait Controller<F> {
+    /// The input to apply from `t` until the next sample.
+    fn step(&mut self, t: F, y: &Measurement<F>) -> F;
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

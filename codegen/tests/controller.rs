@@ -1,0 +1,484 @@
+//! The emitted controller: gains, determinism, one changed line per changed
+//! parameter, compilation as a `#![no_std]` crate under clippy's panic lints
+//! (f64 and f32), the law against the designer's tape, and finite saturated
+//! outputs at φ = 0, z = 0 and NaN inputs.
+//!
+//! The check crate is written under the workspace's
+//! `target/codegen-check-controller/` and built in the target dir of
+//! `compiled.rs` (`target/codegen-check-target/`).
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use codegen::{emit_controller, gains, ControllerInput, Float, OperationTable};
+use designer::description::{parse_str, Gains, Operation};
+use designer::design::{Flat, Linearization, Polynomial, Reference, Segments};
+use designer::model::Model;
+use designer::sym::{Id, Tape};
+
+const VALVE: &str = "../examples/perfect-tracking-valve.toml";
+const T0: f64 = 1e-3;
+const TF: f64 = 6e-3;
+
+fn valve_text() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(VALVE)).unwrap()
+}
+
+/// The quintic z0 → zf of (52)–(53) as one exact table segment.
+fn quintic_reference(z0: f64, zf: f64) -> (Polynomial, Segments) {
+    let p = Polynomial {
+        z0,
+        zf,
+        t0: T0,
+        tf: TF,
+    };
+    let h = TF - T0;
+    // s'''(0) = s'''(1) = 60: the jerk at both ends of the quintic
+    let jerk = 60.0 * (zf - z0) / (h * h * h);
+    let at_t0 = Flat {
+        z: z0,
+        v: 0.0,
+        a: 0.0,
+        jerk,
+    };
+    let seg = Segments::segment(T0, h, at_t0, 0.0, jerk);
+    let s = Segments {
+        segments: vec![seg],
+        end: TF,
+        z_start: z0,
+        z_end: zf,
+    };
+    (p, s)
+}
+
+struct Valve {
+    model: Model,
+    lin: Linearization,
+    segments: Segments,
+    opening: Segments,
+    polynomial: Polynomial,
+    text: String,
+}
+
+fn valve(text: &str) -> Valve {
+    let d = parse_str(text, VALVE).unwrap_or_else(|e| panic!("{e}"));
+    let mut model = Model::build(&d);
+    let lin = Linearization::derive(&mut model).unwrap();
+    let (z_min, z_max) = (d.mechanics.z_min, d.mechanics.z_max);
+    let (polynomial, segments) = quintic_reference(z_max, z_min);
+    let (_, opening) = quintic_reference(z_min, z_max);
+    Valve {
+        model,
+        lin,
+        segments,
+        opening,
+        polynomial,
+        text: text.to_owned(),
+    }
+}
+
+fn emit(v: &Valve, floats: &[Float]) -> String {
+    emit_ops(v, floats, false)
+}
+
+/// The closing controller, with the opening one too if `both`.
+fn emit_ops(v: &Valve, floats: &[Float], both: bool) -> String {
+    let d = &v.model.description;
+    let s = &v.model.states;
+    let input = ControllerInput {
+        name: &d.name,
+        graph: &v.model.graph,
+        params: v.model.params.iter().collect(),
+        states: [s[0], s[1], s[2]],
+        linearization: &v.lin,
+        gains: gains(&Gains::SettlingTime(1e-3)),
+        sample_period: 1e-5,
+        u_min: d.supply.u_min,
+        u_max: d.supply.u_max,
+        takeoff: T0,
+        landing: TF,
+        operations: vec![OperationTable {
+            operation: Operation::Closing,
+            z0: d.mechanics.z_max,
+            zf: d.mechanics.z_min,
+            segments: &v.segments,
+        }]
+        .into_iter()
+        .chain(both.then_some(OperationTable {
+            operation: Operation::Opening,
+            z0: d.mechanics.z_min,
+            zf: d.mechanics.z_max,
+            segments: &v.opening,
+        }))
+        .collect(),
+        floats: floats.to_vec(),
+        source_file: "perfect-tracking-valve.toml",
+        source_text: &v.text,
+        generator_version: env!("CARGO_PKG_VERSION"),
+    };
+    emit_controller(&input).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn gains_from_settling_time_and_poles() {
+    // "a 1 ms 5 % settling time of the triple pole is λ ≈ 6296 s⁻¹"
+    let [k1, k2, k3] = gains(&Gains::SettlingTime(1e-3));
+    let lambda = k3 / 3.0;
+    assert!((lambda - 6295.8).abs() < 0.05, "λ = {lambda}");
+    assert!((k2 - 3.0 * lambda * lambda).abs() <= 1e-9 * k2);
+    assert!((k1 - lambda.powi(3)).abs() <= 1e-9 * k1);
+    // the step response of the triple pole is at 95 % at t_s
+    let x: f64 = lambda * 1e-3;
+    assert!(((-x).exp() * (1.0 + x + x * x / 2.0) - 0.05).abs() < 1e-12);
+    // (s + 1)(s + 2)(s + 3) = s³ + 6s² + 11s + 6
+    assert_eq!(gains(&Gains::Poles([-1.0, -2.0, -3.0])), [6.0, 11.0, 6.0]);
+}
+
+#[test]
+fn the_table_reproduces_the_quintic() {
+    let v = valve(&valve_text());
+    for k in 0..=50 {
+        let t = T0 + (TF - T0) * k as f64 / 50.0;
+        let seg = &v.segments.segments[0];
+        let got = Segments::eval_segment(seg, t - seg[0]);
+        let want = v.polynomial.at(t);
+        assert!((got.z - want.z).abs() < 1e-15, "z at {t}");
+        assert!((got.v - want.v).abs() < 1e-12, "v at {t}");
+        assert!((got.a - want.a).abs() < 1e-8 * 240.0, "a at {t}");
+    }
+}
+
+#[test]
+fn output_is_byte_identical_across_runs() {
+    let text = valve_text();
+    let floats = [Float::F64, Float::F32];
+    assert_eq!(emit(&valve(&text), &floats), emit(&valve(&text), &floats));
+}
+
+#[test]
+fn one_parameter_change_is_one_params_line_and_the_hash_line() {
+    let text = valve_text();
+    let changed = text.replacen("resistance = 75.0", "resistance = 80.5", 1);
+    assert_ne!(text, changed);
+    let floats = [Float::F64, Float::F32];
+    let (a, b) = (
+        emit(&valve(&text), &floats),
+        emit(&valve(&changed), &floats),
+    );
+    let (la, lb): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
+    assert_eq!(la.len(), lb.len());
+    let diff: Vec<(&str, &str)> = la
+        .iter()
+        .zip(&lb)
+        .filter(|(x, y)| x != y)
+        .map(|(x, y)| (*x, *y))
+        .collect();
+    assert_eq!(diff.len(), 2, "{diff:#?}");
+    assert!(diff[0].0.starts_with("// source sha256: "), "{diff:?}");
+    assert_eq!(
+        diff[1],
+        (
+            "        pub const R: $f = 75.0;",
+            "        pub const R: $f = 80.5;"
+        )
+    );
+}
+
+#[test]
+fn header_and_sections_are_there() {
+    let text = valve_text();
+    let code = emit(&valve(&text), &[Float::F64, Float::F32]);
+    let hash = codegen::sha256_hex(&text);
+    assert!(code.starts_with("// @generated by reldesign-codegen "));
+    assert!(code.contains("DO NOT EDIT"));
+    assert!(code.contains(&format!("// source sha256: {hash}\n")));
+    assert!(code.contains("macro_rules! params"));
+    for needle in [
+        "pub mod f64 {",
+        "pub mod f32 {",
+        "pub fn law(",
+        "pub fn guarded_law(",
+        "pub const REFERENCE_CLOSING: [[f64; 7]; 1]",
+        "pub const REFERENCE_CLOSING: [[f32; 7]; 1]",
+        "pub struct Controller",
+        "// (50) u = α + β·w",
+    ] {
+        assert!(code.contains(needle), "missing {needle}");
+    }
+    for forbidden in [
+        ".unwrap()",
+        ".expect(",
+        "panic!",
+        " as f",
+        " as usize",
+        "unsafe",
+    ] {
+        assert!(
+            !code.contains(forbidden),
+            "emitted code contains {forbidden}"
+        );
+    }
+}
+
+fn workspace_target() -> PathBuf {
+    match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(t) => PathBuf::from(t),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../target"),
+    }
+}
+
+fn write_if_changed(path: &Path, text: &str) {
+    if std::fs::read_to_string(path).ok().as_deref() != Some(text) {
+        std::fs::write(path, text).unwrap();
+    }
+}
+
+fn cargo(dir: &Path, args: &[&str]) -> std::process::Output {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo)
+        .args(args)
+        .current_dir(dir)
+        .env(
+            "CARGO_TARGET_DIR",
+            workspace_target().join("codegen-check-target"),
+        )
+        .env_remove("RUSTFLAGS")
+        .env_remove("CARGO_ENCODED_RUSTFLAGS")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "cargo {args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// States x = [z, v, φ] in D₀⁺ and references [z_r, v_r, a_r, j_r].
+fn law_points() -> Vec<[f64; 7]> {
+    (0..8)
+        .map(|k| {
+            let f = (k as f64 + 0.5) / 8.0;
+            [
+                1e-3 * (0.05 + 0.9 * f),
+                0.3 * (3.7 * f).sin(),
+                2e-6 + 1.5e-5 * f,
+                1e-3 * (0.9 - 0.8 * f),
+                -0.2 * f,
+                50.0 * (2.1 * f).cos(),
+                -3e5 * (1.0 - 2.0 * f),
+            ]
+        })
+        .collect()
+}
+
+/// α + β·(K·(ξ_r − T(x)) + j_r) by the designer's tape, parameters bound.
+fn law_by_tape(v: &mut Valve, k: [f64; 3], points: &[[f64; 7]]) -> Vec<f64> {
+    let g = &mut v.model.graph;
+    let refs: Vec<Id> = ["t_zr", "t_vr", "t_ar", "t_jr"]
+        .iter()
+        .map(|n| g.symbol(n))
+        .collect();
+    let mut terms = Vec::new();
+    for i in 0..3 {
+        let e = g.sub(refs[i], v.lin.transform[i]);
+        terms.push(g.scale(k[i], e));
+    }
+    terms.push(refs[3]);
+    let w = g.sum(&terms);
+    let bw = g.mul(v.lin.beta, w);
+    let u = g.add(v.lin.alpha, bw);
+    let map: HashMap<Id, Id> = v
+        .model
+        .params
+        .iter()
+        .map(|(_, id, val)| (id, g.constant(val)))
+        .collect();
+    let bound = g.substitute_all(&[u], &map);
+    let s = &v.model.states;
+    let inputs = [s[0], s[1], s[2], refs[0], refs[1], refs[2], refs[3]];
+    let tape = Tape::compile(g, &inputs, &bound).unwrap();
+    points
+        .iter()
+        .map(|p| {
+            let mut out = [0.0];
+            tape.eval(p, &mut tape.scratch(), &mut out);
+            out[0]
+        })
+        .collect()
+}
+
+/// (t, z, v, φ) of the robustness checks: φ = 0, z = 0, NaN, ±∞, every stage.
+fn edge_points() -> Vec<[f64; 4]> {
+    let nan = f64::NAN;
+    let inf = f64::INFINITY;
+    let mut pts = Vec::new();
+    for t in [0.0, 0.5e-3, 2e-3, 4e-3, 7e-3, nan] {
+        for (z, v, phi) in [
+            (1e-3, 0.0, 0.0),
+            (0.0, 0.0, 0.0),
+            (0.0, 0.0, 1e-5),
+            (0.0, 0.0, -1e-5),
+            (5e-4, -0.1, 1e-5),
+            (nan, 0.0, 1e-5),
+            (5e-4, nan, 1e-5),
+            (5e-4, 0.0, nan),
+            (nan, nan, nan),
+            (inf, -inf, inf),
+            (-1e-4, 0.0, 1e-5),
+        ] {
+            pts.push([t, z, v, phi]);
+        }
+    }
+    pts
+}
+
+#[test]
+fn emitted_controller_compiles_passes_clippy_and_matches_the_tape() {
+    let mut v = valve(&valve_text());
+    let code = emit_ops(&v, &[Float::F64, Float::F32], true);
+    let dir = workspace_target().join("codegen-check-controller");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let runtime = root.join("runtime").canonicalize().unwrap();
+    std::fs::create_dir_all(dir.join("src")).unwrap();
+    let manifest = format!(
+        "[package]\nname = \"codegen-check-controller\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n\
+         [dependencies]\nreldesign-runtime = {{ path = {:?} }}\n\n[workspace]\n",
+        runtime.display().to_string()
+    );
+    write_if_changed(&dir.join("Cargo.toml"), &manifest);
+    if let Ok(lock) = std::fs::read_to_string(root.join("Cargo.lock")) {
+        if !dir.join("Cargo.lock").exists() {
+            std::fs::write(dir.join("Cargo.lock"), lock).unwrap();
+        }
+    }
+    write_if_changed(
+        &dir.join("src/lib.rs"),
+        "//! Emitted by codegen/tests/controller.rs.\n#![no_std]\n#![forbid(unsafe_code)]\n\npub mod valve;\n",
+    );
+    write_if_changed(&dir.join("src/valve.rs"), &code);
+
+    let points = law_points();
+    let edges = edge_points();
+    let mut main = String::from("use codegen_check_controller::valve;\n\nfn main() {\n");
+    for module in ["f64", "f32"] {
+        for p in &points {
+            let a: Vec<String> = p.iter().map(|x| format!("{x:?}")).collect();
+            writeln!(
+                main,
+                "    println!(\"{{:?}}\", valve::{module}::law({}));",
+                a.join(", ")
+            )
+            .unwrap();
+        }
+        writeln!(
+            main,
+            "    let mut c = valve::{module}::Controller::new(valve::{module}::Operation::Closing);\n    c.start(0.0);"
+        )
+        .unwrap();
+        for e in &edges {
+            let a: Vec<String> = e
+                .iter()
+                .map(|x| format!("{module}::from({}f32)", x))
+                .collect();
+            let a: Vec<String> = a
+                .into_iter()
+                .map(|s| {
+                    s.replace("NaNf32", "f32::NAN")
+                        .replace("-inff32", "f32::NEG_INFINITY")
+                        .replace("inff32", "f32::INFINITY")
+                })
+                .collect();
+            writeln!(main, "    println!(\"{{:?}}\", c.step({}));", a.join(", ")).unwrap();
+        }
+        for k in 0..=20 {
+            let t = 7e-3 * k as f64 / 20.0;
+            writeln!(main, "    println!(\"{{:?}}\", c.reference({t:?}));").unwrap();
+        }
+    }
+    main.push_str("}\n");
+    write_if_changed(&dir.join("src/main.rs"), &main);
+
+    cargo(
+        &dir,
+        &[
+            "clippy",
+            "--offline",
+            "--lib",
+            "--",
+            "-D",
+            "warnings",
+            "-D",
+            "clippy::unwrap_used",
+            "-D",
+            "clippy::expect_used",
+            "-D",
+            "clippy::indexing_slicing",
+            "-D",
+            "clippy::panic",
+            "-D",
+            "clippy::as_conversions",
+        ],
+    );
+    let out = cargo(&dir, &["run", "--offline", "--quiet"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+
+    let k = gains(&Gains::SettlingTime(1e-3));
+    let want = law_by_tape(&mut v, k, &points);
+    for (float, tol) in [("f64", 1e-12), ("f32", 2e-3)] {
+        for (p, w) in points.iter().zip(&want) {
+            let got: f64 = lines.next().unwrap().parse().unwrap();
+            // relative to the size of the terms (u = α + β·w may cancel)
+            let scale = w.abs().max(1.0);
+            assert!(
+                (got - w).abs() <= tol * scale,
+                "{float} law at {p:?}: emitted {got:e}, tape {w:e}"
+            );
+        }
+        for e in &edges {
+            let got: f64 = lines.next().unwrap().parse().unwrap();
+            assert!(
+                got.is_finite() && (-24.0..=24.0).contains(&got),
+                "{float} step at {e:?} = {got}"
+            );
+            let [t, z, _, phi] = *e;
+            if t < T0 && phi == 0.0 && z.is_finite() {
+                assert_eq!(got, 24.0, "{float}: the guard at φ = 0 commands u_max");
+            }
+            if t > TF && z == 0.0 && phi != 0.0 && phi.is_finite() {
+                assert_eq!(
+                    got,
+                    24.0 * phi.signum(),
+                    "{float}: expert rule (43) at z_min"
+                );
+            }
+        }
+        for kk in 0..=20 {
+            let t = 7e-3 * kk as f64 / 20.0;
+            let line = lines.next().unwrap();
+            let got: Vec<f64> = line
+                .trim_matches(|c| c == '[' || c == ']')
+                .split(", ")
+                .map(|x| x.parse().unwrap())
+                .collect();
+            let r = v.polynomial.at(t);
+            let ztol = if float == "f64" { 1e-15 } else { 1e-9 };
+            assert!(
+                (got[0] - r.z).abs() <= ztol,
+                "{float} z_r({t}) = {} vs {}",
+                got[0],
+                r.z
+            );
+            assert!(
+                (got[1] - r.v).abs() <= 1e3 * ztol,
+                "{float} v_r({t}) = {} vs {}",
+                got[1],
+                r.v
+            );
+        }
+    }
+    assert!(lines.next().is_none());
+}
