@@ -4,6 +4,7 @@
 //! never a panic or a backtrace.
 
 mod atomic;
+mod build;
 mod check;
 mod eval;
 mod plot;
@@ -42,6 +43,8 @@ enum Command {
     },
     /// Replay an input through the hybrid model from rest at z_max.
     Simulate(simulate::Args),
+    /// Design the soft-landing controller and emit its no_std Rust code.
+    Build(build::Args),
 }
 
 fn main() -> ExitCode {
@@ -55,6 +58,7 @@ fn main() -> ExitCode {
         Command::Check { model } => check::run(&model),
         Command::Eval { model, states } => eval::run(&model, &states),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Build(args) => build::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -20,6 +20,7 @@
 //! | `format.rs` | `prettyplease` formatting and `//` comments |
 //! | `error.rs` | [`EmitError`] |
 
+mod build;
 mod controller;
 mod emit;
 mod error;
@@ -30,6 +31,7 @@ mod lower;
 mod names;
 mod plan;
 
+pub use build::{build_file, compile, operation_name, write_if_changed, BuildError, Design, DesignedOperation};
 pub use controller::{
     emit_controller, gains, triple_pole_settling_product, ControllerError, ControllerInput,
     OperationTable,

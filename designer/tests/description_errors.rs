@@ -95,8 +95,22 @@ fn every_bad_description_is_rejected_with_its_expected_message() {
 }
 
 /// The text of a bundled example, for tests that edit it.
+/// The physics sections of a bundled example (its design sections, and the
+/// comment lines that introduce them, are cut off so tests can add their own).
 fn example_text(name: &str) -> String {
-    std::fs::read_to_string(workspace_dir("examples").join(name)).expect("example exists")
+    let text =
+        std::fs::read_to_string(workspace_dir("examples").join(name)).expect("example exists");
+    let mut lines: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.starts_with("[trajectory]") && !l.starts_with("[controller]"))
+        .collect();
+    while lines
+        .last()
+        .is_some_and(|l| l.starts_with('#') || l.trim().is_empty())
+    {
+        lines.pop();
+    }
+    lines.join("\n") + "\n"
 }
 
 fn example(name: &str) -> Description {
@@ -362,15 +376,26 @@ fn with_sections(example: &str, sections: &str) -> Description {
 }
 
 #[test]
-fn bundled_examples_have_no_design_sections() {
+fn the_perfect_tracking_example_carries_the_papers_design() {
     for path in toml_files(&workspace_dir("examples")) {
         let d = parse_file(&path).unwrap_or_else(|e| panic!("{e}"));
+        let designed = path
+            .file_name()
+            .is_some_and(|n| n == "perfect-tracking-valve.toml");
         assert_eq!(
-            (d.trajectory, d.controller),
-            (None, None),
+            d.trajectory.is_some() && d.controller.is_some(),
+            designed,
             "{}",
             path.display()
         );
+        if designed {
+            let t = d.trajectory.unwrap();
+            assert_eq!(
+                (t.takeoff, t.landing, t.u_bound, t.shape),
+                (1e-3, 6e-3, 20.0, Shape::EnergyOptimal)
+            );
+            assert_eq!(d.controller.unwrap().gains, Gains::SettlingTime(1e-3));
+        }
     }
 }
 
@@ -486,7 +511,10 @@ fn jiles_atherton_core_takes_no_design_sections() {
     let text = example_text("jiles-atherton-valve.toml") + TRAJECTORY;
     let err = parse_str(&text, "ja.toml").expect_err("JA + trajectory");
     assert_eq!(err.key(), "core.model");
-    assert!(err.message().contains("T⁻¹") && err.message().contains("input-affine"), "{err}");
+    assert!(
+        err.message().contains("T⁻¹") && err.message().contains("input-affine"),
+        "{err}"
+    );
     let text = example_text("jiles-atherton-valve.toml") + TRAJECTORY + CONTROLLER;
     let err = parse_str(&text, "ja.toml").expect_err("JA + controller");
     let line = text

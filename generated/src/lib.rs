@@ -1,4 +1,13 @@
-//! Checked-in generated code for the bundled examples, rewritten by
-//! `UPDATE_GENERATED=1 cargo test` and checked for staleness by a test.
-//! Filled by the soft-landing pipeline (issue 3).
+//! Checked-in controller code for the bundled examples that carry
+//! `[trajectory]` and `[controller]` sections, exactly as `reldesign build`
+//! emits it. `tests/fresh.rs` regenerates every module and fails when one is
+//! stale; `UPDATE_GENERATED=1 cargo test -p reldesign-generated` rewrites them.
+//!
+//! This crate is `no_std` and depends only on the runtime, like a firmware
+//! crate using the generated code would.
 #![no_std]
+#![forbid(unsafe_code)]
+
+/// `examples/perfect-tracking-valve.toml`: the valve of
+/// perfect-tracking-soft-landing Table 1 with the paper's design.
+pub mod perfect_tracking_valve;

@@ -87,11 +87,14 @@ struct Tracker {
     condition: Condition,
     /// +1: the value must stay ≤ bound; −1: ≥ bound.
     sense: f64,
+    /// Excess tolerated as round-off: an energy-optimal reference rides
+    /// exactly on its input bound.
+    slack: f64,
     worst_margin: f64,
 }
 
 impl Tracker {
-    fn new(name: &'static str, bound: f64, sense: f64) -> Tracker {
+    fn new(name: &'static str, bound: f64, sense: f64, slack: f64) -> Tracker {
         Tracker {
             condition: Condition {
                 name,
@@ -101,6 +104,7 @@ impl Tracker {
                 bound,
             },
             sense,
+            slack,
             worst_margin: f64::NEG_INFINITY,
         }
     }
@@ -117,7 +121,7 @@ impl Tracker {
             self.condition.worst_t = t;
             self.condition.worst_value = value;
         }
-        if excess > 0.0 {
+        if excess > self.slack {
             let (a, _) = self.condition.violated.unwrap_or((t, t));
             self.condition.violated = Some((a, t));
         }
@@ -141,16 +145,19 @@ pub fn check(
         Core::Saturating { phi_sat, .. } => phi_sat,
         _ => f64::INFINITY,
     };
-    let mut z_low = Tracker::new("(57) z_r ≥ z_min", mech.z_min, -1.0);
-    let mut z_high = Tracker::new("(57) z_r ≤ z_max", mech.z_max, 1.0);
+    let stroke_slack = 1e-9 * (mech.z_max - mech.z_min);
+    let input_slack = 1e-6 * u_bounds.0.abs().max(u_bounds.1.abs()).max(1.0);
+    let mut z_low = Tracker::new("(57) z_r ≥ z_min", mech.z_min, -1.0, stroke_slack);
+    let mut z_high = Tracker::new("(57) z_r ≤ z_max", mech.z_max, 1.0, stroke_slack);
     let mut attract = Tracker::new(
         "(56) φ_r² > 0 (the magnetic force only attracts)",
         0.0,
         -1.0,
+        0.0,
     );
-    let mut saturation = Tracker::new("(56) φ_r² < φ_sat²", phi_sat * phi_sat, 1.0);
-    let mut u_high = Tracker::new("(54) α + β·z⁽³⁾ ≤ u_max", u_bounds.1, 1.0);
-    let mut u_low = Tracker::new("(54) α + β·z⁽³⁾ ≥ u_min", u_bounds.0, -1.0);
+    let mut saturation = Tracker::new("(56) φ_r² < φ_sat²", phi_sat * phi_sat, 1.0, 0.0);
+    let mut u_high = Tracker::new("(54) α + β·z⁽³⁾ ≤ u_max", u_bounds.1, 1.0, input_slack);
+    let mut u_low = Tracker::new("(54) α + β·z⁽³⁾ ≥ u_min", u_bounds.0, -1.0, input_slack);
     let (t0, tf) = reference.motion();
     let (mut flux_range, mut input_range) = (
         (f64::INFINITY, f64::NEG_INFINITY),

@@ -11,6 +11,7 @@
 
 mod bvp;
 mod feasibility;
+mod fit_segments;
 mod lie;
 mod linearization;
 mod optimal;
@@ -22,6 +23,10 @@ pub use bvp::{
     BvpSolution,
 };
 pub use feasibility::{check as check_feasibility, Condition, Feasibility};
+pub use fit_segments::{
+    fit_segments, knot_jumps, table_errors, FitError, SegmentFit, SegmentTolerance, Signal,
+    Signals, TableErrors, ACCEPT,
+};
 pub use lie::{lie, vanishing_factors, AffineSystem, OutputDerivatives};
 pub use linearization::{DesignError, Linearization};
 pub use optimal::{

@@ -1,0 +1,53 @@
+//! The checked-in generated code is what `reldesign build` emits today
+//! (rust-analyzer style): regenerates every module from its example and fails
+//! when one is stale. `UPDATE_GENERATED=1` rewrites stale files instead.
+
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Examples with design sections, and the module each one generates.
+fn designed_examples() -> Vec<(PathBuf, String)> {
+    let mut out = Vec::new();
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(root().join("examples"))
+        .expect("examples/")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    for path in paths {
+        let d = designer::description::parse_file(&path).unwrap_or_else(|e| panic!("{e}"));
+        if d.trajectory.is_some() && d.controller.is_some() {
+            out.push((path, d.name));
+        }
+    }
+    out
+}
+
+#[test]
+fn generated_code_is_fresh() {
+    let update = std::env::var_os("UPDATE_GENERATED").is_some_and(|v| v == "1");
+    let lib = std::fs::read_to_string(root().join("generated/src/lib.rs")).expect("lib.rs");
+    let mut stale = Vec::new();
+    let designed = designed_examples();
+    assert!(!designed.is_empty(), "no example carries design sections");
+    for (example, name) in designed {
+        let (_, code) = codegen::build_file(&example).unwrap_or_else(|e| panic!("{e}"));
+        let target = root().join("generated/src").join(format!("{name}.rs"));
+        if std::fs::read_to_string(&target).ok().as_deref() != Some(code.as_str()) {
+            if update {
+                codegen::write_if_changed(&target, &code).unwrap_or_else(|e| panic!("{e}"));
+                eprintln!("updated {}", target.display());
+            } else {
+                stale.push(target.display().to_string());
+            }
+        }
+        assert!(
+            lib.contains(&format!("pub mod {name};")),
+            "generated/src/lib.rs does not declare `pub mod {name};`"
+        );
+    }
+    assert!(stale.is_empty(), "stale generated code: {stale:?}\nrun `UPDATE_GENERATED=1 cargo test -p reldesign-generated` and commit the result");
+}
