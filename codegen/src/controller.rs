@@ -21,10 +21,14 @@
 //!   law brings ξ₃ = a(x) to 0, i.e. the forces into balance at takeoff;
 //! - on [t₀, t_f]: ξ_r, j_r from the table, the segment cursor advanced
 //!   monotonically (lookup with `.get()`);
-//! - after t_f: ξ_r = [z_f, 0, 0], and the expert rules of
-//!   model-free-sliding-mode-soft-landing (43) once the armature is at its
-//!   end stop (within `LANDED_BAND`): closing → u = u_max·sgn φ (holds it
-//!   closed; sgn 0 taken as +1), opening → u = 0;
+//! - after t_f: ξ_r = [z_f + (z_f − z₀)·PRESS, 0, 0], a reference just beyond
+//!   the end stop (10⁻⁶ of the stroke), so the loop closes whatever gap the
+//!   tracking error left gently (at about λ·gap, tens of µm/s) and the
+//!   contact is certain; then, once the armature is at its end stop (within
+//!   `LANDED_BAND`, 10⁻⁹ of the stroke: contact, not proximity — switching to
+//!   full voltage a few nm early would slam it in), the expert rules of
+//!   model-free-sliding-mode-soft-landing (43): closing → u = u_max·sgn φ
+//!   (holds it closed; sgn 0 taken as +1), opening → u = 0;
 //! - guard at φ → 0: where φ ≤ `PHI_GUARD` (10⁻³ of the smallest flux the
 //!   reference needs, rounded down to one significant digit) the law is not
 //!   evaluated and u = u_max drives the flux into D₀⁺ = {φ > 0};
@@ -56,7 +60,9 @@ const SETTLING_FRACTION: f64 = 0.05;
 const GUARD_FRACTION: f64 = 1e-3;
 
 /// Fraction of the stroke within which the armature counts as landed.
-const LANDED_FRACTION: f64 = 1e-3;
+const LANDED_FRACTION: f64 = 1e-9;
+/// The reference after t_f lies this fraction of the stroke beyond the end stop.
+const PRESS_FRACTION: f64 = 1e-6;
 
 /// Reference samples per segment when searching the smallest flux.
 const FLUX_SAMPLES: usize = 64;
@@ -184,6 +190,7 @@ const DESIGN_CONSTS: &[&str] = &[
     "SAMPLE_PERIOD",
     "PHI_GUARD",
     "LANDED_BAND",
+    "PRESS",
     "REFERENCE_CLOSING",
     "REFERENCE_OPENING",
 ];
@@ -534,7 +541,8 @@ fn float_module(
         ("T_LANDING", input.landing, "t_f [s] from the operation's start: end of the motion (51)."),
         ("SAMPLE_PERIOD", input.sample_period, "T_s [s]: call `Controller::step` once per sample period."),
         ("PHI_GUARD", design.phi_guard, "Guard at φ → 0 [Wb]: where φ ≤ PHI_GUARD the law is not evaluated and u = u_max\n(drives the flux into D₀⁺). 10⁻³ of the smallest flux the reference needs, rounded down."),
-        ("LANDED_BAND", design.landed_band, "Distance [m] to the end stop within which the armature counts as landed\n(expert rules after t_f): 10⁻³ of the stroke, rounded down."),
+        ("LANDED_BAND", design.landed_band, "Distance [m] to the end stop within which the armature counts as in contact\n(expert rules after t_f): 10⁻⁹ of the stroke, rounded down."),
+        ("PRESS", PRESS_FRACTION, "After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes\nthe last gap gently and the contact is certain."),
     ];
     let mut items = TokenStream::new();
     for (name, value, doc) in consts {
@@ -719,7 +727,7 @@ fn float_module(
                             None => [z0, 0.0, 0.0, 0.0],
                         }
                     } else if time > T_LANDING {
-                        [zf, 0.0, 0.0, 0.0]
+                        [zf + (zf - z0) * PRESS, 0.0, 0.0, 0.0]
                     } else {
                         // before t₀ (and a NaN time): pre-movement stage
                         [z0, 0.0, 0.0, 0.0]

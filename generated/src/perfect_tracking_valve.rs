@@ -62,9 +62,13 @@ pub mod f32 {
     /// (drives the flux into D₀⁺). 10⁻³ of the smallest flux the reference needs, rounded down.
     pub const PHI_GUARD: f32 = 2e-9;
 
-    /// Distance [m] to the end stop within which the armature counts as landed
-    /// (expert rules after t_f): 10⁻³ of the stroke, rounded down.
-    pub const LANDED_BAND: f32 = 1e-6;
+    /// Distance [m] to the end stop within which the armature counts as in contact
+    /// (expert rules after t_f): 10⁻⁹ of the stroke, rounded down.
+    pub const LANDED_BAND: f32 = 1e-12;
+
+    /// After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes
+    /// the last gap gently and the contact is certain.
+    pub const PRESS: f32 = 1e-6;
 
     /// Reference of the closing motion z_m on [t₀, t_f] (51): one row
     /// [t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;
@@ -935,7 +939,7 @@ pub mod f32 {
                     None => [z0, 0.0, 0.0, 0.0],
                 }
             } else if time > T_LANDING {
-                [zf, 0.0, 0.0, 0.0]
+                [zf + (zf - z0) * PRESS, 0.0, 0.0, 0.0]
             } else {
                 [z0, 0.0, 0.0, 0.0]
             }
@@ -1021,9 +1025,13 @@ pub mod f64 {
     /// (drives the flux into D₀⁺). 10⁻³ of the smallest flux the reference needs, rounded down.
     pub const PHI_GUARD: f64 = 2e-9;
 
-    /// Distance [m] to the end stop within which the armature counts as landed
-    /// (expert rules after t_f): 10⁻³ of the stroke, rounded down.
-    pub const LANDED_BAND: f64 = 1e-6;
+    /// Distance [m] to the end stop within which the armature counts as in contact
+    /// (expert rules after t_f): 10⁻⁹ of the stroke, rounded down.
+    pub const LANDED_BAND: f64 = 1e-12;
+
+    /// After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes
+    /// the last gap gently and the contact is certain.
+    pub const PRESS: f64 = 1e-6;
 
     /// Reference of the closing motion z_m on [t₀, t_f] (51): one row
     /// [t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;
@@ -1911,7 +1919,7 @@ pub mod f64 {
                     None => [z0, 0.0, 0.0, 0.0],
                 }
             } else if time > T_LANDING {
-                [zf, 0.0, 0.0, 0.0]
+                [zf + (zf - z0) * PRESS, 0.0, 0.0, 0.0]
             } else {
                 [z0, 0.0, 0.0, 0.0]
             }
