@@ -3,7 +3,7 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use designer::description::{Core, Description, Drive, Gap};
+use designer::description::{Core, Description, Drive, FloatType, Gains, Gap, Shape};
 use designer::model::{Model, ModelPlant, Statics, SwitchingPoint};
 use miette::Report;
 
@@ -77,6 +77,60 @@ pub fn summary(model: &mut Model, file: &str) -> String {
         let _ = writeln!(
             s,
             "  (Jiles–Atherton core: statics on the anhysteretic curve)"
+        );
+    }
+    s.push_str(&design_text(&d));
+    s
+}
+
+/// The `[trajectory]` and `[controller]` sections, if any.
+fn design_text(d: &Description) -> String {
+    let mut s = String::new();
+    if let Some(t) = &d.trajectory {
+        let ops: Vec<&str> = t
+            .operations
+            .iter()
+            .map(|&o| codegen::operation_name(o))
+            .collect();
+        let shape = match t.shape {
+            Shape::Polynomial => "5th-degree polynomial",
+            Shape::EnergyOptimal => "energy-optimal",
+        };
+        let _ = writeln!(s, "\ntrajectory");
+        let _ = writeln!(
+            s,
+            "  {}; takeoff t0 = {:e} s, landing tf = {:e} s",
+            ops.join(" and "),
+            t.takeoff,
+            t.landing
+        );
+        let _ = writeln!(
+            s,
+            "  shape {shape}, input bound {} (supply [{}, {}])",
+            t.u_bound, d.supply.u_min, d.supply.u_max
+        );
+    }
+    if let Some(c) = &d.controller {
+        let gains = match c.gains {
+            Gains::SettlingTime(ts) => format!("5 % settling time {ts:e} s (triple pole)"),
+            Gains::Poles(p) => format!("poles {p:?} s⁻¹"),
+        };
+        let floats: Vec<&str> = c
+            .floats
+            .iter()
+            .map(|f| if *f == FloatType::F32 { "f32" } else { "f64" })
+            .collect();
+        let _ = writeln!(s, "\ncontroller");
+        let _ = writeln!(s, "  feedback linearization (eq. 50), {gains}");
+        let _ = writeln!(
+            s,
+            "  sample period {:e} s, emitted for {}",
+            c.sample_period,
+            floats.join(" and ")
+        );
+        let _ = writeln!(
+            s,
+            "  `reldesign build` designs the references and emits the code"
         );
     }
     s

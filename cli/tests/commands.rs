@@ -1257,3 +1257,94 @@ fn usage_errors_are_helpful() {
     rd!("eval", "valve.toml").rejected(&["STATES"]);
     rd!("simulate", "valve.toml", "--bogus").rejected(&["--bogus"]);
 }
+
+// ------------------------------------------------------------------ build
+
+/// `build` writes exactly the checked-in generated module, twice the same
+/// bytes, and reports the design on stderr.
+#[test]
+fn build_emits_the_checked_in_module_deterministically() {
+    let dir = TempDir::new("build");
+    let (a, b) = (dir.join("a.rs"), dir.join("b.rs"));
+    let model = example("perfect-tracking-valve.toml");
+    for out in [&a, &b] {
+        let run = exec(&[
+            OsStr::new("build"),
+            model.as_os_str(),
+            OsStr::new("--out"),
+            out.as_os_str(),
+        ]);
+        assert!(run.ok().is_empty(), "the code goes to --out, not stdout");
+        for needle in ["energy-optimal: J =", "reference table:", "(54)", "gains K"] {
+            assert!(
+                run.stderr.contains(needle),
+                "report lacks {needle:?}\n{}",
+                run.context()
+            );
+        }
+    }
+    let code = std::fs::read(&a).unwrap();
+    assert_eq!(
+        code,
+        std::fs::read(&b).unwrap(),
+        "build is not deterministic"
+    );
+    let checked_in = std::fs::read(root().join("generated/src/perfect_tracking_valve.rs")).unwrap();
+    assert_eq!(
+        code, checked_in,
+        "generated/ is stale or build differs from it"
+    );
+    // stdout mode prints the same module
+    let run = exec(&[
+        OsStr::new("build"),
+        model.as_os_str(),
+        OsStr::new("--quiet"),
+    ]);
+    assert_eq!(run.ok().as_bytes(), code.as_slice());
+    assert!(
+        run.stderr.is_empty(),
+        "--quiet prints no report\n{}",
+        run.context()
+    );
+}
+
+/// A description without design sections, and an infeasible design, are
+/// clear errors that write nothing.
+#[test]
+fn build_refuses_what_it_cannot_design() {
+    let dir = TempDir::new("build-bad");
+    let out = dir.join("out.rs");
+    let run = exec(&[
+        OsStr::new("build"),
+        example("semera-valve.toml").as_os_str(),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ]);
+    run.rejected(&[
+        "semera-valve.toml",
+        "nothing to build",
+        "[trajectory]",
+        "[controller]",
+    ]);
+    assert!(!out.exists());
+    // The paper's valve with a 5th-degree polynomial within ±20 V: the closing
+    // needs 24.5 V right after takeoff (Fig. 5's saturation).
+    let text = std::fs::read_to_string(example("perfect-tracking-valve.toml"))
+        .unwrap()
+        .replace("shape = \"energy-optimal\"", "shape = \"polynomial\"");
+    let model = dir.join("polynomial.toml");
+    std::fs::write(&model, text).unwrap();
+    let run = exec(&[
+        OsStr::new("build"),
+        model.as_os_str(),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ]);
+    run.rejected(&[
+        "polynomial.toml",
+        "closing reference is infeasible",
+        "FAIL (54)",
+        "longer motion",
+    ]);
+    assert!(!out.exists());
+}
