@@ -205,6 +205,7 @@ pub fn function_tokens(
         }
 
         #fn_doc
+        #[inline]
         #[must_use]
         #allow
         pub fn #fn_name(#(#args),*) -> #out_ty {

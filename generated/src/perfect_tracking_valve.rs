@@ -759,6 +759,7 @@ pub mod f32 {
     /// The terms of the tracking law (50) at the state x = [z, v, φ] and the
     /// reference ξ_r = [z_r, v_r, a_r], z_r⁽³⁾ = j_r (not saturated, not guarded:
     /// φ = 0 makes β infinite, see [`guarded_law`]).
+    #[inline]
     #[must_use]
     pub fn law_terms(
         z: f32,
@@ -1738,6 +1739,7 @@ pub mod f64 {
     /// The terms of the tracking law (50) at the state x = [z, v, φ] and the
     /// reference ξ_r = [z_r, v_r, a_r], z_r⁽³⁾ = j_r (not saturated, not guarded:
     /// φ = 0 makes β infinite, see [`guarded_law`]).
+    #[inline]
     #[must_use]
     pub fn law_terms(
         z: f64,

@@ -464,11 +464,17 @@ fn collocation<P: BvpProblem + ?Sized>(
 /// [         A B     ]
 /// [Ba            Bb ]
 /// ```
+///
+/// The buffers are kept across factorizations (Newton iterations and meshes)
+/// so that the hot loop does not allocate; the Householder vectors are stored
+/// column-major so that the dot products of the solve run over contiguous
+/// memory, and the reflections are applied to the work matrix row by row.
+#[derive(Default)]
 struct BlockFactor {
     n: usize,
     m: usize,
-    /// Householder vectors of each interior step: (m−2) × (2n × n), column k
-    /// holds v_k in rows k..2n.
+    /// Householder vectors of each interior step: (m−2) × (n × 2n), column-
+    /// major: vector k occupies `[k * 2n .. (k + 1) * 2n]`, v_k in rows k..2n.
     hv: Vec<f64>,
     /// (m−2) × n.
     beta: Vec<f64>,
@@ -479,115 +485,187 @@ struct BlockFactor {
     /// Final (2n × 2n) LU with row pivots.
     lu: Vec<f64>,
     piv: Vec<usize>,
+    // scratch
+    cw: Vec<f64>,
+    dw: Vec<f64>,
+    /// Work matrix, 2n rows × 3n columns [y₀ | yᵢ | yᵢ₊₁], row-major.
+    w: Vec<f64>,
+    /// Householder coefficients of the 3n columns of `w`.
+    dots: Vec<f64>,
+    v: Vec<f64>,
+    g: Vec<f64>,
+    wr: Vec<f64>,
+    carried: Vec<f64>,
+    z: Vec<f64>,
+    t: Vec<f64>,
 }
 
 struct Singular;
 
+fn resize(v: &mut Vec<f64>, len: usize) {
+    v.clear();
+    v.resize(len, 0.0);
+}
+
 impl BlockFactor {
-    /// `a`, `b`: (m−1) blocks n×n row-major; `ba`, `bb`: n×n.
+    /// Factors into `self`. `a`, `b`: (m−1) blocks n×n row-major; `ba`, `bb`: n×n.
     fn factor(
+        &mut self,
         n: usize,
         m: usize,
         a: &[f64],
         b: &[f64],
         ba: &[f64],
         bb: &[f64],
-    ) -> Result<BlockFactor, Singular> {
+    ) -> Result<(), Singular> {
+        // the common small dimensions get loops of constant length (unrolled,
+        // no bounds checks); the arithmetic is the same in every instance
+        match n {
+            2 => self.factor_n::<2>(n, m, a, b, ba, bb),
+            3 => self.factor_n::<3>(n, m, a, b, ba, bb),
+            4 => self.factor_n::<4>(n, m, a, b, ba, bb),
+            6 => self.factor_n::<6>(n, m, a, b, ba, bb),
+            _ => self.factor_n::<0>(n, m, a, b, ba, bb),
+        }
+    }
+
+    /// Solves J·x = rhs (rhs: (m−1)·n collocation rows, then n bc rows).
+    fn solve(&mut self, rhs: &[f64], x: &mut [f64]) {
+        match self.n {
+            2 => self.solve_n::<2>(rhs, x),
+            3 => self.solve_n::<3>(rhs, x),
+            4 => self.solve_n::<4>(rhs, x),
+            6 => self.solve_n::<6>(rhs, x),
+            _ => self.solve_n::<0>(rhs, x),
+        }
+    }
+
+    /// [`Self::factor`] with n = N when N > 0, else n = `n_rt`.
+    #[allow(clippy::too_many_arguments)]
+    fn factor_n<const N: usize>(
+        &mut self,
+        n_rt: usize,
+        m: usize,
+        a: &[f64],
+        b: &[f64],
+        ba: &[f64],
+        bb: &[f64],
+    ) -> Result<(), Singular> {
+        let n = if N > 0 { N } else { n_rt };
         let nn = n * n;
         let steps = m - 2;
-        let mut f = BlockFactor {
-            n,
-            m,
-            hv: vec![0.0; steps * 2 * nn],
-            beta: vec![0.0; steps * n],
-            r: vec![0.0; steps * nn],
-            c0: vec![0.0; steps * nn],
-            e: vec![0.0; steps * nn],
-            lu: vec![0.0; 4 * nn],
-            piv: vec![0; 2 * n],
-        };
-        // Carried rows W = [C | D] on (y₀, yᵢ).
-        let mut cw = a[..nn].to_vec();
-        let mut dw = b[..nn].to_vec();
-        // Work matrix: 2n rows × 3n cols [y₀ | yᵢ | yᵢ₊₁].
+        let n2 = 2 * n;
         let w3 = 3 * n;
-        let mut w = vec![0.0; 2 * n * w3];
+        self.n = n;
+        self.m = m;
+        // every entry below is written before it is read
+        self.hv.resize(steps * 2 * nn, 0.0);
+        self.beta.resize(steps * n, 0.0);
+        self.r.resize(steps * nn, 0.0);
+        self.c0.resize(steps * nn, 0.0);
+        self.e.resize(steps * nn, 0.0);
+        resize(&mut self.lu, 4 * nn);
+        self.piv.clear();
+        self.piv.resize(n2, 0);
+        resize(&mut self.v, n2);
+        resize(&mut self.w, n2 * w3);
+        // Carried rows W = [C | D] on (y₀, yᵢ).
+        self.cw.clear();
+        self.cw.extend_from_slice(&a[..nn]);
+        self.dw.clear();
+        self.dw.extend_from_slice(&b[..nn]);
+        resize(&mut self.dots, w3);
+        let (cw, dw, w, v, dots) = (
+            &mut self.cw,
+            &mut self.dw,
+            &mut self.w,
+            &mut self.v,
+            &mut self.dots,
+        );
         for st in 0..steps {
             let i = st + 1;
-            w.iter_mut().for_each(|v| *v = 0.0);
+            w.iter_mut().for_each(|x| *x = 0.0);
+            let (ai, bi) = (&a[i * nn..(i + 1) * nn], &b[i * nn..(i + 1) * nn]);
             for r in 0..n {
                 for c in 0..n {
                     w[r * w3 + c] = cw[r * n + c];
                     w[r * w3 + n + c] = dw[r * n + c];
-                    w[(n + r) * w3 + n + c] = a[i * nn + r * n + c];
-                    w[(n + r) * w3 + 2 * n + c] = b[i * nn + r * n + c];
+                    w[(n + r) * w3 + n + c] = ai[r * n + c];
+                    w[(n + r) * w3 + 2 * n + c] = bi[r * n + c];
                 }
             }
             let mut maxnorm: f64 = 0.0;
             for c in 0..n {
-                let s: f64 = (0..2 * n).map(|r| w[r * w3 + n + c].powi(2)).sum();
+                let s: f64 = (0..n2).map(|r| w[r * w3 + n + c].powi(2)).sum();
                 maxnorm = maxnorm.max(s.sqrt());
             }
-            let hv = &mut f.hv[st * 2 * nn..(st + 1) * 2 * nn];
-            let beta = &mut f.beta[st * n..(st + 1) * n];
-            let mut v = vec![0.0; 2 * n];
+            let hv = &mut self.hv[st * 2 * nn..(st + 1) * 2 * nn];
+            let beta = &mut self.beta[st * n..(st + 1) * n];
             for k in 0..n {
                 let col = n + k;
-                let norm: f64 = (k..2 * n)
-                    .map(|r| w[r * w3 + col].powi(2))
-                    .sum::<f64>()
-                    .sqrt();
+                let norm: f64 = (k..n2).map(|r| w[r * w3 + col].powi(2)).sum::<f64>().sqrt();
                 if !(norm > 4.0 * n as f64 * f64::EPSILON * maxnorm) {
                     return Err(Singular);
                 }
                 let x0 = w[k * w3 + col];
                 let alpha = if x0 >= 0.0 { -norm } else { norm };
-                for r in k..2 * n {
+                for r in k..n2 {
                     v[r] = w[r * w3 + col];
                 }
                 v[k] -= alpha;
-                let vv: f64 = (k..2 * n).map(|r| v[r] * v[r]).sum();
+                let vv: f64 = v[k..].iter().map(|x| x * x).sum();
                 let bt = if vv > 0.0 { 2.0 / vv } else { 0.0 };
-                for j in 0..w3 {
-                    if j >= n && j < col {
-                        continue; // already-reduced columns of the yᵢ block
-                    }
-                    let dot: f64 = (k..2 * n).map(|r| v[r] * w[r * w3 + j]).sum();
-                    let g = bt * dot;
-                    if g != 0.0 {
-                        for r in k..2 * n {
-                            w[r * w3 + j] -= g * v[r];
-                        }
+                // w ← (I − bt·v·vᵀ)·w, row by row: every column's dot product
+                // vᵀw_j still sums over the rows in order k..2n, but the
+                // columns are processed side by side (contiguous, vectorizable)
+                let dots = &mut dots[..w3];
+                dots.iter_mut().for_each(|d| *d = 0.0);
+                for r in k..n2 {
+                    let vr = v[r];
+                    let row = &w[r * w3..(r + 1) * w3];
+                    for (d, &q) in dots.iter_mut().zip(row) {
+                        *d += vr * q;
                     }
                 }
-                for r in 0..2 * n {
-                    hv[r * n + k] = if r >= k { v[r] } else { 0.0 };
+                for d in dots.iter_mut() {
+                    *d *= bt;
                 }
+                // the already-reduced columns n..col of the yᵢ block are left alone
+                dots[n..col].iter_mut().for_each(|d| *d = 0.0);
+                for r in k..n2 {
+                    let vr = v[r];
+                    let row = &mut w[r * w3..(r + 1) * w3];
+                    for (q, &g) in row.iter_mut().zip(dots.iter()) {
+                        *q -= g * vr;
+                    }
+                }
+                let hk = &mut hv[k * n2..(k + 1) * n2];
+                hk[..k].iter_mut().for_each(|x| *x = 0.0);
+                hk[k..].copy_from_slice(&v[k..]);
                 beta[k] = bt;
             }
             let base = st * nn;
             for r in 0..n {
                 for c in 0..n {
-                    f.c0[base + r * n + c] = w[r * w3 + c];
-                    f.r[base + r * n + c] = if c >= r { w[r * w3 + n + c] } else { 0.0 };
-                    f.e[base + r * n + c] = w[r * w3 + 2 * n + c];
+                    self.c0[base + r * n + c] = w[r * w3 + c];
+                    self.r[base + r * n + c] = if c >= r { w[r * w3 + n + c] } else { 0.0 };
+                    self.e[base + r * n + c] = w[r * w3 + 2 * n + c];
                     cw[r * n + c] = w[(n + r) * w3 + c];
                     dw[r * n + c] = w[(n + r) * w3 + 2 * n + c];
                 }
             }
         }
         // Final system [[C, D], [Ba, Bb]] on (y₀, y_{m−1}).
-        let n2 = 2 * n;
         for r in 0..n {
             for c in 0..n {
-                f.lu[r * n2 + c] = cw[r * n + c];
-                f.lu[r * n2 + n + c] = dw[r * n + c];
-                f.lu[(n + r) * n2 + c] = ba[r * n + c];
-                f.lu[(n + r) * n2 + n + c] = bb[r * n + c];
+                self.lu[r * n2 + c] = cw[r * n + c];
+                self.lu[r * n2 + n + c] = dw[r * n + c];
+                self.lu[(n + r) * n2 + c] = ba[r * n + c];
+                self.lu[(n + r) * n2 + n + c] = bb[r * n + c];
             }
         }
-        let maxabs = f.lu.iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
-        let lu = &mut f.lu;
+        let maxabs = self.lu.iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
+        let lu = &mut self.lu;
         for k in 0..n2 {
             let (mut p, mut pv) = (k, lu[k * n2 + k].abs());
             for r in k + 1..n2 {
@@ -599,7 +677,7 @@ impl BlockFactor {
             if !(pv > 4.0 * n2 as f64 * f64::EPSILON * maxabs) {
                 return Err(Singular);
             }
-            f.piv[k] = p;
+            self.piv[k] = p;
             if p != k {
                 for c in 0..n2 {
                     lu.swap(k * n2 + c, p * n2 + c);
@@ -616,37 +694,44 @@ impl BlockFactor {
                 }
             }
         }
-        Ok(f)
+        Ok(())
     }
 
-    /// Solves J·x = rhs (rhs: (m−1)·n collocation rows, then n bc rows).
-    fn solve(&self, rhs: &[f64], x: &mut [f64]) {
-        let (n, m) = (self.n, self.m);
+    /// [`Self::solve`] with n = N when N > 0, else n = `self.n`.
+    fn solve_n<const N: usize>(&mut self, rhs: &[f64], x: &mut [f64]) {
+        let n = if N > 0 { N } else { self.n };
+        let m = self.m;
         let nn = n * n;
+        let n2 = 2 * n;
         let steps = m - 2;
-        let mut g = vec![0.0; steps * n];
-        let mut wr = vec![0.0; 2 * n];
-        let mut carried = rhs[..n].to_vec();
+        resize(&mut self.g, steps * n);
+        resize(&mut self.wr, n2);
+        resize(&mut self.t, n);
+        resize(&mut self.z, n2);
+        self.carried.clear();
+        self.carried.extend_from_slice(&rhs[..n]);
+        let (g, wr, carried) = (&mut self.g, &mut self.wr, &mut self.carried);
         for st in 0..steps {
             let i = st + 1;
-            wr[..n].copy_from_slice(&carried);
+            wr[..n].copy_from_slice(carried);
             wr[n..].copy_from_slice(&rhs[i * n..(i + 1) * n]);
             let hv = &self.hv[st * 2 * nn..(st + 1) * 2 * nn];
             for k in 0..n {
                 let bt = self.beta[st * n + k];
-                let dot: f64 = (k..2 * n).map(|r| hv[r * n + k] * wr[r]).sum();
+                let hk = &hv[k * n2 + k..(k + 1) * n2];
+                let wk = &mut wr[k..];
+                let dot: f64 = hk.iter().zip(wk.iter()).map(|(p, q)| p * q).sum();
                 let gm = bt * dot;
-                for r in k..2 * n {
-                    wr[r] -= gm * hv[r * n + k];
+                for (q, p) in wk.iter_mut().zip(hk) {
+                    *q -= gm * p;
                 }
             }
             g[st * n..(st + 1) * n].copy_from_slice(&wr[..n]);
             carried.copy_from_slice(&wr[n..]);
         }
         // Final 2n system.
-        let n2 = 2 * n;
-        let mut z = vec![0.0; n2];
-        z[..n].copy_from_slice(&carried);
+        let z = &mut self.z;
+        z[..n].copy_from_slice(carried);
         z[n..].copy_from_slice(&rhs[(m - 1) * n..m * n]);
         for k in 0..n2 {
             z.swap(k, self.piv[k]);
@@ -668,10 +753,10 @@ impl BlockFactor {
         x[..n].copy_from_slice(&z[..n]);
         x[(m - 1) * n..m * n].copy_from_slice(&z[n..]);
         // Back substitution: R yᵢ = gᵢ − C₀ y₀ − E yᵢ₊₁.
+        let t = &mut self.t;
         for st in (0..steps).rev() {
             let i = st + 1;
             let base = st * nn;
-            let mut t = vec![0.0; n];
             for r in 0..n {
                 let mut s = g[st * n + r];
                 for c in 0..n {
@@ -687,35 +772,58 @@ impl BlockFactor {
                 }
                 t[r] = s / self.r[base + r * n + r];
             }
-            x[i * n..(i + 1) * n].copy_from_slice(&t);
+            x[i * n..(i + 1) * n].copy_from_slice(t);
         }
     }
 }
 
-/// Builds the global Jacobian blocks (scipy's `construct_global_jac`) and factors it.
+/// Buffers of the global Jacobian, kept across Newton iterations and meshes.
+#[derive(Default)]
+struct JacWork {
+    /// ∂f/∂y at the nodes, m × (n × n).
+    jn: Vec<f64>,
+    /// ∂Φᵢ/∂yᵢ, ∂Φᵢ/∂yᵢ₊₁, (m−1) × (n × n).
+    a: Vec<f64>,
+    b: Vec<f64>,
+    jm: Vec<f64>,
+    ba: Vec<f64>,
+    bb: Vec<f64>,
+    fac: BlockFactor,
+}
+
+/// Builds the global Jacobian blocks (scipy's `construct_global_jac`) and
+/// factors it into `w.fac`; Ok(false) when it is singular.
 fn jacobian_factor<P: BvpProblem + ?Sized>(
     ev: &mut Eval<'_, P>,
     x: &[f64],
     y: &[f64],
     c: &Colloc,
-) -> Result<Option<BlockFactor>, BvpError> {
+    w: &mut JacWork,
+) -> Result<bool, BvpError> {
     let n = ev.n;
     let nn = n * n;
     let m = x.len();
-    let mut jn = vec![0.0; m * nn];
+    w.jn.resize(m * nn, 0.0);
+    w.a.resize((m - 1) * nn, 0.0);
+    w.b.resize((m - 1) * nn, 0.0);
+    resize(&mut w.jm, nn);
+    resize(&mut w.ba, nn);
+    resize(&mut w.bb, nn);
     for i in 0..m {
-        ev.jac(x[i], &y[i * n..(i + 1) * n], &mut jn[i * nn..(i + 1) * nn])?;
+        ev.jac(
+            x[i],
+            &y[i * n..(i + 1) * n],
+            &mut w.jn[i * nn..(i + 1) * nn],
+        )?;
     }
-    let mut a = vec![0.0; (m - 1) * nn];
-    let mut b = vec![0.0; (m - 1) * nn];
-    let mut jm = vec![0.0; nn];
+    let jm = &mut w.jm;
     for i in 0..m - 1 {
         let h = x[i + 1] - x[i];
-        ev.jac(x[i] + 0.5 * h, &c.y_mid[i * n..(i + 1) * n], &mut jm)?;
-        let j0 = &jn[i * nn..(i + 1) * nn];
-        let j1 = &jn[(i + 1) * nn..(i + 2) * nn];
-        let ai = &mut a[i * nn..(i + 1) * nn];
-        let bi = &mut b[i * nn..(i + 1) * nn];
+        ev.jac(x[i] + 0.5 * h, &c.y_mid[i * n..(i + 1) * n], jm)?;
+        let j0 = &w.jn[i * nn..(i + 1) * nn];
+        let j1 = &w.jn[(i + 1) * nn..(i + 2) * nn];
+        let ai = &mut w.a[i * nn..(i + 1) * nn];
+        let bi = &mut w.b[i * nn..(i + 1) * nn];
         for r in 0..n {
             for col in 0..n {
                 let mut t0 = 0.0;
@@ -731,10 +839,17 @@ fn jacobian_factor<P: BvpProblem + ?Sized>(
             }
         }
     }
-    let mut ba = vec![0.0; nn];
-    let mut bb = vec![0.0; nn];
-    ev.bc_jac(x[0], &y[..n], &y[(m - 1) * n..], &mut ba, &mut bb)?;
-    Ok(BlockFactor::factor(n, m, &a, &b, &ba, &bb).ok())
+    ev.bc_jac(x[0], &y[..n], &y[(m - 1) * n..], &mut w.ba, &mut w.bb)?;
+    Ok(w.fac
+        .factor(
+            n,
+            m,
+            &w.a[..(m - 1) * nn],
+            &w.b[..(m - 1) * nn],
+            &w.ba,
+            &w.bb,
+        )
+        .is_ok())
 }
 
 // ---------------------------------------------------------------------------
@@ -779,6 +894,7 @@ fn newton<P: BvpProblem + ?Sized>(
     bc_tol: f64,
     max_iter: usize,
     max_njev: usize,
+    work: &mut JacWork,
 ) -> Result<NewtonOut, BvpError> {
     const SIGMA: f64 = 0.2;
     const TAU: f64 = 0.5;
@@ -804,23 +920,19 @@ fn newton<P: BvpProblem + ?Sized>(
     let mut y_new = vec![0.0; len];
     let mut c_new = Colloc::new(n, m);
     let mut cost = 0.0;
-    let mut lu: Option<BlockFactor> = None;
     let mut recompute = true;
     for _ in 0..max_iter {
         if recompute {
-            match jacobian_factor(ev, x, y, c)? {
-                Some(f) => lu = Some(f),
-                None => {
-                    out.singular = true;
-                    out.jacobians += 1;
-                    break;
-                }
+            if !jacobian_factor(ev, x, y, c, work)? {
+                out.singular = true;
+                out.jacobians += 1;
+                break;
             }
             out.jacobians += 1;
-            lu.as_ref().unwrap().solve(&res, &mut step);
+            work.fac.solve(&res, &mut step);
             cost = step.iter().map(|s| s * s).sum();
         }
-        let fac = lu.as_ref().unwrap();
+        let fac = &mut work.fac;
         out.iterations += 1;
         let mut alpha = 1.0;
         let mut ok = false;
@@ -1077,6 +1189,7 @@ pub fn solve_bvp<P: BvpProblem + ?Sized>(
         jac: 0,
         passes: 0,
     };
+    let mut work = JacWork::default();
     loop {
         let m = x.len();
         let mut c = Colloc::new(n, m);
@@ -1089,6 +1202,7 @@ pub fn solve_bvp<P: BvpProblem + ?Sized>(
             bc_tol,
             opts.max_newton,
             opts.max_jacobians,
+            &mut work,
         )?;
         k.newton += nw.iterations;
         k.jac += nw.jacobians;
@@ -1213,6 +1327,7 @@ pub fn solve_collocation<P: BvpProblem + ?Sized>(
         jac: 0,
         passes: 0,
     };
+    let mut work = JacWork::default();
     let mut c = Colloc::new(n, m);
     for _ in 0..opts.max_iterations.max(1) {
         let nw = newton(
@@ -1224,6 +1339,7 @@ pub fn solve_collocation<P: BvpProblem + ?Sized>(
             bc_tol,
             opts.max_newton,
             opts.max_jacobians,
+            &mut work,
         )?;
         k.newton += nw.iterations;
         k.jac += nw.jacobians;
