@@ -6,10 +6,12 @@
 //! The check crate is written under the workspace's `target/codegen-check/`
 //! and built with its own target dir there (reused across runs).
 
+mod common;
+use common::{cargo, workspace_target, write_if_changed};
+
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
 use codegen::{emit_function, emit_params, Float, FunctionSpec, Param};
 use designer::description::parse_file;
@@ -194,13 +196,6 @@ fn valve_law() -> Case {
     }
 }
 
-fn workspace_target() -> PathBuf {
-    match std::env::var_os("CARGO_TARGET_DIR") {
-        Some(t) => PathBuf::from(t),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../target"),
-    }
-}
-
 /// Writes the check crate: lib = params + functions in `double` and
 /// `single`; main = prints every output at every point, one line each.
 fn write_crate(dir: &Path, cases: &[Case]) {
@@ -256,33 +251,6 @@ fn write_crate(dir: &Path, cases: &[Case]) {
     }
     main.push_str("}\n");
     write_if_changed(&dir.join("src/main.rs"), &main);
-}
-
-fn write_if_changed(path: &Path, text: &str) {
-    if std::fs::read_to_string(path).ok().as_deref() != Some(text) {
-        std::fs::write(path, text).unwrap();
-    }
-}
-
-fn cargo(dir: &Path, args: &[&str]) -> std::process::Output {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = Command::new(cargo)
-        .args(args)
-        .current_dir(dir)
-        .env(
-            "CARGO_TARGET_DIR",
-            workspace_target().join("codegen-check-target"),
-        )
-        .env_remove("RUSTFLAGS")
-        .env_remove("CARGO_ENCODED_RUSTFLAGS")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "cargo {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
 }
 
 #[test]

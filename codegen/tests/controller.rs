@@ -7,10 +7,12 @@
 //! `target/codegen-check-controller/` and built in the target dir of
 //! `compiled.rs` (`target/codegen-check-target/`).
 
+mod common;
+use common::{cargo, workspace_target, write_if_changed};
+
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
 use codegen::{emit_controller, gains, ControllerInput, Float, OperationTable};
 use designer::description::{parse_str, Gains, Operation};
@@ -220,40 +222,6 @@ fn header_and_sections_are_there() {
             "emitted code contains {forbidden}"
         );
     }
-}
-
-fn workspace_target() -> PathBuf {
-    match std::env::var_os("CARGO_TARGET_DIR") {
-        Some(t) => PathBuf::from(t),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../target"),
-    }
-}
-
-fn write_if_changed(path: &Path, text: &str) {
-    if std::fs::read_to_string(path).ok().as_deref() != Some(text) {
-        std::fs::write(path, text).unwrap();
-    }
-}
-
-fn cargo(dir: &Path, args: &[&str]) -> std::process::Output {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = Command::new(cargo)
-        .args(args)
-        .current_dir(dir)
-        .env(
-            "CARGO_TARGET_DIR",
-            workspace_target().join("codegen-check-target"),
-        )
-        .env_remove("RUSTFLAGS")
-        .env_remove("CARGO_ENCODED_RUSTFLAGS")
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "cargo {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
 }
 
 /// States x = [z, v, φ] in D₀⁺ and references [z_r, v_r, a_r, j_r].
