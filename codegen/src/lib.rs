@@ -31,7 +31,9 @@ mod lower;
 mod names;
 mod plan;
 
-pub use build::{build_file, compile, operation_name, write_if_changed, BuildError, Design, DesignedOperation};
+pub use build::{
+    build_file, compile, operation_name, write_if_changed, BuildError, Design, DesignedOperation,
+};
 pub use controller::{
     emit_controller, gains, triple_pole_settling_product, ControllerError, ControllerInput,
     OperationTable,

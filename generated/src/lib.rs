@@ -10,4 +10,5 @@
 
 /// `examples/perfect-tracking-valve.toml`: the valve of
 /// perfect-tracking-soft-landing Table 1 with the paper's design.
+#[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
 pub mod perfect_tracking_valve;
