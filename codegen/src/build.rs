@@ -36,7 +36,7 @@ pub enum BuildError {
         operation: &'static str,
         report: String,
     },
-    #[error("{file}: the {operation} energy-optimal trajectory: {message}")]
+    #[error("{file}: the {operation} energy-optimal trajectory: {message}\nhint: if the motion cannot be done with |u| ≤ trajectory.u_bound the problem has no solution: try a larger u_bound (up to the supply limit) or a longer motion (landing − takeoff); `shape = \"polynomial\"` shows which feasibility condition the motion violates")]
     Optimal {
         file: String,
         operation: &'static str,
