@@ -18,6 +18,10 @@ pub struct Args {
     /// Do not print the design report
     #[arg(long)]
     quiet: bool,
+    /// Also write the design figures as JSON (per operation: J, max |u|,
+    /// saturation switches, mesh size, residuals, table size)
+    #[arg(long)]
+    report_json: Option<PathBuf>,
 }
 
 pub fn run(args: &Args) -> Result<(), Report> {
@@ -32,11 +36,44 @@ pub fn run(args: &Args) -> Result<(), Report> {
             design.report()
         );
     }
-    match &args.out {
-        Some(path) => {
-            crate::atomic::write_all(&[(path.as_path(), code.as_bytes())]).map_err(fail)?
-        }
-        None => print!("{code}"),
+    let report = args
+        .report_json
+        .as_ref()
+        .map(|path| (path, report_json(&design)));
+    let mut files: Vec<(&std::path::Path, &[u8])> = Vec::new();
+    if let Some(path) = &args.out {
+        files.push((path.as_path(), code.as_bytes()));
+    }
+    if let Some((path, json)) = &report {
+        files.push((path.as_path(), json.as_bytes()));
+    }
+    crate::atomic::write_all(&files).map_err(fail)?;
+    if args.out.is_none() {
+        print!("{code}");
     }
     Ok(())
+}
+
+/// The design figures, for scripts and oracles.
+fn report_json(design: &codegen::Design) -> String {
+    let operations: serde_json::Map<String, serde_json::Value> = design
+        .operations
+        .iter()
+        .map(|o| {
+            let mut entry = serde_json::json!({
+                "z0": o.z0,
+                "zf": o.zf,
+                "segments": o.table.segments.len(),
+                "feasible": o.feasibility.is_feasible(),
+                "max_input": o.feasibility.max_input,
+                "min_input": o.feasibility.min_input,
+            });
+            if let (Some(opt), Some(map)) = (&o.optimal, entry.as_object_mut()) {
+                map.insert("optimal".into(), opt.summary_json());
+            }
+            (codegen::operation_name(o.operation).to_string(), entry)
+        })
+        .collect();
+    let value = serde_json::json!({ "name": design.description.name, "gains": design.gains, "operations": operations });
+    serde_json::to_string_pretty(&value).unwrap_or_default() + "\n"
 }

@@ -136,3 +136,16 @@ fn scipy_automaton_self_test() {
         "self-test: OK",
     );
 }
+
+/// The energy-optimal closing and opening of `reldesign build` against scipy
+/// `solve_bvp` with CasADi Jacobians: J within 1e-6, the same max |u|, the
+/// same saturation switches within one mesh interval.
+#[test]
+fn energy_optimal_trajectories_agree_with_scipy_solve_bvp() {
+    let model = root().join("examples/perfect-tracking-valve.toml");
+    oracle(
+        "check_optimal.py",
+        &[model.into(), "--reldesign".into(), BIN.into()],
+        "check_optimal: OK",
+    );
+}

@@ -27,6 +27,7 @@ Exit status 1 on a mismatch.
 from __future__ import annotations
 
 import argparse
+import tomllib
 import json
 import os
 import subprocess
@@ -224,15 +225,38 @@ def rust_summaries():
     return res
 
 
+def binary_summaries(binary, model):
+    """`reldesign build MODEL --report-json`: the design's own figures, for the
+    bound of the description's [trajectory] section."""
+    import shlex
+    import tempfile
+    with tempfile.TemporaryDirectory(prefix="check_optimal_") as tmp:
+        report = os.path.join(tmp, "report.json")
+        subprocess.run([*shlex.split(binary), "build", model, "--quiet", "--out",
+                        os.path.join(tmp, "code.rs"), "--report-json", report],
+                       check=True, capture_output=True, text=True)
+        with open(report) as fh:
+            data = json.load(fh)
+    with open(model, "rb") as fh:
+        bound = tomllib.load(fh)["trajectory"]["u_bound"]
+    return bound, {(case, bound): op["optimal"] for case, op in data["operations"].items()}
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("model")
     ap.add_argument("--bound", type=float, action="append")
     ap.add_argument("--tol", type=float, default=1e-6)
-    ap.add_argument("--rust", action="store_true")
+    ap.add_argument("--rust", action="store_true",
+                    help="compare with the designer's ignored test (cargo)")
+    ap.add_argument("--reldesign", metavar="BIN",
+                    help="compare with `BIN build MODEL --report-json` (the bound of [trajectory])")
     args = ap.parse_args()
     bounds = args.bound or [20.0, 1000.0]
     rust = rust_summaries() if args.rust else {}
+    if args.reldesign:
+        bound, rust = binary_summaries(args.reldesign, args.model)
+        bounds = [bound]
     ok = True
     for case, (z0, zf) in (("closing", (1e-3, 0.0)), ("opening", (0.0, 1e-3))):
         for b in bounds:
@@ -245,7 +269,7 @@ def main():
                   f"H spread {r['hamiltonian_spread']:.2e}")
             got = rust.get((case, b))
             if got is None:
-                if args.rust:
+                if args.rust or args.reldesign:
                     print(f"  reldesign: no summary for {case} ±{b:g}")
                     ok = False
                 continue
@@ -262,6 +286,7 @@ def main():
                   f"{got['max_abs_input']:.10g} (rel {du:.1e}), switches "
                   f"{[round(w['t'], 12) for w in got['switches']]} (max mesh h {h:.2e}), "
                   f"nodes {got['nodes']}: {'OK' if good else 'MISMATCH'}")
+    print("\ncheck_optimal:", "OK" if ok else "FAIL")
     sys.exit(0 if ok else 1)
 
 
