@@ -2,7 +2,9 @@
 //! `reldesign simulate` (and, later, `diagnose`).
 //!
 //! The actuator starts at rest at z_max with zero flux (and H_c = 0:
-//! demagnetised), in the mode the automaton's guards allow.
+//! demagnetised), in the mode the automaton's guards allow. The coil outputs
+//! are computed after the simulation, for all output times at once
+//! ([`ModelPlant::currents_and_voltages`]).
 
 use crate::model::{Model, ModelPlant};
 use crate::sim::{simulate, Input, Mode, Options, SimError, State, Trajectory};
@@ -51,16 +53,8 @@ pub fn replay_plant<I: Input + ?Sized>(
         output_times,
         options,
     )?;
-    let (current, voltage) = trajectory
-        .t
-        .iter()
-        .zip(&trajectory.x)
-        .zip(&trajectory.u)
-        .map(|((&t, x), &u)| {
-            let c = plant.coil(t, x, u);
-            (c.current, c.voltage)
-        })
-        .unzip();
+    let tr = &trajectory;
+    let (current, voltage) = plant.currents_and_voltages(&tr.t, &tr.x, &tr.u);
     Ok(Replay {
         trajectory,
         current,

@@ -169,6 +169,34 @@ fn steps_respect_limit_and_max_step() {
 }
 
 #[test]
+fn a_shortened_step_keeps_the_proposal_except_towards_a_breakpoint() {
+    let run = |to_breakpoint: bool| {
+        let mut rk = Dopri5::<2>::new(2, 1e-6, [1e-6; 2]);
+        let mut f = decay;
+        rk.init(0.0, &decay_exact(0.0), &mut f, &mut always);
+        rk.integrate_to(&mut f, &mut always, 1.0).unwrap();
+        let (proposed, t) = (rk.step_size(), rk.t());
+        let limit = t + 0.01 * proposed;
+        let h = if to_breakpoint {
+            rk.step_to_breakpoint(&mut f, &mut always, limit)
+        } else {
+            rk.step(&mut f, &mut always, limit)
+        };
+        assert_eq!(h.unwrap(), limit - t);
+        assert_eq!(rk.t(), limit);
+        (proposed, rk.step_size())
+    };
+    let (proposed, after) = run(false);
+    assert_eq!(after, proposed, "the earlier proposal stands");
+    let (proposed, after) = run(true);
+    // The short step's own proposal: at most 10 times its size.
+    assert!(
+        after <= 10.0 * 0.01 * proposed * (1.0 + 1e-12),
+        "{after} vs {proposed}"
+    );
+}
+
+#[test]
 fn restart_keeps_step_size_and_init_does_not() {
     let mut f = oscillator;
     let mut rk = Dopri5::<2>::new(2, 1e-8, [1e-8; 2]);

@@ -6,8 +6,20 @@
 //! guards are checked on the dense output and, if one fired, its crossing time
 //! is located by an Illinois (modified regula falsi) bracketing root finder to
 //! `event_tol·max(1, |t|)`; the step is cut there, the reset applied and the
-//! integrator restarted. Input breakpoints are hard stops too, so no step ever
-//! spans a jump or kink of the input.
+//! integrator restarted (keeping its step size: the motion just before an
+//! event predicts the next step better than a fresh heuristic). Input
+//! breakpoints are hard stops too, so no step ever spans a jump or kink of
+//! the input. A plant's switching functions are handled alike (see
+//! `switching.rs`): the field runs on held branches and a sign change is
+//! located and cut at, with the other branch after it (recorded in
+//! [`Trajectory::switches`]).
+//!
+//! **Event refinement.** The stages of a step that crosses a position limit
+//! see the field beyond it. Unless the plant continues its field smoothly
+//! there ([`Plant::smooth_beyond_limits`]), the step's dense output loses
+//! order near the crossing: a step that finds an impact is then repeated with
+//! the located time as its end, so that the impact is located on a step
+//! whose stages lie (almost) all before it.
 //!
 //! Guards (all fire when strictly positive):
 //! - Free: `z_min − z` (impact at the lower limit), `z − z_max` (upper limit);
@@ -43,7 +55,8 @@ use thiserror::Error;
 
 use super::input::{Affine, Input};
 use super::rk::{Dopri5, RkError, StepStats};
-use super::{Limits, Mode, Plant, State, MAX_DIM};
+use super::switching::Locking;
+use super::{Branches, Limits, Mode, Plant, State, MAX_DIM, MAX_SWITCHES};
 
 /// Largest number of extra integrals (quadratures) of [`simulate_with`].
 pub const MAX_QUAD: usize = 8;
@@ -126,7 +139,9 @@ pub struct Options {
     pub max_step: f64,
     /// Smallest step before giving up (default 0: only the ulp floor).
     pub min_step: f64,
-    /// First step after each (re)start at an event (default: Hairer's heuristic).
+    /// First step at the start and after every event (default: Hairer's
+    /// heuristic at the start; after an event the step size in force, which
+    /// fits the motion just before it better than the heuristic does).
     pub first_step: Option<f64>,
     /// Accepted plus rejected steps before giving up (default 1 000 000).
     pub max_steps: usize,
@@ -164,9 +179,21 @@ pub struct Trajectory {
     pub q: Vec<QuadState>,
     /// All events, in time order.
     pub events: Vec<Event>,
-    /// Integrator work; `evaluations` counts every `plant.deriv` call
-    /// (integration stages, guards and reset checks).
+    /// The located sign changes of the plant's switching functions, in time
+    /// order (see [`Plant::switches`]).
+    pub switches: Vec<Switch>,
+    /// Integrator work; `evaluations` counts every evaluation of the plant's
+    /// field or acceleration (integration stages, guards and reset checks).
     pub stats: StepStats,
+}
+
+/// A located sign change of a switching function: from `t` on, the field
+/// runs on the other branch.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Switch {
+    pub t: f64,
+    /// Which switching function.
+    pub index: usize,
 }
 
 impl Trajectory {
@@ -282,15 +309,16 @@ pub(crate) fn check_times(times: &[f64]) -> Result<(), SimError> {
     Ok(())
 }
 
+/// The plant's states of an extended state (unused entries 0). Element by
+/// element over the fixed size: a `memcpy` call would cost more (hot path).
+#[inline]
 fn plant_state(x: &Ext, pd: usize) -> State {
-    let mut s = [0.0; MAX_DIM];
-    s[..pd].copy_from_slice(&x[..pd]);
-    s
+    std::array::from_fn(|i| if i < pd { x[i] } else { 0.0 })
 }
 
 /// Illinois root finder on `[a, b]` with `g(a) ≤ 0 < g(b)`: returns a time
 /// within `tol` of the crossing on its triggered side (`g > 0`).
-fn locate<G: FnMut(f64) -> f64>(
+pub(super) fn locate<G: FnMut(f64) -> f64>(
     mut g: G,
     mut a: f64,
     mut ga: f64,
@@ -348,6 +376,8 @@ pub(crate) struct Engine<'a, P: Plant, Q: Quadrature> {
     x: Ext,
     mode: Mode,
     need_init: bool,
+    /// Branches held for the plant's switching functions.
+    lock: Locking,
     /// Time of the last impact at each limit (Zeno rule).
     last_impact: [f64; 2],
     extra_evals: usize,
@@ -368,6 +398,11 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
     ) -> Result<Self, SimError> {
         let (pd, nq, lim) = (plant.dim(), quad.len(), plant.limits());
         check_plant(pd, nq, &lim)?;
+        if plant.switches() > MAX_SWITCHES {
+            return Err(SimError::Plant(
+                "more switching functions than MAX_SWITCHES",
+            ));
+        }
         let rk = make_rk(plant, quad, opts)?;
         let mut x = [0.0; EXT];
         x[..pd].copy_from_slice(&x0[..pd]);
@@ -393,6 +428,7 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
             x,
             mode: mode0,
             need_init: true,
+            lock: Locking::new(plant.switches()),
             last_impact: [f64::NEG_INFINITY; 2],
             extra_evals: 0,
             out_times,
@@ -419,6 +455,7 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
         if !(piece.u0.is_finite() && piece.slope.is_finite() && piece.value(t_target).is_finite()) {
             return Err(SimError::NonFiniteInput { t: self.t });
         }
+        self.lock.start_piece();
         loop {
             self.resolve(piece)?;
             self.emit_current(piece, t_target);
@@ -439,49 +476,48 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
         Ok(traj)
     }
 
-    /// Integrates until `t_target` (returns true) or until a guard fires
-    /// (returns false, with the state at the event time before its reset).
+    /// Integrates until `t_target` (returns true) or until a guard fires or
+    /// a switching function changes sign (returns false, with the state at
+    /// that time, before any reset).
     fn integrate(&mut self, t_target: f64, piece: Affine) -> Result<bool, SimError> {
-        let (plant, quad, pd, nq, mode) = (self.plant, self.quad, self.pd, self.nq, self.mode);
-        let mut f =
-            move |t: f64, x: &Ext, dx: &mut Ext| rhs(plant, quad, pd, nq, mode, piece, t, x, dx);
-        let mut dom = move |x: &Ext| plant.in_domain(&plant_state(x, pd));
-        if self.need_init {
+        self.choose_branches(t_target, piece);
+        let (mut f, mut dom) = (self.field_fn(piece), self.domain_fn());
+        if std::mem::take(&mut self.need_init) {
             self.rk.init(self.t, &self.x, &mut f, &mut dom);
         } else {
             self.rk.restart(self.t, &self.x, &mut f, &mut dom);
         }
-        self.need_init = false;
-        // Event refinement: a step that crosses a guard has stages beyond it,
-        // where the plant's field is only an extension (at a position limit, the
-        // field stops being smooth), so its dense output loses order near the
-        // crossing. When a step finds an event, roll back to the step's start and
-        // integrate with the located time as a ceiling: the event is then located
-        // on a step whose stages lie (almost) all before it. At most
-        // `MAX_REFINEMENTS` rollbacks per event keep this finite.
-        let mut ceiling = f64::INFINITY;
-        let mut refinements = 0;
+        let steps0 = self.rk.stats().accepted;
+        // Event refinement (module docs): roll back to the step's start and
+        // integrate with the located impact time as a ceiling, at most
+        // `MAX_REFINEMENTS` times per event.
+        let refine = self.mode == Mode::Free && !self.plant.smooth_beyond_limits();
+        let (mut ceiling, mut refinements) = (f64::INFINITY, 0);
         loop {
-            let s = self.rk.stats();
-            if s.accepted + s.rejected >= self.opts.max_steps {
-                return Err(SimError::TooManySteps {
-                    t: self.rk.t(),
-                    max: self.opts.max_steps,
-                });
-            }
+            self.check_step_budget()?;
             let (t_start, x_start) = (self.rk.t(), *self.rk.x());
-            self.rk.step(&mut f, &mut dom, t_target.min(ceiling))?;
-            if let Some(te) = self.find_event(piece) {
-                if refinements < MAX_REFINEMENTS && te > t_start {
+            if ceiling < t_target {
+                self.rk.step(&mut f, &mut dom, ceiling)?;
+            } else {
+                self.rk.step_to_breakpoint(&mut f, &mut dom, t_target)?;
+            }
+            let switch = self.find_switch(piece);
+            let t_hi = switch.map_or(self.rk.t(), |s| s.0);
+            if let Some(te) = self.find_event(piece, t_hi) {
+                if refine && refinements < MAX_REFINEMENTS && te > t_start {
                     refinements += 1;
                     ceiling = te;
                     self.rk.restart(t_start, &x_start, &mut f, &mut dom);
                     continue;
                 }
-                self.emit_dense(te, false, piece, t_target);
-                self.rk.dense(te, &mut self.x);
-                self.t = te;
-                self.need_init = true;
+                self.stop_at(te, piece, t_target);
+                self.need_init = self.opts.first_step.is_some();
+                return Ok(false);
+            }
+            if let Some((ts, index)) = switch {
+                self.traj.switches.push(Switch { t: ts, index });
+                self.stop_at(ts, piece, t_target);
+                self.lock.switched(self.rk.stats().accepted - steps0);
                 return Ok(false);
             }
             self.emit_dense(self.rk.t(), true, piece, t_target);
@@ -496,15 +532,70 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
         }
     }
 
-    /// Earliest guard crossing inside the last accepted step, if any.
-    fn find_event(&mut self, piece: Affine) -> Option<f64> {
-        let (ta, tb) = (self.rk.t_prev(), self.rk.t());
+    /// Chooses the branches of the switching functions for a (re)start.
+    fn choose_branches(&mut self, t_target: f64, piece: Affine) {
+        let h = self.rk.step_size();
+        let probe = if h > 0.0 { h } else { t_target - self.t }.min(t_target - self.t);
+        let x = plant_state(&self.x, self.pd);
+        self.lock.choose(self.plant, self.t, &x, piece, probe);
+    }
+
+    /// The vector field integrated in the current mode and branches.
+    fn field_fn(&self, piece: Affine) -> impl FnMut(f64, &Ext, &mut Ext) + 'a {
+        let (plant, quad, pd, nq, mode) = (self.plant, self.quad, self.pd, self.nq, self.mode);
+        let branch = self.lock.held();
+        move |t: f64, x: &Ext, dx: &mut Ext| rhs(plant, quad, pd, nq, mode, branch, piece, t, x, dx)
+    }
+
+    /// The plant's domain predicate on extended states.
+    fn domain_fn(&self) -> impl FnMut(&Ext) -> bool + 'a {
+        let (plant, pd) = (self.plant, self.pd);
+        move |x: &Ext| plant.in_domain(&plant_state(x, pd))
+    }
+
+    fn check_step_budget(&self) -> Result<(), SimError> {
+        let s = self.rk.stats();
+        if s.accepted + s.rejected >= self.opts.max_steps {
+            return Err(SimError::TooManySteps {
+                t: self.rk.t(),
+                max: self.opts.max_steps,
+            });
+        }
+        Ok(())
+    }
+
+    /// Ends the integration at `t` inside the last step: records the outputs
+    /// before it and takes the state there from the dense output.
+    fn stop_at(&mut self, t: f64, piece: Affine, t_target: f64) {
+        self.emit_dense(t, false, piece, t_target);
+        self.rk.dense(t, &mut self.x);
+        self.t = t;
+    }
+
+    /// Earliest guard crossing inside the last accepted step up to `tb`, if any.
+    fn find_event(&mut self, piece: Affine, tb: f64) -> Option<f64> {
+        let ta = self.rk.t_prev();
         let tol = self.opts.event_tol * tb.abs().max(1.0);
         match self.mode {
             Mode::Free => self.find_impact(ta, tb, tol),
             Mode::StuckMin => self.find_lift_off(ta, tb, tol, 1.0, piece),
             Mode::StuckMax => self.find_lift_off(ta, tb, tol, -1.0, piece),
         }
+    }
+
+    /// Earliest sign change of a switching function inside the last accepted
+    /// step, if any: (time, which function) (see `switching.rs`).
+    fn find_switch(&self, piece: Affine) -> Option<(f64, usize)> {
+        let (rk, pd) = (&self.rk, self.pd);
+        let (ta, tb) = (rk.t_prev(), rk.t());
+        let tol = self.opts.event_tol * tb.abs().max(1.0);
+        let x_end = plant_state(rk.x(), pd);
+        let s_end = self
+            .lock
+            .values_at(self.plant, tb, &x_end, rk.dx(), piece.value(tb))?;
+        let dense = |t: f64| head_state(rk.dense_head(t), pd);
+        self.lock
+            .find(self.plant, ta, tb, &s_end, dense, piece, tol)
     }
 
     /// Position guards, checked at 4 points of the step (cheap: dense output
@@ -548,11 +639,12 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
         piece: Affine,
     ) -> Option<f64> {
         let mut evals = 0;
+        let branch = self.lock.held();
         let mut g = |t: f64| {
             evals += 1;
             let mut x = [0.0; EXT];
             self.rk.dense(t, &mut x);
-            sign * free_accel(self.plant, self.pd, t, &x, piece)
+            sign * free_accel(self.plant, self.pd, branch, t, &x, piece)
         };
         let (mut tp, mut gp) = (ta, f64::NEG_INFINITY);
         let mut found = None;
@@ -577,7 +669,7 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
             if !self.reset_once(piece) {
                 return Ok(());
             }
-            self.need_init = true;
+            self.need_init = self.opts.first_step.is_some();
         }
         Err(SimError::EventLoop {
             t: self.t,
@@ -678,7 +770,14 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
     /// Free-motion acceleration at the current state.
     fn accel(&mut self, piece: Affine) -> f64 {
         self.extra_evals += 1;
-        free_accel(self.plant, self.pd, self.t, &self.x, piece)
+        free_accel(
+            self.plant,
+            self.pd,
+            self.lock.held(),
+            self.t,
+            &self.x,
+            piece,
+        )
     }
 
     fn push(&mut self, kind: EventKind, mode_after: Mode) {
@@ -704,15 +803,30 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
     /// Records the outputs before `t_hi` (or at it if `inclusive`) and before
     /// `limit` from the dense output of the last step.
     fn emit_dense(&mut self, t_hi: f64, inclusive: bool, piece: Affine, limit: f64) {
-        let mut x = [0.0; EXT];
-        while let Some(&to) = self.out_times.get(self.next_out) {
-            let before = to < t_hi || (inclusive && to == t_hi);
-            if !before || to >= limit {
-                break;
-            }
-            self.rk.dense(to, &mut x);
-            self.record(to, &x, piece.value(to));
+        let pending = &self.out_times[self.next_out..];
+        let n = pending
+            .iter()
+            .take_while(|&&to| (to < t_hi || (inclusive && to == t_hi)) && to < limit)
+            .count();
+        if n == 0 {
+            return;
         }
+        // All of them at once: one capacity check per column, tight loops.
+        let (times, rk, pd, nq) = (&pending[..n], &self.rk, self.pd, self.nq);
+        let dense = |&to: &f64| {
+            let mut x = [0.0; EXT];
+            rk.dense(to, &mut x);
+            x
+        };
+        let tr = &mut self.traj;
+        tr.t.extend_from_slice(times);
+        tr.x.extend(times.iter().map(|&to| head_state(rk.dense_head(to), pd)));
+        tr.u.extend(times.iter().map(|&to| piece.value(to)));
+        tr.mode.extend(std::iter::repeat_n(self.mode, n));
+        if nq > 0 {
+            tr.q.extend(times.iter().map(|to| quad_state(&dense(to), pd, nq)));
+        }
+        self.next_out += n;
     }
 
     fn record(&mut self, t: f64, x: &Ext, u: f64) {
@@ -722,12 +836,34 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
         tr.u.push(u);
         tr.mode.push(self.mode);
         if self.nq > 0 {
-            let mut q = [0.0; MAX_QUAD];
-            q[..self.nq].copy_from_slice(&x[self.pd..self.pd + self.nq]);
-            tr.q.push(q);
+            tr.q.push(quad_state(x, self.pd, self.nq));
         }
         self.next_out += 1;
     }
+}
+
+/// The plant's states of the head of an extended state (unused entries 0).
+#[inline]
+fn head_state(x: State, pd: usize) -> State {
+    std::array::from_fn(|i| if i < pd { x[i] } else { 0.0 })
+}
+
+/// The quadratures of an extended state (unused entries 0).
+fn quad_state(x: &Ext, pd: usize, nq: usize) -> QuadState {
+    let mut q = [0.0; MAX_QUAD];
+    q[..nq].copy_from_slice(&x[pd..pd + nq]);
+    q
+}
+
+/// The plant's field, on the held `branch` or (`None`) with the live signs.
+#[inline]
+fn field<P: Plant>(plant: &P, branch: Option<Branches>, t: f64, x: &State, u: f64) -> State {
+    let mut dx = [0.0; MAX_DIM];
+    match branch {
+        Some(b) => plant.deriv_branch(t, x, u, &b, &mut dx),
+        None => plant.deriv(t, x, u, &mut dx),
+    }
+    dx
 }
 
 /// The vector field of `mode`: plant derivative (`ż = v̇ = 0` when stuck),
@@ -740,6 +876,7 @@ fn rhs<P: Plant, Q: Quadrature>(
     pd: usize,
     nq: usize,
     mode: Mode,
+    branch: Option<Branches>,
     piece: Affine,
     t: f64,
     x: &Ext,
@@ -747,13 +884,23 @@ fn rhs<P: Plant, Q: Quadrature>(
 ) {
     let xs = plant_state(x, pd);
     let u = piece.value(t);
-    let mut dx = [0.0; MAX_DIM];
-    plant.deriv(t, &xs, u, &mut dx);
+    let mut dx = match (mode, branch) {
+        (Mode::Free, _) | (_, None) => field(plant, branch, t, &xs, u),
+        (_, Some(b)) => {
+            let mut dx = [0.0; MAX_DIM];
+            plant.deriv_resting(t, &xs, u, &b, &mut dx);
+            dx
+        }
+    };
     if mode != Mode::Free {
         dx[0] = 0.0;
         dx[1] = 0.0;
     }
-    out[..pd].copy_from_slice(&dx[..pd]);
+    for (i, o) in out.iter_mut().enumerate().take(MAX_DIM) {
+        if i < pd {
+            *o = dx[i];
+        }
+    }
     if nq > 0 {
         let mut q = [0.0; MAX_QUAD];
         quad.integrand(t, &xs, &dx, u, mode, &mut q);
@@ -761,10 +908,19 @@ fn rhs<P: Plant, Q: Quadrature>(
     }
 }
 
-fn free_accel<P: Plant>(plant: &P, pd: usize, t: f64, x: &Ext, piece: Affine) -> f64 {
-    let mut dx = [0.0; MAX_DIM];
-    plant.deriv(t, &plant_state(x, pd), piece.value(t), &mut dx);
-    dx[1]
+fn free_accel<P: Plant>(
+    plant: &P,
+    pd: usize,
+    branch: Option<Branches>,
+    t: f64,
+    x: &Ext,
+    piece: Affine,
+) -> f64 {
+    let (xs, u) = (plant_state(x, pd), piece.value(t));
+    match branch {
+        Some(b) => plant.accel_branch(t, &xs, u, &b),
+        None => field(plant, None, t, &xs, u)[1],
+    }
 }
 
 fn check_plant(pd: usize, nq: usize, lim: &Limits) -> Result<(), SimError> {
