@@ -77,7 +77,7 @@ fn value(r: &Recipe, x: f64, y: f64) -> f64 {
 
 fn build(g: &mut Graph, r: &Recipe) -> Id {
     let one = g.one();
-    let mut sq1 = |g: &mut Graph, a: Id| {
+    let sq1 = |g: &mut Graph, a: Id| {
         let a2 = g.powi(a, 2);
         g.add(one, a2)
     };
