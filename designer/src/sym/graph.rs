@@ -45,6 +45,7 @@ impl Func {
         }
     }
 
+    #[inline]
     pub fn apply(self, x: f64) -> f64 {
         match self {
             Func::Sqrt => x.sqrt(),

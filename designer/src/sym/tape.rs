@@ -424,7 +424,7 @@ fn run<S: Slot, M: IndexMut<usize, Output = f64> + ?Sized>(code: &[Op<S>], s: &m
             Op::Recip(d, a) => (d, 1.0 / s[a.ix()]),
             Op::Powi(d, a, n) => (d, s[a.ix()].powi(n)),
             Op::Powf(d, a, b) => (d, s[a.ix()].powf(s[b.ix()])),
-            Op::Func(f, d, a) => (d, apply(f, s[a.ix()])),
+            Op::Func(f, d, a) => (d, Func::apply(f, s[a.ix()])),
             Op::Min(d, a, b) => (d, s[a.ix()].min(s[b.ix()])),
             Op::Max(d, a, b) => (d, s[a.ix()].max(s[b.ix()])),
             Op::Select(d, c, a, b) => (
@@ -510,18 +510,6 @@ impl Op<u32> {
     }
 }
 
-#[inline]
-fn apply(f: Func, x: f64) -> f64 {
-    match f {
-        Func::Sqrt => x.sqrt(),
-        Func::Exp => x.exp(),
-        Func::Ln => x.ln(),
-        Func::Abs => x.abs(),
-        Func::Sign => sign(x),
-        Func::Tanh => x.tanh(),
-        Func::Coth => 1.0 / x.tanh(),
-    }
-}
 
 #[cfg(test)]
 mod tests {
