@@ -510,7 +510,6 @@ impl Op<u32> {
     }
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
