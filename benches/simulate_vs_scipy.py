@@ -20,7 +20,7 @@ N = 20.  RELDESIGN is the binary's path or a quoted command (split like a shell)
        RELDESIGN simulate MODEL --input IN --out OUT.csv --rtol RTOL --repeat 1
    (or --rust-rtol), then --rust-processes times (default 5)
        RELDESIGN simulate MODEL --input IN --out OUT.csv --rtol RTOL --repeat N
-   which must print `elapsed_per_run_s=<float>` on stderr (mean time per
+   which must print `elapsed_per_run_s=<float>` on stderr (median time per
    simulation over the N runs of that process, parsing and output excluded)
    and write the trajectory (t,v,i,z,vz,phi[,Hc],mode); the time reported is
    the median over the processes (like scipy's median over its runs, it

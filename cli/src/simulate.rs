@@ -44,7 +44,7 @@ pub struct Args {
     /// Relative tolerance of the integrator
     #[arg(long, default_value_t = 1e-9)]
     rtol: f64,
-    /// Run N times and print `elapsed_per_run_s=` on stderr (benchmarks)
+    /// Run N times and print the median `elapsed_per_run_s=` (and the mean) on stderr (benchmarks)
     #[arg(long, default_value_t = 1)]
     repeat: usize,
 }
@@ -81,18 +81,26 @@ pub fn run(args: &Args) -> Result<(), Report> {
         ..Options::default()
     };
     let plant = ModelPlant::new(&mut model);
-    let start = Instant::now();
+    // Each run is timed on its own: `elapsed_per_run_s` is the median (the
+    // statistic the scipy side of benches/simulate_vs_scipy.py uses), and the
+    // mean, which includes the cold first run, is printed beside it.
     let mut result = None;
+    let mut seconds = Vec::with_capacity(args.repeat.max(1));
     for _ in 0..args.repeat.max(1) {
+        drop(result.take()); // free the previous run's buffers before timing the next
+        let start = Instant::now();
         result = Some(
             replay_plant(&plant, &model, &input, &times, &options)
                 .map_err(|e| fail(format!("{}: simulation failed: {e}", args.model.display())))?,
         );
+        seconds.push(start.elapsed().as_secs_f64());
     }
     if args.repeat > 1 {
+        let mean = seconds.iter().sum::<f64>() / seconds.len() as f64;
+        seconds.sort_by(f64::total_cmp);
         eprintln!(
-            "elapsed_per_run_s={:e}",
-            start.elapsed().as_secs_f64() / args.repeat as f64
+            "elapsed_per_run_s={:e} elapsed_mean_s={mean:e}",
+            seconds[seconds.len() / 2]
         );
     }
     let replay = result.ok_or_else(|| fail("nothing simulated"))?;
