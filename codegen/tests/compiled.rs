@@ -7,7 +7,7 @@
 //! and built with its own target dir there (reused across runs).
 
 mod common;
-use common::{cargo, workspace_target, write_if_changed};
+use common::{cargo, clippy_panic_free, workspace_target, write_if_changed};
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -258,27 +258,7 @@ fn emitted_code_compiles_passes_clippy_and_matches_the_tape() {
     let mut cases = [synthetic(), valve_law()];
     let dir = workspace_target().join("codegen-check");
     write_crate(&dir, &cases);
-    cargo(
-        &dir,
-        &[
-            "clippy",
-            "--offline",
-            "--lib",
-            "--",
-            "-D",
-            "warnings",
-            "-D",
-            "clippy::unwrap_used",
-            "-D",
-            "clippy::expect_used",
-            "-D",
-            "clippy::indexing_slicing",
-            "-D",
-            "clippy::panic",
-            "-D",
-            "clippy::as_conversions",
-        ],
-    );
+    clippy_panic_free(&dir);
     let out = cargo(&dir, &["run", "--offline", "--quiet"]);
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();

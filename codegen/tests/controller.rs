@@ -8,7 +8,7 @@
 //! `compiled.rs` (`target/codegen-check-target/`).
 
 mod common;
-use common::{cargo, workspace_target, write_if_changed};
+use common::{cargo, clippy_panic_free, workspace_target, write_if_changed};
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -369,27 +369,7 @@ fn emitted_controller_compiles_passes_clippy_and_matches_the_tape() {
     main.push_str("}\n");
     write_if_changed(&dir.join("src/main.rs"), &main);
 
-    cargo(
-        &dir,
-        &[
-            "clippy",
-            "--offline",
-            "--lib",
-            "--",
-            "-D",
-            "warnings",
-            "-D",
-            "clippy::unwrap_used",
-            "-D",
-            "clippy::expect_used",
-            "-D",
-            "clippy::indexing_slicing",
-            "-D",
-            "clippy::panic",
-            "-D",
-            "clippy::as_conversions",
-        ],
-    );
+    clippy_panic_free(&dir);
     let out = cargo(&dir, &["run", "--offline", "--quiet"]);
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();

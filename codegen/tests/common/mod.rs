@@ -40,3 +40,23 @@ pub fn cargo(dir: &Path, args: &[&str]) -> std::process::Output {
     );
     out
 }
+
+/// The lints that define "panic-free" for emitted code: clippy on the
+/// scratch crate's library with these denied.
+pub const PANIC_FREE_LINTS: [&str; 6] = [
+    "warnings",
+    "clippy::unwrap_used",
+    "clippy::expect_used",
+    "clippy::indexing_slicing",
+    "clippy::panic",
+    "clippy::as_conversions",
+];
+
+/// Runs clippy on the scratch crate `dir` with [`PANIC_FREE_LINTS`] denied.
+pub fn clippy_panic_free(dir: &Path) {
+    let mut args = vec!["clippy", "--offline", "--lib", "--"];
+    for lint in PANIC_FREE_LINTS {
+        args.extend(["-D", lint]);
+    }
+    cargo(dir, &args);
+}
