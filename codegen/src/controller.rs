@@ -368,15 +368,29 @@ fn smallest_reference_flux(input: &ControllerInput) -> Result<f64, ControllerErr
     }
 }
 
-/// The law's symbols and expressions in the (cloned) graph.
+/// The law's symbols and expressions in the (cloned) graph. The outputs
+/// build on each other through symbols that stand for earlier outputs, as
+/// the equations do: w uses ξ₃, u = β·(w − L_f³h) uses β, w and L_f³h.
 struct LawSymbols {
     refs: [Id; 4],
     gains: [Id; 3],
+    /// Symbols standing for the outputs ξ₃, L_f³h, β, w.
+    staged: [Id; 4],
+    /// (41) ξ₃ = L_f²h, (31) L_f³h, (32) β: the linearization's expressions
+    /// with common factors pulled out of their sums (`Graph::factor_sums`).
+    xi3: Id,
+    lf3h: Id,
+    beta: Id,
+    /// (32) α = −L_f³h·β
+    alpha: Id,
     /// (48) w = K·(ξ_r − T(x)) + j_r
     w: Id,
-    /// (50) u = α + β·w
+    /// (50) u = α + β·w = β·(w − L_f³h)
     u: Id,
 }
+
+/// Output names the `staged` symbols stand for, in order.
+const STAGED_OUTPUTS: [&str; 4] = ["xi3", "lf3h", "beta", "w"];
 
 impl LawSymbols {
     fn build(g: &mut Graph, input: &ControllerInput) -> Result<LawSymbols, ControllerError> {
@@ -398,17 +412,42 @@ impl LawSymbols {
             fresh(g, GAIN_SYMBOLS[1])?,
             fresh(g, GAIN_SYMBOLS[2])?,
         ];
+        let staged = [
+            fresh(g, "law_xi3")?,
+            fresh(g, "law_lf3h")?,
+            fresh(g, "law_beta")?,
+            fresh(g, "law_w")?,
+        ];
+        let [xi3, lf3h, beta, w_sym] = staged;
         let lin = input.linearization;
+        // (41) T(x) = [z, v, ξ₃]
+        let transform = [lin.transform[0], lin.transform[1], xi3];
         let mut terms = Vec::new();
         for i in 0..3 {
-            let err = g.sub(refs[i], lin.transform[i]);
+            let err = g.sub(refs[i], transform[i]);
             terms.push(g.mul(gains[i], err));
         }
         terms.push(refs[3]);
         let w = g.sum(&terms);
-        let bw = g.mul(lin.beta, w);
-        let u = g.add(lin.alpha, bw);
-        Ok(LawSymbols { refs, gains, w, u })
+        let minus_lf3h = g.neg(lf3h);
+        let alpha = g.mul(minus_lf3h, beta);
+        let w_minus_lf3h = g.sub(w_sym, lf3h);
+        let u = g.mul(beta, w_minus_lf3h);
+        let factored = g.factor_sums(&[lin.transform[2], lin.lf3h, lin.beta, w, alpha, u]);
+        let &[xi3_expr, lf3h_expr, beta_expr, w, alpha, u] = factored.as_slice() else {
+            unreachable!("factor_sums maps each root")
+        };
+        Ok(LawSymbols {
+            refs,
+            gains,
+            staged,
+            xi3: xi3_expr,
+            lf3h: lf3h_expr,
+            beta: beta_expr,
+            alpha,
+            w,
+            u,
+        })
     }
 }
 
@@ -494,7 +533,6 @@ fn float_module(
 
     // the law (50), through the expression emitter
     let [z, v, phi] = input.states;
-    let lin = input.linearization;
     let mut params: Vec<Param> = input.params.clone();
     for (k, (&id, name)) in law.gains.iter().zip(GAIN_SYMBOLS).enumerate() {
         params.push((name, id, input.gains[k]));
@@ -514,17 +552,23 @@ fn float_module(
             ("jr", law.refs[3]),
         ],
         outputs: vec![
-            ("xi3", lin.transform[2], "(41) ξ₃ = a(x) = L_f²h"),
-            ("alpha", lin.alpha, "(32) α(x) = −L_f³h / L_g L_f²h"),
-            ("beta", lin.beta, "(32) β(x) = 1 / L_g L_f²h"),
+            ("xi3", law.xi3, "(41) ξ₃ = a(x) = L_f²h"),
+            ("lf3h", law.lf3h, "(31) L_f³h"),
+            ("beta", law.beta, "(32) β(x) = 1 / L_g L_f²h"),
             (
                 "w",
                 law.w,
                 "(48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)",
             ),
-            ("u", law.u, "(50) u = α + β·w"),
+            (
+                "alpha",
+                law.alpha,
+                "(32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β",
+            ),
+            ("u", law.u, "(50) u = α + β·w = β·(w − L_f³h)"),
         ],
         named: vec![],
+        output_symbols: STAGED_OUTPUTS.into_iter().zip(law.staged).collect(),
         float,
     };
     let law_fn = function_tokens(graph, &spec, &params)?;

@@ -1,6 +1,6 @@
 //! The public emitters: a parameter block and a function over named outputs.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use designer::sym::{Graph, Id};
 use proc_macro2::TokenStream;
@@ -32,6 +32,11 @@ pub struct FunctionSpec<'a> {
     /// Subexpressions the caller names: each reachable one becomes
     /// `let name = …;` and is referenced by that name.
     pub named: Vec<(&'a str, Id)>,
+    /// (output name, symbol): the symbol stands for that output's value in
+    /// the outputs listed after it, so a later output can be written in
+    /// terms of an earlier one (u = β·(w − L_f³h) rather than β's and w's
+    /// expressions multiplied out). The output then gets a `let` of its own.
+    pub output_symbols: Vec<(&'a str, Id)>,
     pub float: Float,
 }
 
@@ -137,24 +142,35 @@ pub fn function_tokens(
         .iter()
         .map(|&(n, id)| (n.to_owned(), id))
         .collect();
+    let output_symbols: Vec<(String, Id)> = spec
+        .output_symbols
+        .iter()
+        .map(|&(n, id)| (n.to_owned(), id))
+        .collect();
     let request = PlanRequest {
         inputs: &inputs,
         params: &const_by_id,
         outputs: &outputs,
         named: &named,
+        output_symbols: &output_symbols,
     };
     let plan = plan(graph, &request, &mut namer)?;
 
+    let param_ids: HashSet<Id> = const_by_id.keys().copied().collect();
     let mut lower = Lowerer {
         graph,
         bound: &plan.bound,
         float: spec.float,
         uses_real: false,
+        params: &param_ids,
+        statics: HashMap::new(),
+        defined: HashSet::new(),
     };
     let mut body = TokenStream::new();
     for b in &plan.lets {
         let name = ident(&b.name);
         let rhs = lower.definition(b.id)?;
+        lower.defined.insert(b.id);
         body.extend(quote!(let #name = #rhs;));
     }
     for (name, id) in &outputs {

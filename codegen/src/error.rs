@@ -19,6 +19,8 @@ pub enum EmitError {
         value: String,
         float: &'static str,
     },
+    #[error("output `{0}` is used (through its symbol) before it is computed")]
+    OutputUsedEarly(String),
     #[error("internal error: the emitted tokens do not parse as Rust: {0}")]
     Syntax(String),
 }

@@ -3,10 +3,12 @@
 //!
 //! - sums with negative terms as subtractions, a positive term first and the
 //!   constant last: `a + b - 2.0 * c - 1.5`;
-//! - products with negative integer powers as a division: `c * a / (b * d)`;
+//! - products with negative integer powers as a division, parameter-only
+//!   factors first so that they fold to one constant: `c * K / M * a / (b * d)`;
 //! - x² and x³ as `x * x`, `x * x * x` (the plan binds x first), other integer
 //!   powers up to 64 as `Real::powi(x, n)`, x^½ as `Real::sqrt(x)`, x⁻¹ as
-//!   `1.0 / x`, anything else as `Real::powf(x, e)`;
+//!   `1.0 / x`, x⁻² and x⁻³ through the `let`s of x⁻¹ and x⁻² when there
+//!   are any (`inv_x * inv_x`), anything else as `Real::powf(x, e)`;
 //! - `select(c, a, b)` as `if c >= 0.0 { a } else { b }`;
 //! - functions, `min`, `max` through `reldesign_runtime::math::Real`, with
 //!   sign(0) = 0 (`Real::signum0`).
@@ -14,7 +16,7 @@
 //! Parentheses come from operator precedence, never from the tree shape.
 //! Bound nodes (inputs, parameter consts, earlier `let`s) print as names.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use designer::sym::{Func, Graph, Id, Node};
 use proc_macro2::TokenStream;
@@ -68,6 +70,12 @@ pub(crate) struct Lowerer<'a> {
     pub float: Float,
     /// Set when a `Real::…` call was emitted (the function then imports it).
     pub uses_real: bool,
+    /// Parameter symbols (their consts are compile-time values).
+    pub params: &'a HashSet<Id>,
+    /// Memo of [`Lowerer::is_static`].
+    pub statics: HashMap<Id, bool>,
+    /// `let`s emitted so far (a node may be written through them).
+    pub defined: HashSet<Id>,
 }
 
 impl Lowerer<'_> {
@@ -237,40 +245,69 @@ impl Lowerer<'_> {
         Ok(Lowered::new(acc, SUM))
     }
 
-    /// c · Π factors, negative powers in a denominator.
+    /// c · Π factors, negative powers in a denominator. Parameter-only
+    /// factors come first, `c * A / (B * C) * x * y / (d * e)`: evaluated
+    /// left to right, the prefix is a constant the compiler folds, so the
+    /// call pays only for the factors that depend on the inputs.
     fn product(&mut self, c: f64, factors: &[Id]) -> Result<Lowered, EmitError> {
         let g = self.graph;
-        let mut num: Vec<Lowered> = Vec::new();
-        let mut den: Vec<Lowered> = Vec::new();
-        if c.abs() != 1.0 {
-            num.push(self.constant(c.abs())?);
-        }
+        let mut parts: [Vec<Lowered>; 4] = Default::default(); // [static num, static den, num, den]
         for &f in factors {
+            let group = if self.is_static(f) { 0 } else { 2 };
             if !self.bound.contains_key(&f) {
                 if let Node::Pow(b, e) = g.node(f) {
                     if let Some(ev) = g.as_const(*e).filter(|&e| e < 0.0) {
+                        if let Some(p) = self.inverse_power(*b, -ev)? {
+                            parts[group].push(p);
+                            continue;
+                        }
                         if let Some(p) = self.positive_power(*b, -ev)? {
-                            den.push(p);
+                            parts[group + 1].push(p);
                             continue;
                         }
                     }
                 }
             }
-            num.push(self.expr(f)?);
+            parts[group].push(self.expr(f)?);
         }
-        let numerator = if num.is_empty() {
-            self.constant(1.0)?
-        } else {
-            Self::chain(num)
-        };
-        let body = if den.is_empty() {
-            numerator
-        } else {
-            let n = numerator.at(PRODUCT);
-            let d = Self::chain(den).at(UNARY);
-            Lowered::new(quote!(#n / #d), PRODUCT)
-        };
+        let [static_num, static_den, num, den] = parts;
+        let mut head = Vec::new();
+        if c.abs() != 1.0 || (static_num.is_empty() && (!static_den.is_empty() || num.is_empty())) {
+            head.push(self.constant(c.abs())?);
+        }
+        head.extend(static_num);
+        let mut all = Vec::new();
+        if !head.is_empty() {
+            all.push(Self::quotient(Self::chain(head), static_den));
+        }
+        all.extend(num);
+        let body = Self::quotient(Self::chain(all), den);
         Ok(if c < 0.0 { Self::negate(body) } else { body })
+    }
+
+    /// `n / (d₁ * d₂)` (n alone when there is no denominator).
+    fn quotient(n: Lowered, den: Vec<Lowered>) -> Lowered {
+        if den.is_empty() {
+            return n;
+        }
+        let n = n.at(PRODUCT);
+        let d = Self::chain(den).at(UNARY);
+        Lowered::new(quote!(#n / #d), PRODUCT)
+    }
+
+    /// Whether `id` depends on parameters and constants only (memoised).
+    fn is_static(&mut self, id: Id) -> bool {
+        if let Some(&s) = self.statics.get(&id) {
+            return s;
+        }
+        let g = self.graph;
+        let s = match g.node(id) {
+            Node::Const(_) => true,
+            Node::Sym(_) => self.params.contains(&id),
+            _ => g.children(id).into_iter().all(|c| self.is_static(c)),
+        };
+        self.statics.insert(id, s);
+        s
     }
 
     /// a * b * c (left-associated; right operands parenthesised if needed).
@@ -289,6 +326,33 @@ impl Lowerer<'_> {
             acc = quote!(#acc * #f);
         }
         Lowered::new(acc, PRODUCT)
+    }
+
+    /// b⁻ⁿ (n = 2, 3, 4) written with the `let`s of b⁻¹ and b⁻² already
+    /// emitted (`inv_t * inv_t_sq`): multiplications instead of a division.
+    fn inverse_power(&mut self, b: Id, n: f64) -> Result<Option<Lowered>, EmitError> {
+        if !(2.0..=4.0).contains(&n) || n.fract() != 0.0 {
+            return Ok(None);
+        }
+        let g = self.graph;
+        let bound_inverse = |k: f64| {
+            let e = g.find(&Node::Const((-k).to_bits()))?;
+            let id = g.find(&Node::Pow(b, e))?;
+            self.defined.contains(&id).then_some(id)
+        };
+        let (inv1, inv2) = (bound_inverse(1.0), bound_inverse(2.0));
+        let ids: Vec<Id> = match (n as u8, inv1, inv2) {
+            (2, Some(i1), _) => vec![i1, i1],
+            (3, Some(i1), Some(i2)) => vec![i2, i1],
+            (3, Some(i1), None) => vec![i1, i1, i1],
+            (4, _, Some(i2)) => vec![i2, i2],
+            _ => return Ok(None),
+        };
+        let mut factors = Vec::with_capacity(ids.len());
+        for id in ids {
+            factors.push(self.expr(id)?);
+        }
+        Ok(Some(Self::chain(factors)))
     }
 
     /// b^p for p > 0 when it has a non-`powf` form (integer ≤ 64, or ½).
@@ -322,6 +386,11 @@ impl Lowerer<'_> {
 
     fn pow(&mut self, b: Id, e: Id) -> Result<Lowered, EmitError> {
         if let Some(ev) = self.graph.as_const(e) {
+            if ev < 0.0 {
+                if let Some(p) = self.inverse_power(b, -ev)? {
+                    return Ok(p);
+                }
+            }
             if let Some(p) = self.positive_power(b, ev.abs())? {
                 if ev > 0.0 {
                     return Ok(p);

@@ -10,7 +10,8 @@
 //!   are written `x * x` and `x * x * x`;
 //! - named by the caller (`named`), or an output that other outputs reuse
 //!   (it then takes the output's name);
-//! - a `select`, so that every `if … else …` is a statement of its own.
+//! - a `select`, so that every `if … else …` is a statement of its own;
+//! - an output that later outputs use through its symbol (`output_symbols`).
 
 use std::collections::HashMap;
 
@@ -41,6 +42,8 @@ pub(crate) struct PlanRequest<'a> {
     /// (name, root) of the outputs
     pub outputs: &'a [(String, Id)],
     pub named: &'a [(String, Id)],
+    /// (output name, symbol standing for that output in later outputs)
+    pub output_symbols: &'a [(String, Id)],
 }
 
 pub(crate) fn plan(g: &Graph, req: &PlanRequest, namer: &mut Namer) -> Result<Plan, EmitError> {
@@ -70,10 +73,23 @@ pub(crate) fn plan(g: &Graph, req: &PlanRequest, namer: &mut Namer) -> Result<Pl
         output_name.insert(*id, n.as_str());
     }
 
+    let staged: HashMap<&str, Id> = req
+        .output_symbols
+        .iter()
+        .map(|(n, id)| (n.as_str(), *id))
+        .collect();
     let mut input_used = vec![false; req.inputs.len()];
     let mut lets = Vec::new();
     for &id in &order {
         if let Node::Sym(i) = g.node(id) {
+            if let Some((name, _)) = req.output_symbols.iter().find(|(_, s)| *s == id) {
+                // an earlier output's value: its `let` must already exist
+                if !lets.iter().any(|b: &Binding| &b.name == name) {
+                    return Err(EmitError::OutputUsedEarly(name.clone()));
+                }
+                bound.insert(id, name.clone());
+                continue;
+            }
             match req.inputs.iter().position(|(_, s)| *s == id) {
                 Some(k) => input_used[k] = true,
                 None if req.params.contains_key(&id) => {}
@@ -85,9 +101,10 @@ pub(crate) fn plan(g: &Graph, req: &PlanRequest, namer: &mut Namer) -> Result<Pl
             continue;
         }
         let is_root = output_name.contains_key(&id);
+        let is_staged = output_name.get(&id).is_some_and(|n| staged.contains_key(n));
         let shared = uses.get(&id).copied().unwrap_or(0) >= 2 && !is_trivial(g, id);
         let is_select = matches!(g.node(id), Node::Select(..));
-        let wanted = named.contains_key(&id) || shared || (is_select && !is_root);
+        let wanted = named.contains_key(&id) || shared || is_staged || (is_select && !is_root);
         if !wanted {
             continue;
         }

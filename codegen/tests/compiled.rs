@@ -27,6 +27,8 @@ struct Case {
     inputs: Vec<(&'static str, Id)>,
     outputs: Vec<(&'static str, Id, &'static str)>,
     named: Vec<(&'static str, Id)>,
+    /// (output, symbol standing for it in later outputs)
+    output_symbols: Vec<(&'static str, Id)>,
     points: Vec<Vec<f64>>,
 }
 
@@ -45,6 +47,7 @@ impl Case {
             inputs: self.inputs.clone(),
             outputs: self.outputs.clone(),
             named: self.named.clone(),
+            output_symbols: self.output_symbols.clone(),
             float,
         };
         let params = self.params();
@@ -61,8 +64,17 @@ impl Case {
             .iter()
             .map(|(_, id, v)| (*id, self.graph.constant(*v)))
             .collect();
-        let roots: Vec<Id> = self.outputs.iter().map(|o| o.1).collect();
-        let bound = self.graph.substitute_all(&roots, &map);
+        // outputs in order; an output's symbol stands for its value after it
+        let mut map = map;
+        let mut bound = Vec::new();
+        for &(name, root, _) in &self.outputs {
+            let b = self.graph.substitute(root, &map);
+            if let Some(&(_, sym)) = self.output_symbols.iter().find(|o| o.0 == name) {
+                map.insert(sym, b);
+            }
+            bound.push(b);
+        }
+        let roots = &bound;
         let inputs: Vec<Id> = self.inputs.iter().map(|i| i.1).collect();
         let tape = Tape::compile(&self.graph, &inputs, &bound).unwrap();
         self.points
@@ -140,6 +152,10 @@ fn synthetic() -> Case {
     let m1 = g.constant(-1.0);
     let ny = g.neg(y);
     let e5 = g.sum(&[nx, ny, m1]);
+    // e6 = e1·y + x through the symbol standing for the output e1
+    let e1_value = g.symbol("e1_value");
+    let e1y = g.mul(e1_value, y);
+    let e6 = g.add(e1y, x);
     let points = [
         [0.7, 1.3, 2.5],
         [0.2, 0.9, 1.1],
@@ -159,8 +175,10 @@ fn synthetic() -> Case {
             ("e4", e4, "reuses e1"),
             ("e5", e5, "negative terms only"),
             ("same_x", x, "an input"),
+            ("e6", e6, "uses the output e1 by its symbol"),
         ],
         named: vec![("sum_xy", s)],
+        output_symbols: vec![("e1", e1_value)],
         points: points.iter().map(|p| p.to_vec()).collect(),
     }
 }
@@ -192,6 +210,7 @@ fn valve_law() -> Case {
             ("beta", lin.beta, "(32) β(x)"),
         ],
         named: vec![("r_gap", m.r_gap), ("r_gap_dz", m.r_gap_dz)],
+        output_symbols: vec![],
         points,
     }
 }

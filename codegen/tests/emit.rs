@@ -35,6 +35,7 @@ fn alpha_beta_code(text: &str, float: Float) -> (String, String) {
             ("beta", lin.beta, "(32) β(x)"),
         ],
         named: vec![("r_gap", m.r_gap), ("r_gap_dz", m.r_gap_dz)],
+        output_symbols: vec![],
         float,
     };
     let p = emit_params(&m.graph, &params, float).unwrap();
@@ -113,6 +114,7 @@ fn emit_xy(build: impl FnOnce(&mut Graph, Id, Id) -> Vec<Id>) -> Result<String, 
         inputs: vec![("x", x), ("y", y)],
         outputs: outs.iter().zip(names).map(|(&o, n)| (n, o, "")).collect(),
         named: vec![],
+        output_symbols: vec![],
         float: Float::F64,
     };
     emit_function(&g, &spec, &[("k", k, 2.0)])
@@ -141,8 +143,8 @@ fn arithmetic_is_written_as_a_person_would() {
     assert!(f.contains("let a = 1.0_f64 / x;"), "{f}");
     assert!(f.contains("let b = x - y;"), "{f}");
     assert!(
-        f.contains("let c = y * K * a;"),
-        "outputs are reused by name: {f}"
+        f.contains("let c = K * y * a;"),
+        "outputs are reused by name, parameters first: {f}"
     );
     assert!(f.contains("let d = x * x * x;"), "{f}");
     assert!(f.contains("Real::powi(x, 4)"), "{f}");
@@ -157,6 +159,71 @@ fn arithmetic_is_written_as_a_person_would() {
         !f.contains("use reldesign_runtime")
             || f.contains("    use reldesign_runtime::math::Real;\n")
     );
+}
+
+#[test]
+fn parameter_factors_lead_and_inverse_powers_reuse_lets() {
+    let f = emit_xy(|g, x, y| {
+        let k = g.find_symbol("k").unwrap();
+        let rx = g.recip(x);
+        let rk = g.recip(k);
+        let xm2 = g.powi(x, -2);
+        let xm3 = g.powi(x, -3);
+        // 3·y·k / (k·x² ... ): k⁻¹·y·x⁻² and 2·k·y·x⁻³
+        let a = g.product(&[rk, y, xm2]);
+        let two = g.constant(2.0);
+        let b = g.product(&[two, k, y, xm3]);
+        let e = g.add(rx, y); // x⁻¹ used twice: it gets its `let` first
+        vec![rx, xm2, a, b, e]
+    })
+    .unwrap();
+    assert!(f.contains("let a = 1.0_f64 / x;"), "{f}");
+    assert!(f.contains("let b = a * a;"), "x⁻² through x⁻¹: {f}");
+    assert!(
+        f.contains("let c = 1.0_f64 / K * y * b;"),
+        "parameters first: {f}"
+    );
+    assert!(f.contains("let d = 2.0_f64 * K * y * (b * a);"), "{f}");
+}
+
+#[test]
+fn outputs_build_on_earlier_outputs_through_their_symbols() {
+    let mut g = Graph::new();
+    let (x, y) = (g.symbol("x"), g.symbol("y"));
+    let (sa, sb) = (g.symbol("a_value"), g.symbol("b_value"));
+    let a = g.mul(x, y);
+    let b = g.add(x, y);
+    let ab = g.mul(sa, sb);
+    let c = g.add(ab, x);
+    let spec = |outputs: Vec<(&'static str, Id, &'static str)>| FunctionSpec {
+        name: "f",
+        doc: "",
+        inputs: vec![("x", x), ("y", y)],
+        outputs,
+        named: vec![],
+        output_symbols: vec![("a", sa), ("b", sb)],
+        float: Float::F64,
+    };
+    let f = emit_function(
+        &g,
+        &spec(vec![("a", a, ""), ("b", b, ""), ("c", c, "")]),
+        &[],
+    )
+    .unwrap();
+    assert!(f.contains("let a = x * y;"), "{f}");
+    assert!(f.contains("let b = x + y;"), "{f}");
+    assert!(
+        f.contains("let c = x + a * b;") || f.contains("let c = a * b + x;"),
+        "{f}"
+    );
+    // c before a: its symbol is used before the output is computed
+    let err = emit_function(
+        &g,
+        &spec(vec![("c", c, ""), ("a", a, ""), ("b", b, "")]),
+        &[],
+    )
+    .unwrap_err();
+    assert_eq!(err, EmitError::OutputUsedEarly("a".into()));
 }
 
 #[test]
@@ -188,6 +255,7 @@ fn bad_requests_are_refused_with_the_name() {
             inputs: vec![(input, x)],
             outputs: vec![(output, x, "")],
             named: vec![],
+            output_symbols: vec![],
             float: Float::F64,
         };
         let err = emit_function(&g, &spec, &[]).unwrap_err();

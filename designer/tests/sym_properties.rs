@@ -1,7 +1,9 @@
 //! Property tests of the symbolic core against independent oracles:
 //! - simplification, tape compilation and CSE against a direct f64 evaluation
 //!   of the same random recipe (which never touches the graph);
-//! - derivatives (first and second order) against central finite differences.
+//! - derivatives (first and second order) against central finite differences;
+//! - `factor_sums` (common factors out of sums) keeps the values of an
+//!   expression and of its derivatives, where sums share the most factors.
 
 use designer::sym::{Graph, Id, Tape};
 use proptest::prelude::*;
@@ -237,5 +239,27 @@ proptest! {
         let d_cse = g.eval(cse.outputs[1], &lookup);
         prop_assert!(close(via_cse, direct, 1e-9, 1e-12));
         prop_assert!(close(d_cse, d_direct, 1e-9, 1e-12) || !d_direct.is_finite());
+    }
+
+    /// Pulling common factors out of sums keeps values, on the recipe and on
+    /// its first and second x-derivatives (quotient-rule sums, which share
+    /// factors such as (1 + a²)⁻ⁿ).
+    #[test]
+    fn factor_sums_preserves_values(r in recipe(), (x, y) in point()) {
+        let direct = value(&r, x, y);
+        prop_assume!(direct.is_finite() && direct.abs() < 1e6);
+        let mut g = Graph::new();
+        let e = build(&mut g, &r);
+        let sx = g.symbol("x");
+        let d = g.diff(e, sx);
+        let dd = g.diff(d, sx);
+        let factored = g.factor_sums(&[e, d, dd]);
+        for (&before, &after) in [e, d, dd].iter().zip(&factored) {
+            let (want, got) = (eval_tape(&g, before, x, y), eval_tape(&g, after, x, y));
+            prop_assume!(want.is_finite() && want.abs() < 1e8);
+            let scale = want.abs().max(1.0);
+            prop_assert!(close(got, want, 1e-9, 1e-11 * scale),
+                "factored {got} vs {want}: {} vs {}", g.display(after), g.display(before));
+        }
     }
 }

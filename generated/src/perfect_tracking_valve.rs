@@ -746,13 +746,15 @@ pub mod f32 {
     pub struct LawTermsOutput {
         /// (41) ξ₃ = a(x) = L_f²h
         pub xi3: f32,
-        /// (32) α(x) = −L_f³h / L_g L_f²h
-        pub alpha: f32,
+        /// (31) L_f³h
+        pub lf3h: f32,
         /// (32) β(x) = 1 / L_g L_f²h
         pub beta: f32,
         /// (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
         pub w: f32,
-        /// (50) u = α + β·w
+        /// (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
+        pub alpha: f32,
+        /// (50) u = α + β·w = β·(w − L_f³h)
         pub u: f32,
     }
 
@@ -771,52 +773,47 @@ pub mod f32 {
         jr: f32,
     ) -> LawTermsOutput {
         use reldesign_runtime::math::Real;
-        let inv_a_gap = 1.0_f32 / A_GAP;
-        let t0 = z + 1e-9_f32;
-        let inv_t0 = 1.0_f32 / t0;
-        let ln = Real::ln(2.0_f32 * L_W * inv_t0);
-        let inv_sqrt_a_gap = 1.0_f32 / Real::sqrt(A_GAP);
-        let t1 = z * ln * inv_sqrt_a_gap + 1.0_f32;
-        let inv_t1 = 1.0_f32 / t1;
-        let t2 = ln * inv_sqrt_a_gap - z * inv_t0 * inv_sqrt_a_gap;
-        let inv_t1_sq = 1.0_f32 / (t1 * t1);
-        let t3 = 795774.7_f32 * inv_a_gap * inv_t1
-            - 795774.7_f32 * z * inv_a_gap * t2 * inv_t1_sq;
-        let phi_sq = phi * phi;
-        let t4 = -0.5_f32 * t3 * phi_sq - (F0 + z * K_S + v * C);
         let inv_m = 1.0_f32 / M;
-        let t5 = N * N + R * K_E;
-        let inv_phi = 1.0_f32 / phi;
-        let inv_n = 1.0_f32 / N;
-        let inv_t3 = 1.0_f32 / t3;
-        // (32) α(x) = −L_f³h / L_g L_f²h
-        let alpha = M * t5
-            * (v * inv_m
-                * (-0.5_f32 * phi_sq
-                    * (1591549.4_f32 * z * inv_a_gap * (t2 * t2) / (t1 * t1 * t1)
-                        - 795774.7_f32 * z * inv_a_gap * inv_t1_sq
-                            * (z * inv_sqrt_a_gap / (t0 * t0)
-                                - 2.0_f32 * inv_t0 * inv_sqrt_a_gap)
-                        - 1591549.4_f32 * inv_a_gap * t2 * inv_t1_sq) - K_S)
-                - C * t4 / (M * M)
-                + phi * R * t3
-                    * (phi * R_CORE0 / (1.0_f32 - Real::abs(phi) / PHI_SAT)
-                        + 795774.7_f32 * z * phi * inv_a_gap * inv_t1) * inv_m / t5)
-            * inv_phi * inv_n * inv_t3;
-        // (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
-        let w = jr + GAIN_K1 * (zr - z) + GAIN_K2 * (vr - v)
-            + GAIN_K3 * (ar - t4 * inv_m);
+        let inv_a_gap = 1.0_f32 / A_GAP;
+        let t0 = 1.0_f32 / (z + 1e-9_f32);
+        let ln = Real::ln(2.0_f32 * L_W * t0);
+        let inv_sqrt_a_gap = 1.0_f32 / Real::sqrt(A_GAP);
+        let t1 = inv_sqrt_a_gap * z * ln + 1.0_f32;
+        let inv_t1 = 1.0_f32 / t1;
+        let phi_sq = phi * phi;
+        let t2 = ln - z * t0;
+        let t3 = 1.0_f32 - inv_sqrt_a_gap * z * inv_t1 * t2;
+        let t4 = -(F0 + K_S * z + C * v)
+            - 397887.34_f32 * inv_a_gap * inv_t1 * phi_sq * t3;
         // (41) ξ₃ = a(x) = L_f²h
-        let xi3 = t4 * inv_m;
+        let xi3 = inv_m * t4;
+        let t5 = N * N + R * K_E;
+        // (31) L_f³h
+        let lf3h = inv_m
+            * (v
+                * (-K_S
+                    - 397887.34_f32 * inv_sqrt_a_gap * inv_a_gap * (inv_t1 * inv_t1)
+                        * phi_sq
+                        * (2.0_f32 * inv_sqrt_a_gap * z * inv_t1 * (t2 * t2)
+                            - z * t0 * (z * t0 - 2.0_f32) - 2.0_f32 * t2))
+                - C * inv_m * t4
+                + 795774.7_f32 * R * inv_a_gap / t5 * inv_t1 * phi_sq * t3
+                    * (795774.7_f32 * inv_a_gap * z * inv_t1
+                        + R_CORE0 / (1.0_f32 - 1.0_f32 / PHI_SAT * Real::abs(phi))));
         // (32) β(x) = 1 / L_g L_f²h
-        let beta = -M * t5 * inv_phi * inv_n * inv_t3;
-        // (50) u = α + β·w
-        let u = alpha - M * t5 * inv_phi * inv_n * inv_t3 * w;
+        let beta = -1.256637e-6_f32 * A_GAP * M * t5 / N * t1 / (phi * t3);
+        // (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
+        let w = jr + GAIN_K1 * (zr - z) + GAIN_K2 * (vr - v) + GAIN_K3 * (ar - xi3);
+        // (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
+        let alpha = -lf3h * beta;
+        // (50) u = α + β·w = β·(w − L_f³h)
+        let u = beta * (w - lf3h);
         LawTermsOutput {
             xi3,
-            alpha,
+            lf3h,
             beta,
             w,
+            alpha,
             u,
         }
     }
@@ -1726,13 +1723,15 @@ pub mod f64 {
     pub struct LawTermsOutput {
         /// (41) ξ₃ = a(x) = L_f²h
         pub xi3: f64,
-        /// (32) α(x) = −L_f³h / L_g L_f²h
-        pub alpha: f64,
+        /// (31) L_f³h
+        pub lf3h: f64,
         /// (32) β(x) = 1 / L_g L_f²h
         pub beta: f64,
         /// (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
         pub w: f64,
-        /// (50) u = α + β·w
+        /// (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
+        pub alpha: f64,
+        /// (50) u = α + β·w = β·(w − L_f³h)
         pub u: f64,
     }
 
@@ -1751,53 +1750,47 @@ pub mod f64 {
         jr: f64,
     ) -> LawTermsOutput {
         use reldesign_runtime::math::Real;
-        let inv_a_gap = 1.0_f64 / A_GAP;
-        let t0 = z + 1e-9_f64;
-        let inv_t0 = 1.0_f64 / t0;
-        let ln = Real::ln(2.0_f64 * L_W * inv_t0);
-        let inv_sqrt_a_gap = 1.0_f64 / Real::sqrt(A_GAP);
-        let t1 = z * ln * inv_sqrt_a_gap + 1.0_f64;
-        let inv_t1 = 1.0_f64 / t1;
-        let t2 = ln * inv_sqrt_a_gap - z * inv_t0 * inv_sqrt_a_gap;
-        let inv_t1_sq = 1.0_f64 / (t1 * t1);
-        let t3 = 795774.7154594767_f64 * inv_a_gap * inv_t1
-            - 795774.7154594767_f64 * z * inv_a_gap * t2 * inv_t1_sq;
-        let phi_sq = phi * phi;
-        let t4 = -0.5_f64 * t3 * phi_sq - (F0 + z * K_S + v * C);
         let inv_m = 1.0_f64 / M;
-        let t5 = N * N + R * K_E;
-        let inv_phi = 1.0_f64 / phi;
-        let inv_n = 1.0_f64 / N;
-        let inv_t3 = 1.0_f64 / t3;
-        // (32) α(x) = −L_f³h / L_g L_f²h
-        let alpha = M * t5
-            * (v * inv_m
-                * (-0.5_f64 * phi_sq
-                    * (1591549.4309189534_f64 * z * inv_a_gap * (t2 * t2)
-                        / (t1 * t1 * t1)
-                        - 795774.7154594767_f64 * z * inv_a_gap * inv_t1_sq
-                            * (z * inv_sqrt_a_gap / (t0 * t0)
-                                - 2.0_f64 * inv_t0 * inv_sqrt_a_gap)
-                        - 1591549.4309189534_f64 * inv_a_gap * t2 * inv_t1_sq) - K_S)
-                - C * t4 / (M * M)
-                + phi * R * t3
-                    * (phi * R_CORE0 / (1.0_f64 - Real::abs(phi) / PHI_SAT)
-                        + 795774.7154594767_f64 * z * phi * inv_a_gap * inv_t1) * inv_m
-                    / t5) * inv_phi * inv_n * inv_t3;
-        // (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
-        let w = jr + GAIN_K1 * (zr - z) + GAIN_K2 * (vr - v)
-            + GAIN_K3 * (ar - t4 * inv_m);
+        let inv_a_gap = 1.0_f64 / A_GAP;
+        let t0 = 1.0_f64 / (z + 1e-9_f64);
+        let ln = Real::ln(2.0_f64 * L_W * t0);
+        let inv_sqrt_a_gap = 1.0_f64 / Real::sqrt(A_GAP);
+        let t1 = inv_sqrt_a_gap * z * ln + 1.0_f64;
+        let inv_t1 = 1.0_f64 / t1;
+        let phi_sq = phi * phi;
+        let t2 = ln - z * t0;
+        let t3 = 1.0_f64 - inv_sqrt_a_gap * z * inv_t1 * t2;
+        let t4 = -(F0 + K_S * z + C * v)
+            - 397887.35772973835_f64 * inv_a_gap * inv_t1 * phi_sq * t3;
         // (41) ξ₃ = a(x) = L_f²h
-        let xi3 = t4 * inv_m;
+        let xi3 = inv_m * t4;
+        let t5 = N * N + R * K_E;
+        // (31) L_f³h
+        let lf3h = inv_m
+            * (v
+                * (-K_S
+                    - 397887.35772973835_f64 * inv_sqrt_a_gap * inv_a_gap
+                        * (inv_t1 * inv_t1) * phi_sq
+                        * (2.0_f64 * inv_sqrt_a_gap * z * inv_t1 * (t2 * t2)
+                            - z * t0 * (z * t0 - 2.0_f64) - 2.0_f64 * t2))
+                - C * inv_m * t4
+                + 795774.7154594767_f64 * R * inv_a_gap / t5 * inv_t1 * phi_sq * t3
+                    * (795774.7154594767_f64 * inv_a_gap * z * inv_t1
+                        + R_CORE0 / (1.0_f64 - 1.0_f64 / PHI_SAT * Real::abs(phi))));
         // (32) β(x) = 1 / L_g L_f²h
-        let beta = -M * t5 * inv_phi * inv_n * inv_t3;
-        // (50) u = α + β·w
-        let u = alpha - M * t5 * inv_phi * inv_n * inv_t3 * w;
+        let beta = -1.2566370614359173e-6_f64 * A_GAP * M * t5 / N * t1 / (phi * t3);
+        // (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
+        let w = jr + GAIN_K1 * (zr - z) + GAIN_K2 * (vr - v) + GAIN_K3 * (ar - xi3);
+        // (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
+        let alpha = -lf3h * beta;
+        // (50) u = α + β·w = β·(w − L_f³h)
+        let u = beta * (w - lf3h);
         LawTermsOutput {
             xi3,
-            alpha,
+            lf3h,
             beta,
             w,
+            alpha,
             u,
         }
     }

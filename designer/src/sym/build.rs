@@ -140,7 +140,7 @@ impl Graph {
     }
 
     /// `c·rest` decomposition of a term: `Mul([Const c, …])` → (c, Π…).
-    fn split_coefficient(&mut self, t: Id) -> (f64, Id) {
+    pub(crate) fn split_coefficient(&mut self, t: Id) -> (f64, Id) {
         if let Node::Mul(xs) = self.node(t) {
             if let Some(c) = self.as_const(xs[0]) {
                 let rest: Vec<Id> = xs[1..].to_vec();

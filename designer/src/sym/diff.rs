@@ -161,7 +161,7 @@ impl Graph {
     }
 
     /// Rebuilds `id` from the (possibly replaced) images of its children.
-    fn rebuild(&mut self, id: Id, memo: &HashMap<Id, Id>) -> Id {
+    pub(crate) fn rebuild(&mut self, id: Id, memo: &HashMap<Id, Id>) -> Id {
         let m = |c: &Id| memo[c];
         match self.node(id).clone() {
             Node::Const(_) | Node::Sym(_) => id,

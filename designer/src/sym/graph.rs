@@ -125,6 +125,11 @@ impl Graph {
         id
     }
 
+    /// The id of `node` if it is already interned (lookup only, no simplification).
+    pub fn find(&self, node: &Node) -> Option<Id> {
+        self.index.get(node).copied()
+    }
+
     /// The symbol called `name` (created on first use).
     pub fn symbol(&mut self, name: &str) -> Id {
         let index = match self.symbol_index.get(name) {

@@ -11,12 +11,14 @@
 //! | `build.rs` | smart constructors = simplification rules |
 //! | `diff.rs` | differentiation, substitution |
 //! | `cse.rs` | common-subexpression elimination |
+//! | `factor.rs` | common factors out of sums |
 //! | `print.rs` | deterministic infix printing |
 //! | `tape.rs` | compilation to a flat tape, fast evaluation |
 
 mod build;
 mod cse;
 mod diff;
+mod factor;
 mod graph;
 mod print;
 mod tape;
