@@ -19,6 +19,9 @@
 //! | `float.rs` | [`Float`] and shortest round-trip literals |
 //! | `format.rs` | `prettyplease` formatting and `//` comments |
 //! | `error.rs` | [`EmitError`] |
+//! | `controller.rs` | the feedback-linearizing controller module |
+//! | `semera.rs` | the SEMERA and integral estimator modules |
+//! | `observer.rs` | the EKF and UKF modules |
 
 mod build;
 mod controller;
@@ -29,7 +32,9 @@ mod format;
 mod header;
 mod lower;
 mod names;
+mod observer;
 mod plan;
+mod semera;
 
 pub use build::{
     build_file, compile, operation_name, write_if_changed, BuildError, Design, DesignedOperation,
@@ -44,3 +49,5 @@ pub use float::Float;
 pub use format::format_items;
 pub use header::{sha256_hex, Header};
 pub use names::const_name;
+pub use observer::*;
+pub use semera::*;

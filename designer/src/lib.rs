@@ -6,6 +6,7 @@
 //! - [`design`]: controller derivations (Lie derivatives, feedback linearization).
 //! - [`description`]: the validated actuator description (`valve.toml`).
 //! - [`model`]: the actuator's state-space model, built symbolically.
+//! - [`observe`]: observers (SEMERA, integral estimator, EKF, UKF).
 //! - [`record`]: recorded signals in the measured-data CSV format.
 //! - [`replay`]: an input replayed through the hybrid model (`simulate`).
 //! - [`sim`]: the hybrid-automaton simulator (knows nothing of magnetics).
@@ -13,6 +14,7 @@
 pub mod description;
 pub mod design;
 pub mod model;
+pub mod observe;
 pub mod record;
 pub mod replay;
 pub mod sim;

@@ -6,6 +6,9 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod linalg;
+mod ln;
+
 /// Scalar math for generated code, through `libm` (no `std`).
 ///
 /// Generated functions call these with the trait path, e.g.

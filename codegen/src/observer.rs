@@ -1,0 +1,1 @@
+//! EKF and UKF emission (being written).

@@ -1,0 +1,1 @@
+//! SEMERA and integral estimator emission (being written).

@@ -1,0 +1,1 @@
+//! Allocation-free fixed-size linear algebra for generated observers (being written).

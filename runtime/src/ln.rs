@@ -1,0 +1,1 @@
+//! Natural logarithm for f64 (being written).
