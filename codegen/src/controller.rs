@@ -21,10 +21,14 @@
 //!   law brings ξ₃ = a(x) to 0, i.e. the forces into balance at takeoff;
 //! - on [t₀, t_f]: ξ_r, j_r from the table, the segment cursor advanced
 //!   monotonically (lookup with `.get()`);
-//! - after t_f: ξ_r = [z_f + (z_f − z₀)·PRESS, 0, 0], a reference just beyond
-//!   the end stop (10⁻⁶ of the stroke), so the loop closes whatever gap the
-//!   tracking error left gently (at about λ·gap, tens of µm/s) and the
-//!   contact is certain; then, once the armature is at its end stop (within
+//! - after t_f: ξ_r = [z_f + (z_f − z₀)·(PRESS + CREEP·(t − t_f)), (z_f − z₀)·CREEP, 0],
+//!   a reference just beyond the end stop (10⁻⁶ of the stroke) that keeps
+//!   creeping beyond it (at 2.5·10⁻³ stroke per motion time, 0.5 mm/s for a 1 mm
+//!   stroke in 5 ms; up to `CREEP_MAX` = 5 % of the stroke), so the loop
+//!   closes whatever gap the tracking error left gently (at about λ·gap, tens
+//!   of µm/s) and, when the plant differs from the model so that a
+//!   pure hold would hover short of the stop, still lands (at about the
+//!   creep speed); then, once the armature is at its end stop (within
 //!   `LANDED_BAND`, 10⁻⁹ of the stroke: contact, not proximity — switching to
 //!   full voltage a few nm early would slam it in), the expert rules of
 //!   model-free-sliding-mode-soft-landing (43): closing → u = u_max·sgn φ
@@ -63,6 +67,11 @@ const GUARD_FRACTION: f64 = 1e-3;
 const LANDED_FRACTION: f64 = 1e-9;
 /// The reference after t_f lies this fraction of the stroke beyond the end stop.
 const PRESS_FRACTION: f64 = 1e-6;
+/// After t_f the reference creeps on beyond the stop by this fraction of the
+/// stroke per motion time t_f − t₀ …
+const CREEP_FRACTION: f64 = 2.5e-3;
+/// … up to this fraction of the stroke beyond it.
+const CREEP_MAX_FRACTION: f64 = 0.05;
 
 /// Reference samples per segment when searching the smallest flux.
 const FLUX_SAMPLES: usize = 64;
@@ -191,6 +200,8 @@ const DESIGN_CONSTS: &[&str] = &[
     "PHI_GUARD",
     "LANDED_BAND",
     "PRESS",
+    "CREEP",
+    "CREEP_MAX",
     "REFERENCE_CLOSING",
     "REFERENCE_OPENING",
 ];
@@ -587,6 +598,8 @@ fn float_module(
         ("PHI_GUARD", design.phi_guard, "Guard at φ → 0 [Wb]: where φ ≤ PHI_GUARD the law is not evaluated and u = u_max\n(drives the flux into D₀⁺). 10⁻³ of the smallest flux the reference needs, rounded down."),
         ("LANDED_BAND", design.landed_band, "Distance [m] to the end stop within which the armature counts as in contact\n(expert rules after t_f): 10⁻⁹ of the stroke, rounded down."),
         ("PRESS", PRESS_FRACTION, "After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes\nthe last gap gently and the contact is certain."),
+        ("CREEP", CREEP_FRACTION / (input.landing - input.takeoff), "After t_f the reference creeps on beyond the stop at CREEP·stroke per second [1/s]:\nwhere the plant differs from the model and a pure hold would hover short of the\nstop, the armature still lands, at about that speed."),
+        ("CREEP_MAX", CREEP_MAX_FRACTION, "The creep stops CREEP_MAX·stroke beyond the end stop."),
     ];
     let mut items = TokenStream::new();
     for (name, value, doc) in consts {
@@ -751,7 +764,8 @@ fn float_module(
                 }
 
                 /// [z_r, v_r, a_r, j_r] at `t` (51): z₀ at rest before t₀, the table on
-                /// [t₀, t_f], z_f at rest after t_f. Advances the segment cursor.
+                /// [t₀, t_f], after t_f just beyond z_f and creeping on (PRESS, CREEP).
+                /// Advances the segment cursor.
                 pub fn reference(&mut self, t: #ty) -> [#ty; 4] {
                     let time = t - self.start;
                     let (table, z0, zf) = self.operation.plan();
@@ -771,7 +785,12 @@ fn float_module(
                             None => [z0, 0.0, 0.0, 0.0],
                         }
                     } else if time > T_LANDING {
-                        [zf + (zf - z0) * PRESS, 0.0, 0.0, 0.0]
+                        let creep = CREEP * (time - T_LANDING);
+                        if creep < CREEP_MAX {
+                            [zf + (zf - z0) * (PRESS + creep), (zf - z0) * CREEP, 0.0, 0.0]
+                        } else {
+                            [zf + (zf - z0) * (PRESS + CREEP_MAX), 0.0, 0.0, 0.0]
+                        }
                     } else {
                         // before t₀ (and a NaN time): pre-movement stage
                         [z0, 0.0, 0.0, 0.0]

@@ -414,8 +414,12 @@ fn emitted_controller_compiles_passes_clippy_and_matches_the_tape() {
                 .collect();
             let mut r = v.polynomial.at(t);
             if t > TF {
-                // after t_f the reference lies PRESS = 1e-6 of the stroke beyond the stop
-                r.z += (v.polynomial.zf - v.polynomial.z0) * 1e-6;
+                // after t_f the reference lies PRESS = 1e-6 of the stroke beyond the
+                // stop and creeps on at CREEP = 2.5e-3 stroke per (t_f − t₀)
+                let stroke = v.polynomial.zf - v.polynomial.z0;
+                let creep = 2.5e-3 / (TF - T0);
+                r.z += stroke * (1e-6 + creep * (t - TF));
+                r.v = stroke * creep;
             }
             let ztol = if float == "f64" { 1e-15 } else { 1e-9 };
             assert!(

@@ -70,6 +70,14 @@ pub mod f32 {
     /// the last gap gently and the contact is certain.
     pub const PRESS: f32 = 1e-6;
 
+    /// After t_f the reference creeps on beyond the stop at CREEP·stroke per second [1/s]:
+    /// where the plant differs from the model and a pure hold would hover short of the
+    /// stop, the armature still lands, at about that speed.
+    pub const CREEP: f32 = 0.5;
+
+    /// The creep stops CREEP_MAX·stroke beyond the end stop.
+    pub const CREEP_MAX: f32 = 0.05;
+
     /// Reference of the closing motion z_m on [t₀, t_f] (51): one row
     /// [t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;
     /// a(τ) = c0 + c1·τ + c2·τ² + c3·τ³ with τ = t − t_k, v and z its integrals.
@@ -916,7 +924,8 @@ pub mod f32 {
         }
 
         /// [z_r, v_r, a_r, j_r] at `t` (51): z₀ at rest before t₀, the table on
-        /// [t₀, t_f], z_f at rest after t_f. Advances the segment cursor.
+        /// [t₀, t_f], after t_f just beyond z_f and creeping on (PRESS, CREEP).
+        /// Advances the segment cursor.
         pub fn reference(&mut self, t: f32) -> [f32; 4] {
             let time = t - self.start;
             let (table, z0, zf) = self.operation.plan();
@@ -937,7 +946,12 @@ pub mod f32 {
                     None => [z0, 0.0, 0.0, 0.0],
                 }
             } else if time > T_LANDING {
-                [zf + (zf - z0) * PRESS, 0.0, 0.0, 0.0]
+                let creep = CREEP * (time - T_LANDING);
+                if creep < CREEP_MAX {
+                    [zf + (zf - z0) * (PRESS + creep), (zf - z0) * CREEP, 0.0, 0.0]
+                } else {
+                    [zf + (zf - z0) * (PRESS + CREEP_MAX), 0.0, 0.0, 0.0]
+                }
             } else {
                 [z0, 0.0, 0.0, 0.0]
             }
@@ -1030,6 +1044,14 @@ pub mod f64 {
     /// After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes
     /// the last gap gently and the contact is certain.
     pub const PRESS: f64 = 1e-6;
+
+    /// After t_f the reference creeps on beyond the stop at CREEP·stroke per second [1/s]:
+    /// where the plant differs from the model and a pure hold would hover short of the
+    /// stop, the armature still lands, at about that speed.
+    pub const CREEP: f64 = 0.5;
+
+    /// The creep stops CREEP_MAX·stroke beyond the end stop.
+    pub const CREEP_MAX: f64 = 0.05;
 
     /// Reference of the closing motion z_m on [t₀, t_f] (51): one row
     /// [t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;
@@ -1893,7 +1915,8 @@ pub mod f64 {
         }
 
         /// [z_r, v_r, a_r, j_r] at `t` (51): z₀ at rest before t₀, the table on
-        /// [t₀, t_f], z_f at rest after t_f. Advances the segment cursor.
+        /// [t₀, t_f], after t_f just beyond z_f and creeping on (PRESS, CREEP).
+        /// Advances the segment cursor.
         pub fn reference(&mut self, t: f64) -> [f64; 4] {
             let time = t - self.start;
             let (table, z0, zf) = self.operation.plan();
@@ -1914,7 +1937,12 @@ pub mod f64 {
                     None => [z0, 0.0, 0.0, 0.0],
                 }
             } else if time > T_LANDING {
-                [zf + (zf - z0) * PRESS, 0.0, 0.0, 0.0]
+                let creep = CREEP * (time - T_LANDING);
+                if creep < CREEP_MAX {
+                    [zf + (zf - z0) * (PRESS + creep), (zf - z0) * CREEP, 0.0, 0.0]
+                } else {
+                    [zf + (zf - z0) * (PRESS + CREEP_MAX), 0.0, 0.0, 0.0]
+                }
             } else {
                 [z0, 0.0, 0.0, 0.0]
             }
