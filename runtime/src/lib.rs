@@ -56,7 +56,7 @@ pub mod math {
                 }
                 #[inline]
                 fn ln(x: $t) -> $t {
-                    libm::$ln(x)
+                    crate::ln::$ln(x)
                 }
                 #[inline]
                 fn tanh(x: $t) -> $t {
@@ -118,7 +118,7 @@ pub mod math {
         };
     }
 
-    real_impl!(f64, sqrt, exp, log, tanh, pow, fabs, fmin, fmax);
+    real_impl!(f64, sqrt, exp, ln, tanh, pow, fabs, fmin, fmax);
     real_impl!(f32, sqrtf, expf, logf, tanhf, powf, fabsf, fminf, fmaxf);
 }
 
