@@ -56,8 +56,11 @@ pub fn run(args: &Args) -> Result<(), Report> {
 
 /// The design figures, for scripts and oracles.
 fn report_json(design: &codegen::Design) -> String {
+    let no_operations = Vec::new();
     let operations: serde_json::Map<String, serde_json::Value> = design
-        .operations
+        .controller
+        .as_ref()
+        .map_or(&no_operations, |c| &c.operations)
         .iter()
         .map(|o| {
             let mut entry = serde_json::json!({
@@ -74,6 +77,6 @@ fn report_json(design: &codegen::Design) -> String {
             (codegen::operation_name(o.operation).to_string(), entry)
         })
         .collect();
-    let value = serde_json::json!({ "name": design.description.name, "gains": design.gains, "operations": operations });
+    let value = serde_json::json!({ "name": design.description.name, "gains": design.controller.as_ref().map(|c| c.gains), "operations": operations });
     serde_json::to_string_pretty(&value).unwrap_or_default() + "\n"
 }

@@ -7,6 +7,7 @@ mod atomic;
 mod build;
 mod check;
 mod eval;
+mod observe;
 mod plot;
 mod simulate;
 
@@ -45,6 +46,8 @@ enum Command {
     Simulate(simulate::Args),
     /// Design the soft-landing controller and emit its no_std Rust code.
     Build(build::Args),
+    /// Run the model-free estimators of [observer] over a recording (semera, integral).
+    Observe(observe::Args),
 }
 
 fn main() -> ExitCode {
@@ -59,6 +62,7 @@ fn main() -> ExitCode {
         Command::Eval { model, states } => eval::run(&model, &states),
         Command::Simulate(args) => simulate::run(&args),
         Command::Build(args) => build::run(&args),
+        Command::Observe(args) => observe::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1316,12 +1316,12 @@ fn build_refuses_what_it_cannot_design() {
     let out = dir.join("out.rs");
     let run = exec(&[
         OsStr::new("build"),
-        example("semera-valve.toml").as_os_str(),
+        example("jiles-atherton-valve.toml").as_os_str(),
         OsStr::new("--out"),
         out.as_os_str(),
     ]);
     run.rejected(&[
-        "semera-valve.toml",
+        "jiles-atherton-valve.toml",
         "nothing to build",
         "[trajectory]",
         "[controller]",

@@ -9,14 +9,20 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use designer::description::{parse_file, Description, FloatType, Operation, Shape};
+use designer::description::{
+    parse_file, Description, Estimator, FloatType, KalmanSection, Operation, Shape,
+};
 use designer::design::{
     check_feasibility, energy_optimal, fit_segments, DesignError, Feasibility, Linearization,
     OptimalSpec, OptimalTrajectory, Polynomial, Reference, SegmentTolerance, Segments,
 };
 use designer::model::Model;
+use designer::observe::discrete::{DiscreteModel, KalmanSettings};
 
 use crate::controller::{emit_controller, gains, ControllerError, ControllerInput, OperationTable};
+use crate::header::Header;
+use crate::observer::{emit_ekf, emit_ukf, wrap_module, ObserverError, ObserverInput};
+use crate::semera::{emit_semera, SemeraError, SemeraInput};
 use crate::Float;
 
 /// Why a description could not be built into code.
@@ -25,9 +31,17 @@ pub enum BuildError {
     #[error("{0}")]
     Description(#[from] designer::description::DescriptionError),
     #[error(
-        "{file}: nothing to build: add [trajectory] and [controller] sections (see the README)"
+        "{file}: nothing to build: add [trajectory] and [controller] sections, or an [observer] section (see the README)"
     )]
     NothingToBuild { file: String },
+    #[error("{file}: [controller] needs a [trajectory] section and [trajectory] a [controller] section (see the README)")]
+    HalfAController { file: String },
+    #[error("{file}: the {estimator} observer: {message}")]
+    Observer {
+        file: String,
+        estimator: &'static str,
+        message: String,
+    },
     #[error("{file}: {source}")]
     Design { file: String, source: DesignError },
     #[error("{file}: the {operation} reference is infeasible (perfect-tracking-soft-landing §4):\n{report}")]
@@ -68,10 +82,18 @@ pub struct DesignedOperation {
     pub optimal: Option<OptimalTrajectory>,
 }
 
-/// A complete design, ready to emit.
+/// A complete design, ready to emit: the controller and/or the observers.
 pub struct Design {
     pub description: Description,
     pub model: Model,
+    /// From `[trajectory]` + `[controller]`.
+    pub controller: Option<ControllerDesign>,
+    /// The EKF/UKF discretised model, from `[observer]` with "ekf" or "ukf".
+    pub kalman: Option<DiscreteModel>,
+}
+
+/// The designed feedback-linearizing controller.
+pub struct ControllerDesign {
     pub linearization: Linearization,
     pub gains: [f64; 3],
     pub operations: Vec<DesignedOperation>,
@@ -85,100 +107,235 @@ pub fn operation_name(op: Operation) -> &'static str {
 }
 
 impl Design {
-    /// Designs everything the description's `[trajectory]` and `[controller]` ask for.
+    /// Designs everything the description's `[trajectory]`, `[controller]`
+    /// and `[observer]` ask for.
     pub fn new(description: &Description) -> Result<Design, BuildError> {
         let file = description.source.file_name.clone();
-        let (Some(trajectory), Some(controller)) =
-            (&description.trajectory, &description.controller)
-        else {
-            return Err(BuildError::NothingToBuild { file });
-        };
         let mut model = Model::build(description);
-        let linearization =
-            Linearization::derive(&mut model).map_err(|source| BuildError::Design {
-                file: file.clone(),
-                source,
-            })?;
-        let mech = &description.mechanics;
-        let bounds = (
-            description.supply.u_min.max(-trajectory.u_bound),
-            trajectory.u_bound,
-        );
-        let mut operations = Vec::new();
-        for &operation in &trajectory.operations {
-            let (z0, zf) = match operation {
-                Operation::Closing => (mech.z_max, mech.z_min),
-                Operation::Opening => (mech.z_min, mech.z_max),
-            };
-            let name = operation_name(operation);
-            let polynomial = Polynomial {
-                z0,
-                zf,
-                t0: trajectory.takeoff,
-                tf: trajectory.landing,
-            };
-            let (reference, optimal): (Box<dyn Reference>, Option<OptimalTrajectory>) =
-                match trajectory.shape {
-                    Shape::Polynomial => (Box::new(polynomial), None),
-                    Shape::EnergyOptimal => {
-                        let spec = OptimalSpec::new(
-                            z0,
-                            zf,
-                            trajectory.takeoff,
-                            trajectory.landing,
-                            bounds.0,
-                            bounds.1,
-                        );
-                        let solution =
-                            energy_optimal(&mut model, &linearization, &spec).map_err(|e| {
-                                BuildError::Optimal {
-                                    file: file.clone(),
-                                    operation: name,
-                                    message: e.to_string(),
-                                }
-                            })?;
-                        (Box::new(solution.clone()), Some(solution))
-                    }
-                };
-            let feasibility =
-                check_feasibility(&mut model, &linearization, reference.as_ref(), bounds, 4000);
-            if !feasibility.is_feasible() {
-                return Err(BuildError::Infeasible {
-                    file,
-                    operation: name,
-                    report: feasibility.report(),
-                });
-            }
-            let breaks: Vec<f64> = optimal
-                .iter()
-                .flat_map(|o| o.switches.iter().map(|s| s.t))
-                .collect();
-            let fit = fit_segments(reference.as_ref(), &breaks, &SegmentTolerance::default())
-                .map_err(|e| BuildError::Table {
-                    file: file.clone(),
-                    operation: name,
-                    message: e.to_string(),
-                })?;
-            operations.push(DesignedOperation {
-                operation,
-                z0,
-                zf,
-                feasibility,
-                table: fit.table,
-                optimal,
-            });
+        let controller = match (&description.trajectory, &description.controller) {
+            (Some(_), Some(_)) => Some(design_controller(description, &mut model)?),
+            (None, None) => None,
+            _ => return Err(BuildError::HalfAController { file }),
+        };
+        let kalman = design_kalman(description, &model)?;
+        if controller.is_none() && description.observer.is_none() {
+            return Err(BuildError::NothingToBuild { file });
         }
         Ok(Design {
             description: description.clone(),
-            gains: gains(&controller.gains),
             model,
-            linearization,
-            operations,
+            controller,
+            kalman,
         })
     }
+}
 
-    /// The emitted module (deterministic bytes).
+/// `[trajectory]` + `[controller]`: linearization, references, feasibility, tables.
+fn design_controller(
+    description: &Description,
+    model: &mut Model,
+) -> Result<ControllerDesign, BuildError> {
+    let file = description.source.file_name.clone();
+    let (Some(trajectory), Some(controller)) = (&description.trajectory, &description.controller)
+    else {
+        return Err(BuildError::NothingToBuild { file });
+    };
+    let linearization = Linearization::derive(model).map_err(|source| BuildError::Design {
+        file: file.clone(),
+        source,
+    })?;
+    let mech = &description.mechanics;
+    let bounds = (
+        description.supply.u_min.max(-trajectory.u_bound),
+        trajectory.u_bound,
+    );
+    let mut operations = Vec::new();
+    for &operation in &trajectory.operations {
+        let (z0, zf) = match operation {
+            Operation::Closing => (mech.z_max, mech.z_min),
+            Operation::Opening => (mech.z_min, mech.z_max),
+        };
+        let name = operation_name(operation);
+        let polynomial = Polynomial {
+            z0,
+            zf,
+            t0: trajectory.takeoff,
+            tf: trajectory.landing,
+        };
+        let (reference, optimal): (Box<dyn Reference>, Option<OptimalTrajectory>) =
+            match trajectory.shape {
+                Shape::Polynomial => (Box::new(polynomial), None),
+                Shape::EnergyOptimal => {
+                    let spec = OptimalSpec::new(
+                        z0,
+                        zf,
+                        trajectory.takeoff,
+                        trajectory.landing,
+                        bounds.0,
+                        bounds.1,
+                    );
+                    let solution = energy_optimal(model, &linearization, &spec).map_err(|e| {
+                        BuildError::Optimal {
+                            file: file.clone(),
+                            operation: name,
+                            message: e.to_string(),
+                        }
+                    })?;
+                    (Box::new(solution.clone()), Some(solution))
+                }
+            };
+        let feasibility =
+            check_feasibility(model, &linearization, reference.as_ref(), bounds, 4000);
+        if !feasibility.is_feasible() {
+            return Err(BuildError::Infeasible {
+                file,
+                operation: name,
+                report: feasibility.report(),
+            });
+        }
+        let breaks: Vec<f64> = optimal
+            .iter()
+            .flat_map(|o| o.switches.iter().map(|s| s.t))
+            .collect();
+        let fit = fit_segments(reference.as_ref(), &breaks, &SegmentTolerance::default()).map_err(
+            |e| BuildError::Table {
+                file: file.clone(),
+                operation: name,
+                message: e.to_string(),
+            },
+        )?;
+        operations.push(DesignedOperation {
+            operation,
+            z0,
+            zf,
+            feasibility,
+            table: fit.table,
+            optimal,
+        });
+    }
+    Ok(ControllerDesign {
+        gains: gains(&controller.gains),
+        linearization,
+        operations,
+    })
+}
+
+/// `[observer.kalman]` → the discretised model (84)–(87) of the EKF/UKF.
+fn design_kalman(
+    description: &Description,
+    model: &Model,
+) -> Result<Option<DiscreteModel>, BuildError> {
+    let Some(o) = &description.observer else {
+        return Ok(None);
+    };
+    let wanted = o
+        .estimators
+        .iter()
+        .any(|e| matches!(e, Estimator::Ekf | Estimator::Ukf));
+    let (true, Some(k)) = (wanted, &o.kalman) else {
+        return Ok(None);
+    };
+    let settings = kalman_settings(o.sample_period, o.voltage_noise, o.current_noise, k);
+    DiscreteModel::new(model, &settings)
+        .map(Some)
+        .map_err(|e| BuildError::Observer {
+            file: description.source.file_name.clone(),
+            estimator: "ekf/ukf",
+            message: e.to_string(),
+        })
+}
+
+/// The designer's filter settings from the description's sections.
+pub fn kalman_settings(
+    sample_period: f64,
+    voltage_noise: f64,
+    current_noise: f64,
+    k: &KalmanSection,
+) -> KalmanSettings {
+    KalmanSettings {
+        sample_period,
+        voltage_noise,
+        current_noise,
+        process_z: k.process_z,
+        process_phi: k.process_phi,
+        process_hc: k.process_hc,
+        initial_z_std: k.initial_z_std,
+        initial_phi_std: k.initial_phi_std,
+        initial_hc_std: k.initial_hc_std,
+        ukf_alpha: k.ukf_alpha,
+        ukf_beta: k.ukf_beta,
+        ukf_kappa: k.ukf_kappa,
+    }
+}
+
+impl Design {
+    /// The emitted module (deterministic bytes): the controller (if any),
+    /// then `pub mod estimators` (SEMERA, integral), `pub mod ekf`, `pub mod ukf`.
     pub fn emit(&self) -> Result<String, BuildError> {
+        let d = &self.description;
+        let mut out = match &self.controller {
+            Some(c) => self.emit_controller(c)?,
+            None => self.header(),
+        };
+        let file = || d.source.file_name.clone();
+        let floats = d
+            .observer
+            .as_ref()
+            .map(|o| floats(&o.floats))
+            .unwrap_or_default();
+        if let Some(input) = SemeraInput::from_description(d) {
+            let items = emit_semera(&input).map_err(|e: SemeraError| BuildError::Observer {
+                file: file(),
+                estimator: "semera/integral",
+                message: e.to_string(),
+            })?;
+            out.push('\n');
+            out.push_str(&wrap_module(
+                "estimators",
+                "The model-free electrical estimators (semera-electromagnetic-estimation):\nSEMERA (Algorithm 1) and the integral estimator (Algorithm 2).",
+                &items,
+            ));
+        }
+        if let (Some(discrete), Some(o)) = (&self.kalman, &d.observer) {
+            let input = ObserverInput {
+                name: &d.name,
+                discrete,
+                floats,
+            };
+            type Emitter = fn(&ObserverInput) -> Result<String, ObserverError>;
+            let kinds: [(Estimator, &str, &str, Emitter); 2] = [
+                (Estimator::Ekf, "ekf", "The extended Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).", emit_ekf),
+                (Estimator::Ukf, "ukf", "The unscented Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).", emit_ukf),
+            ];
+            for (kind, name, doc, emit) in kinds {
+                if !o.estimators.contains(&kind) {
+                    continue;
+                }
+                let items = emit(&input).map_err(|e| BuildError::Observer {
+                    file: file(),
+                    estimator: name,
+                    message: e.to_string(),
+                })?;
+                out.push('\n');
+                out.push_str(&wrap_module(name, doc, &items));
+            }
+        }
+        Ok(out)
+    }
+
+    /// The file header when there is no controller (which writes its own).
+    fn header(&self) -> String {
+        let d = &self.description;
+        Header {
+            what: &format!("observers of `{}`", d.name),
+            generator_version: env!("CARGO_PKG_VERSION"),
+            source_file: file_label(&d.source.file_name),
+            source_text: &d.source.text,
+        }
+        .text()
+    }
+
+    fn emit_controller(&self, c: &ControllerDesign) -> Result<String, BuildError> {
         let d = &self.description;
         let (Some(trajectory), Some(controller)) = (&d.trajectory, &d.controller) else {
             return Err(BuildError::NothingToBuild {
@@ -194,14 +351,14 @@ impl Design {
                 self.model.states[1],
                 self.model.states[2],
             ],
-            linearization: &self.linearization,
-            gains: self.gains,
+            linearization: &c.linearization,
+            gains: c.gains,
             sample_period: controller.sample_period,
             u_min: d.supply.u_min,
             u_max: d.supply.u_max,
             takeoff: trajectory.takeoff,
             landing: trajectory.landing,
-            operations: self
+            operations: c
                 .operations
                 .iter()
                 .map(|o| OperationTable {
@@ -211,14 +368,7 @@ impl Design {
                     segments: &o.table,
                 })
                 .collect(),
-            floats: controller
-                .floats
-                .iter()
-                .map(|f| match f {
-                    FloatType::F32 => Float::F32,
-                    FloatType::F64 => Float::F64,
-                })
-                .collect(),
+            floats: floats(&controller.floats),
             source_file: file_label(&d.source.file_name),
             source_text: &d.source.text,
             generator_version: env!("CARGO_PKG_VERSION"),
@@ -232,40 +382,68 @@ impl Design {
     /// A human-readable design report (what `reldesign build` prints).
     pub fn report(&self) -> String {
         let mut s = String::new();
-        let _ = writeln!(
-            s,
-            "gains K = [{:e}, {:e}, {:e}] (eq. 48)",
-            self.gains[0], self.gains[1], self.gains[2]
-        );
-        let _ = writeln!(
-            s,
-            "{}",
-            self.linearization.singularity_text(&self.model.graph)
-        );
-        for o in &self.operations {
+        if let Some(c) = &self.controller {
             let _ = writeln!(
                 s,
-                "\n{} ({:e} m → {:e} m):",
-                operation_name(o.operation),
-                o.z0,
-                o.zf
+                "gains K = [{:e}, {:e}, {:e}] (eq. 48)",
+                c.gains[0], c.gains[1], c.gains[2]
             );
-            if let Some(opt) = &o.optimal {
+            let _ = writeln!(s, "{}", c.linearization.singularity_text(&self.model.graph));
+            for o in &c.operations {
                 let _ = writeln!(
                     s,
-                    "  energy-optimal: J = ∫u² dt = {:.6e} V²·s, max |u| = {:.4} V, mesh {} nodes, residual {:.2e}, {} saturation switch(es)",
-                    opt.cost,
-                    opt.max_abs_input,
-                    opt.t.len(),
-                    opt.max_residual,
-                    opt.switches.len()
+                    "\n{} ({:e} m → {:e} m):",
+                    operation_name(o.operation),
+                    o.z0,
+                    o.zf
                 );
+                if let Some(opt) = &o.optimal {
+                    let _ = writeln!(
+                        s,
+                        "  energy-optimal: J = ∫u² dt = {:.6e} V²·s, max |u| = {:.4} V, mesh {} nodes, residual {:.2e}, {} saturation switch(es)",
+                        opt.cost,
+                        opt.max_abs_input,
+                        opt.t.len(),
+                        opt.max_residual,
+                        opt.switches.len()
+                    );
+                }
+                let _ = write!(s, "{}", o.feasibility.report());
+                let _ = writeln!(s, "  reference table: {} segments", o.table.segments.len());
             }
-            let _ = write!(s, "{}", o.feasibility.report());
-            let _ = writeln!(s, "  reference table: {} segments", o.table.segments.len());
+        }
+        if let Some(o) = &self.description.observer {
+            let names: Vec<&str> = o
+                .estimators
+                .iter()
+                .map(|e| match e {
+                    Estimator::Semera => "semera",
+                    Estimator::Integral => "integral",
+                    Estimator::Ekf => "ekf",
+                    Estimator::Ukf => "ukf",
+                })
+                .collect();
+            let _ = writeln!(
+                s,
+                "\nobservers: {} at T_s = {:e} s (σ_v = {:e} V, σ_i = {:e} A)",
+                names.join(", "),
+                o.sample_period,
+                o.voltage_noise,
+                o.current_noise
+            );
         }
         s
     }
+}
+
+/// The emitted float types.
+fn floats(list: &[FloatType]) -> Vec<Float> {
+    list.iter()
+        .map(|f| match f {
+            FloatType::F32 => Float::F32,
+            FloatType::F64 => Float::F64,
+        })
+        .collect()
 }
 
 /// The file name as it should appear in generated headers (no directories,

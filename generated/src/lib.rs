@@ -1,5 +1,5 @@
-//! Checked-in controller code for the bundled examples that carry
-//! `[trajectory]` and `[controller]` sections, exactly as `reldesign build`
+//! Checked-in controller and observer code for the bundled examples that
+//! carry `[trajectory]` + `[controller]` or `[observer]` sections, exactly as `reldesign build`
 //! emits it. `tests/fresh.rs` regenerates every module and fails when one is
 //! stale; `UPDATE_GENERATED=1 cargo test -p reldesign-generated` rewrites them.
 //!
@@ -12,3 +12,8 @@
 /// perfect-tracking-soft-landing Table 1 with the paper's design.
 #[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
 pub mod perfect_tracking_valve;
+
+/// `examples/semera-valve.toml`: the valve of semera-electromagnetic-estimation
+/// Table I with the SEMERA and integral estimators of its Table II.
+#[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
+pub mod semera_valve;

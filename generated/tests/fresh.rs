@@ -8,7 +8,8 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// Examples with design sections, and the module each one generates.
+/// Examples with design sections (controller or observer), and the module
+/// each one generates.
 fn designed_examples() -> Vec<(PathBuf, String)> {
     let mut out = Vec::new();
     let mut paths: Vec<PathBuf> = std::fs::read_dir(root().join("examples"))
@@ -19,7 +20,7 @@ fn designed_examples() -> Vec<(PathBuf, String)> {
     paths.sort();
     for path in paths {
         let d = designer::description::parse_file(&path).unwrap_or_else(|e| panic!("{e}"));
-        if d.trajectory.is_some() && d.controller.is_some() {
+        if d.controller.is_some() || d.observer.is_some() {
             out.push((path, d.name));
         }
     }

@@ -4,13 +4,27 @@
 //! a Jiles–Atherton core where the design assumed the saturating one, and
 //! ±10 % on k_s and R. Compared with the sensor-based controller on the same
 //! plant and with uncontrolled 24 V / 0 V switching (the papers' baseline).
+//!
+//! The design is `tests/data/sensorless-valve.toml`: the example's valve and
+//! trajectories with a slower tracking loop (2.5 ms settling instead of 1 ms).
+//! With the example's 1 ms loop the observer's velocity, a difference quotient
+//! of estimated positions (84)–(85), drives u into the ±24 V limits and the
+//! loop oscillates (measured); the slower loop is the sensorless design.
 
 use designer::description::parse_str;
 use designer::description::Description;
 use designer::model::{Model, ModelPlant};
 use designer::sim::{simulate_sampled, EventKind, Limit, Measurement, Mode, Options, State};
-use reldesign_generated::perfect_tracking_valve::f64 as c64;
-use reldesign_tests::root;
+/// The sensorless design: `tests/data/sensorless-valve.toml` (the
+/// perfect-tracking valve with a 2.5 ms settling time and EKF/UKF at 10 µs),
+/// emitted by `tests/build.rs` through `codegen::compile`.
+#[allow(dead_code)] // the test uses the f64 code; the f32 code is checked elsewhere
+mod sensorless_valve {
+    include!(concat!(env!("OUT_DIR"), "/sensorless_valve.rs"));
+}
+use reldesign_generated::perfect_tracking_valve::f64 as example64;
+use reldesign_tests::{root, Rng};
+use sensorless_valve::f64 as c64;
 
 const VALVE: &str = "perfect-tracking-valve.toml";
 
@@ -86,8 +100,84 @@ const HALF: f64 = 10e-3;
 enum Drive {
     /// 24 V until HALF, then 0 V.
     Uncontrolled,
-    /// The generated controller on the true (z, v, φ).
+    /// The example's generated controller (1 ms settling) on the true (z, v, φ).
     SensorBased,
+    /// The generated controller on the estimate of an observer fed with the
+    /// noisy coil voltage and current only.
+    Sensorless(Filter),
+}
+
+/// The observer of a sensorless loop.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Filter {
+    /// The generated f64 EKF of the sensorless design (T_s = 10 µs).
+    GeneratedEkf,
+    /// The generated f64 UKF of the sensorless design (T_s = 10 µs).
+    GeneratedUkf,
+    /// The designer's f64 reference UKF, for sample periods other than the
+    /// example's (the generated f64 UKF agrees with it to 1e-13,
+    /// `codegen/tests/observer.rs`).
+    ReferenceUkf,
+}
+
+/// Measurement noise of the semera paper's study: σ_v = 15 mV, σ_i = 1 mA.
+const SIGMA_V: f64 = 15e-3;
+const SIGMA_I: f64 = 1e-3;
+
+/// An observer: (measured voltage held over the last sample, measured
+/// current now) → estimated (z, v, φ).
+type Observer = Box<dyn FnMut(f64, f64) -> [f64; 3]>;
+
+fn observer(filter: Filter, ts: f64) -> Observer {
+    use sensorless_valve::{ekf, ukf};
+    match filter {
+        Filter::GeneratedEkf => {
+            assert_eq!(ts, ekf::f64::T_S, "the generated filter's sample period");
+            let mut f = ekf::f64::Filter::new();
+            Box::new(move |u, i| {
+                let e = f.step(u, i);
+                [e.z, e.v, e.phi]
+            })
+        }
+        Filter::GeneratedUkf => {
+            assert_eq!(ts, ukf::f64::T_S, "the generated filter's sample period");
+            let mut f = ukf::f64::Filter::new();
+            Box::new(move |u, i| {
+                let e = f.step(u, i);
+                [e.z, e.v, e.phi]
+            })
+        }
+        Filter::ReferenceUkf => {
+            let d =
+                designer::description::parse_file(&root().join("tests/data/sensorless-valve.toml"))
+                    .unwrap_or_else(|e| panic!("{e}"));
+            let o = d.observer.as_ref().expect("[observer]");
+            let k = o.kalman.as_ref().expect("[observer.kalman]");
+            // the example's process noise, scaled ∝ T_s as it was tuned
+            let r = ts / o.sample_period;
+            let mut settings = codegen::kalman_settings(ts, o.voltage_noise, o.current_noise, k);
+            settings.process_z *= r;
+            settings.process_phi *= r;
+            let model = Model::build(&d);
+            let mut f = designer::observe::ukf::Ukf::from_model(&model, &settings)
+                .expect("filter settings");
+            Box::new(move |u, i| {
+                let e = f.step(u, i);
+                [e.z, e.v, e.phi]
+            })
+        }
+    }
+}
+
+/// Gaussian noise (Box–Muller on the tests' SplitMix64).
+struct Noise(Rng);
+
+impl Noise {
+    fn sample(&mut self, sigma: f64) -> f64 {
+        let u1 = self.0.uniform(f64::MIN_POSITIVE, 1.0);
+        let u2 = self.0.uniform(0.0, 1.0);
+        sigma * (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    }
 }
 
 /// Landing speeds of one closing-and-opening cycle.
@@ -96,8 +186,6 @@ struct Cycle {
     closing: f64,
     opening: f64,
     bounces: usize,
-    /// z at the end of the cycle [m].
-    z_end: f64,
 }
 
 /// One closing (from rest at z_max, φ = 0) and opening (started at HALF)
@@ -109,8 +197,17 @@ fn cycle(d: &Description, ts: f64, drive: Drive) -> Cycle {
     let mut closing = c64::Controller::new(c64::Operation::Closing);
     let mut opening = c64::Controller::new(c64::Operation::Opening);
     opening.start(HALF);
+    let mut example_closing = example64::Controller::new(example64::Operation::Closing);
+    let mut example_opening = example64::Controller::new(example64::Operation::Opening);
+    example_opening.start(HALF);
+    let mut observe = match drive {
+        Drive::Sensorless(filter) => Some(observer(filter, ts)),
+        _ => None,
+    };
+    let mut noise = Noise(Rng::new(0x5e9507));
+    let mut held = 0.0; // the voltage applied over the last sample period
     let mut control = |t: f64, m: &Measurement| -> f64 {
-        match drive {
+        let u = match drive {
             Drive::Uncontrolled => {
                 if t < HALF {
                     24.0
@@ -119,10 +216,26 @@ fn cycle(d: &Description, ts: f64, drive: Drive) -> Cycle {
                 }
             }
             Drive::SensorBased => {
-                let k = if t < HALF { &mut closing } else { &mut opening };
+                let k = if t < HALF {
+                    &mut example_closing
+                } else {
+                    &mut example_opening
+                };
                 k.step(t, m.x[0], m.x[1], m.x[2])
             }
-        }
+            Drive::Sensorless(_) => {
+                // the ADC samples i just before the new voltage is applied
+                let (i, _) = plant.current_and_voltage(t, &m.x, held);
+                let (u_meas, i_meas) = (held + noise.sample(SIGMA_V), i + noise.sample(SIGMA_I));
+                let [z, v, phi] = observe
+                    .as_mut()
+                    .map_or([f64::NAN; 3], |o| o(u_meas, i_meas));
+                let k = if t < HALF { &mut closing } else { &mut opening };
+                k.step(t, z, v, phi)
+            }
+        };
+        held = u;
+        u
     };
     let x0: State = [z_max, 0.0, 0.0, 0.0];
     let options = Options {
@@ -147,7 +260,6 @@ fn cycle(d: &Description, ts: f64, drive: Drive) -> Cycle {
         closing: closing_speed,
         opening: opening_speed,
         bounces: b1 + b2,
-        z_end: tr.x.last().map_or(f64::NAN, |x| x[0]),
     }
 }
 
@@ -166,6 +278,80 @@ fn baseline_and_sensor_based_landing_on_the_mismatched_plant() {
                 assert!(
                     soft * 20.0 < hard,
                     "k_s×{ks} R×{r} Ts={ts:e}: {s:?} vs {u:?}"
+                );
+            }
+        }
+    }
+}
+
+/// One row of the sensorless report: (uncontrolled, sensor-based, sensorless).
+fn sensorless_row(ks: f64, r: f64, ts: f64, filter: Filter) -> (Cycle, Cycle, Cycle) {
+    let d = mismatched_plant(ks, r);
+    let hard = cycle(&d, ts, Drive::Uncontrolled);
+    let sensor = cycle(&d, ts, Drive::SensorBased);
+    let soft = cycle(&d, ts, Drive::Sensorless(filter));
+    let pair = |c: &Cycle| format!("{:.2e} / {:.2e}", c.closing, c.opening);
+    eprintln!(
+        "{:>12} {:>6} {:>14} {:>22} {:>22} {:>22}  bounces {} / {}",
+        format!("k×{ks} R×{r}"),
+        format!("{}µs", ts * 1e6),
+        format!("{filter:?}"),
+        pair(&hard),
+        pair(&sensor),
+        pair(&soft),
+        sensor.bounces,
+        soft.bounces
+    );
+    (hard, sensor, soft)
+}
+
+/// Measuring only v and i (σ_v = 15 mV, σ_i = 1 mA), the generated UKF and
+/// EKF with the generated controller of the sensorless design land both
+/// operations on the Jiles–Atherton plant at T_s = 10 µs, softer than
+/// switching: measured 29× (closing) and 4.9× / 5.6× (opening, UKF / EKF).
+/// The issue's target, ≥ 10× for both, is met for closing only; with ±10 %
+/// on k_s and R it is not met (see `sensorless_report`), which is the open
+/// item of the observers issue.
+#[test]
+fn sensorless_loop_lands_on_the_ja_plant() {
+    for filter in [Filter::GeneratedUkf, Filter::GeneratedEkf] {
+        let (hard, _, soft) = sensorless_row(1.0, 1.0, 10e-6, filter);
+        assert!(
+            10.0 * soft.closing <= hard.closing,
+            "{filter:?}: {soft:?} vs {hard:?}"
+        );
+        assert!(
+            3.0 * soft.opening <= hard.opening,
+            "{filter:?}: {soft:?} vs {hard:?}"
+        );
+    }
+}
+
+/// The full report (slow, and not yet meeting the target): every plant
+/// variant, both generated filters at 10 µs and the reference UKF at 50 µs.
+/// `cargo test --release -p reldesign-tests --test sensorless -- --ignored --nocapture`
+#[test]
+#[ignore]
+fn sensorless_report() {
+    eprintln!(
+        "{:>12} {:>6} {:>14} {:>22} {:>22} {:>22}",
+        "plant", "Ts", "observer", "uncontrolled [m/s]", "sensor-based [m/s]", "sensorless [m/s]"
+    );
+    for (ks, r) in [(1.0, 1.0), (1.1, 0.9), (0.9, 1.1), (1.1, 1.1), (0.9, 0.9)] {
+        for (ts, filter) in [
+            (10e-6, Filter::GeneratedUkf),
+            (10e-6, Filter::GeneratedEkf),
+            (50e-6, Filter::ReferenceUkf),
+        ] {
+            let (hard, sensor, _) = sensorless_row(ks, r, ts, filter);
+            // what holds everywhere: the sensor-based loop lands ≥ 20× softer
+            for (s, h) in [
+                (sensor.closing, hard.closing),
+                (sensor.opening, hard.opening),
+            ] {
+                assert!(
+                    20.0 * s < h,
+                    "k×{ks} R×{r} Ts={ts:e}: {sensor:?} vs {hard:?}"
                 );
             }
         }

@@ -25,6 +25,8 @@ pub struct Description {
     pub trajectory: Option<Trajectory>,
     /// `[controller]`: the control law to design and emit (optional).
     pub controller: Option<Controller>,
+    /// `[observer]`: the estimators to design and emit (optional).
+    pub observer: Option<Observer>,
     /// Where the description came from (file name as given, full text).
     pub source: Source,
 }
@@ -198,4 +200,98 @@ pub struct Controller {
 pub enum Law {
     /// u = α + β·(K·(ξ_r − T(x)) + z_r⁽³⁾), perfect-tracking-soft-landing (50).
     FeedbackLinearization,
+}
+
+/// An estimator of `[observer].estimators`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Estimator {
+    /// SEMERA, model-free Kalman estimation of r, l, λ (semera Algorithm 1).
+    Semera,
+    /// The integral estimator with resistance update (semera Algorithm 2, (47)).
+    Integral,
+    /// Extended Kalman filter on the actuator model.
+    Ekf,
+    /// Unscented Kalman filter on the actuator model.
+    Ukf,
+}
+
+/// `[observer]`: what to estimate from the coil voltage and current, sampled
+/// every `sample_period`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observer {
+    /// In the order given, non-empty, no duplicates.
+    pub estimators: Vec<Estimator>,
+    /// Δ [s] (> 0): the estimators run once per sample.
+    pub sample_period: f64,
+    /// Emitted variants, sorted, no duplicates (default: both).
+    pub floats: Vec<FloatType>,
+    /// σ_v [V] (> 0): standard deviation of the voltage measurement noise.
+    pub voltage_noise: f64,
+    /// σ_i [A] (> 0): standard deviation of the current measurement noise.
+    pub current_noise: f64,
+    /// `[observer.semera]`: present iff `estimators` has `Semera`.
+    pub semera: Option<SemeraSettings>,
+    /// `[observer.integral]`: present iff `estimators` has `Integral`.
+    pub integral: Option<IntegralSettings>,
+    /// `[observer.kalman]`: present iff `estimators` has `Ekf` or `Ukf`.
+    pub kalman: Option<KalmanSection>,
+}
+
+/// `[observer.semera]`: the filter parameters of semera Table II (valve) /
+/// Table V (relay), besides σ_v, σ_i and Δ of `[observer]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SemeraSettings {
+    /// r̄₀ [Ω] (> 0): expected initial resistance, (25).
+    pub initial_resistance: f64,
+    /// σ_r0 [Ω] (> 0): its standard deviation, (26).
+    pub initial_resistance_std: f64,
+    /// l̄₀ [H] (> 0): expected inductance at rest, (25); also the expert rule's value.
+    pub initial_inductance: f64,
+    /// σ_l0 [H] (> 0): its standard deviation, (26).
+    pub initial_inductance_std: f64,
+    /// σ_ṙ [Ω/s] (≥ 0): standard deviation of dr/dt, (24).
+    pub resistance_rate_std: f64,
+    /// σ_l̈ [H/s²] (≥ 0): standard deviation of d²l/dt², (24).
+    pub inductance_accel_std: f64,
+    /// n_σ (> 0): half-width of the current's noise confidence interval in σ_i.
+    pub ci_sigmas: f64,
+}
+
+/// `[observer.integral]`: what semera Algorithm 2 needs besides σ_i and Δ.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IntegralSettings {
+    /// r̄₀ [Ω] (> 0): resistance used until the first update (47).
+    pub initial_resistance: f64,
+    /// l̄₀ [H] (> 0): the inductance of the expert rule.
+    pub initial_inductance: f64,
+    /// λ₀ [Wb]: flux linkage at each reset (0 without permanent magnets; default 0).
+    pub initial_flux_linkage: f64,
+    /// n_σ (> 0): half-width of the current's noise confidence interval in σ_i.
+    pub ci_sigmas: f64,
+    /// [V] (> 0): an energizing operation starts where the measured voltage
+    /// rises above this (default: half of `supply.u_max` with voltage drive).
+    pub energize_threshold: f64,
+}
+
+/// `[observer.kalman]`: the model-based filters (EKF, UKF) on x = [z, φ(, H_c)].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KalmanSection {
+    /// Standard deviation of w_z per step [m] (> 0).
+    pub process_z: f64,
+    /// Standard deviation of w_φ per step [Wb] (> 0).
+    pub process_phi: f64,
+    /// Standard deviation of w_Hc per step [A/m] (> 0); only with a Jiles–Atherton core.
+    pub process_hc: Option<f64>,
+    /// Initial standard deviation of z [m] (> 0); the filter starts at rest at z_max.
+    pub initial_z_std: f64,
+    /// Initial standard deviation of φ [Wb] (> 0); the filter starts at φ = 0.
+    pub initial_phi_std: f64,
+    /// Initial standard deviation of H_c [A/m] (> 0); only with a Jiles–Atherton core.
+    pub initial_hc_std: Option<f64>,
+    /// UKF spread α in (0, 1] (default 1).
+    pub ukf_alpha: f64,
+    /// UKF β ≥ 0 (default 2).
+    pub ukf_beta: f64,
+    /// UKF κ (default 0).
+    pub ukf_kappa: f64,
 }

@@ -12,13 +12,14 @@ use toml::de::{DeString, DeTable, DeValue};
 use toml::Spanned;
 
 use super::{
-    Coil, Controller, Core, Description, DescriptionError, Drive, FloatType, Gains, Gap,
-    JilesAtherton, Law, Mechanics, Operation, Shape, Source, Supply, Trajectory,
+    Coil, Controller, Core, Description, DescriptionError, Drive, Estimator, FloatType, Gains, Gap,
+    IntegralSettings, JilesAtherton, KalmanSection, Law, Mechanics, Observer, Operation,
+    SemeraSettings, Shape, Source, Supply, Trajectory,
 };
 
 type Res<T> = Result<T, DescriptionError>;
 
-const TOP_KEYS: [&str; 8] = [
+const TOP_KEYS: [&str; 9] = [
     "name",
     "coil",
     "gap",
@@ -27,9 +28,8 @@ const TOP_KEYS: [&str; 8] = [
     "supply",
     "trajectory",
     "controller",
+    "observer",
 ];
-/// Design sections of later versions: rejected with a clear message for now.
-const RESERVED: [&str; 1] = ["observer"];
 const GAP_MODELS: [&str; 4] = ["linear", "mclyman", "mclyman-fit", "table"];
 const CORE_MODELS: [&str; 3] = ["linear", "saturating", "jiles-atherton"];
 const DRIVES: [&str; 2] = ["voltage", "current"];
@@ -39,6 +39,44 @@ const SHAPES: [&str; 2] = ["energy-optimal", "polynomial"];
 const CONTROLLER_KEYS: [&str; 5] = ["law", "settling_time", "poles", "sample_period", "float"];
 const LAWS: [&str; 1] = ["feedback-linearization"];
 const FLOATS: [&str; 2] = ["f32", "f64"];
+const OBSERVER_KEYS: [&str; 8] = [
+    "estimators",
+    "sample_period",
+    "float",
+    "voltage_noise",
+    "current_noise",
+    "semera",
+    "integral",
+    "kalman",
+];
+const ESTIMATORS: [&str; 4] = ["semera", "integral", "ekf", "ukf"];
+const SEMERA_KEYS: [&str; 7] = [
+    "initial_resistance",
+    "initial_resistance_std",
+    "initial_inductance",
+    "initial_inductance_std",
+    "resistance_rate_std",
+    "inductance_accel_std",
+    "ci_sigmas",
+];
+const INTEGRAL_KEYS: [&str; 5] = [
+    "initial_resistance",
+    "initial_inductance",
+    "initial_flux_linkage",
+    "ci_sigmas",
+    "energize_threshold",
+];
+const KALMAN_KEYS: [&str; 9] = [
+    "process_z",
+    "process_phi",
+    "process_hc",
+    "initial_z_std",
+    "initial_phi_std",
+    "initial_hc_std",
+    "ukf_alpha",
+    "ukf_beta",
+    "ukf_kappa",
+];
 /// The motion [takeoff, landing] must last at least this many sample periods.
 const MIN_SAMPLES_PER_MOTION: f64 = 10.0;
 /// Grid size of the fringing-denominator check on (0, z_max].
@@ -66,7 +104,6 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         table: doc.get_ref(),
         span: 0..0,
     };
-    check_reserved(&root)?;
     root.check_keys(&TOP_KEYS, "at the top level")?;
     let name = parse_name(&root)?;
     let coil = parse_coil(&root.section("coil")?)?;
@@ -97,6 +134,10 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
     if let (Some(s), Some(c)) = (&controller_sect, &controller) {
         check_controller(&root, s, c, trajectory.as_ref(), &core_sect, &core)?;
     }
+    let observer = root
+        .opt_section("observer")?
+        .map(|s| parse_observer(&s, &supply, &core_sect, &core))
+        .transpose()?;
     let source = Source {
         file_name: file_name.to_string(),
         text: text.to_string(),
@@ -110,24 +151,12 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         supply,
         trajectory,
         controller,
+        observer,
         source,
     })
 }
 
 // ---------------------------------------------------------------- sections
-
-fn check_reserved(root: &Sect) -> Res<()> {
-    for section in RESERVED {
-        if root.table.contains_key(section) {
-            let msg = format!(
-                "section [{section}] is not supported yet by this version of reldesign \
-                 (it is reserved for the design sections of a later version); remove it"
-            );
-            return Err(root.err(section, msg, "not supported yet"));
-        }
-    }
-    Ok(())
-}
 
 fn parse_name(root: &Sect) -> Res<String> {
     const WHAT: &str = "an identifier usable as a Rust module name ([A-Za-z_][A-Za-z0-9_-]*)";
@@ -395,6 +424,17 @@ fn parse_controller(s: &Sect) -> Res<Controller> {
     let law = Law::FeedbackLinearization; // the only entry of LAWS
     let gains = parse_gains(s)?;
     let sample_period = s.num("sample_period", Bound::Positive, "s")?;
+    let floats = parse_floats(s)?;
+    Ok(Controller {
+        law,
+        gains,
+        sample_period,
+        floats,
+    })
+}
+
+/// `float`: optional, default both; sorted, no duplicates.
+fn parse_floats(s: &Sect) -> Res<Vec<FloatType>> {
     let mut floats: Vec<FloatType> = s
         .names("float", "float type", &FLOATS, "at least one float type")?
         .unwrap_or(FLOATS.to_vec())
@@ -405,11 +445,166 @@ fn parse_controller(s: &Sect) -> Res<Controller> {
         })
         .collect();
     floats.sort();
-    Ok(Controller {
-        law,
-        gains,
+    Ok(floats)
+}
+
+/// `[observer]` and its sub-sections `[observer.semera]`, `[observer.integral]`,
+/// `[observer.kalman]`: each sub-section is required exactly when one of its
+/// estimators is listed (and refused otherwise).
+fn parse_observer(s: &Sect, supply: &Supply, core_sect: &Sect, core: &Core) -> Res<Observer> {
+    s.check_keys(&OBSERVER_KEYS, "in [observer]")?;
+    let estimators: Vec<Estimator> = s
+        .names(
+            "estimators",
+            "estimator",
+            &ESTIMATORS,
+            "at least one estimator",
+        )?
+        .ok_or_else(|| {
+            s.missing(
+                "estimators",
+                "a non-empty array of \"semera\", \"integral\", \"ekf\", \"ukf\"",
+            )
+        })?
+        .into_iter()
+        .map(|e| match e {
+            "semera" => Estimator::Semera,
+            "integral" => Estimator::Integral,
+            "ekf" => Estimator::Ekf,
+            _ => Estimator::Ukf,
+        })
+        .collect();
+    let sample_period = s.num("sample_period", Bound::Positive, "s")?;
+    let floats = parse_floats(s)?;
+    let voltage_noise = s.num("voltage_noise", Bound::Positive, "V")?;
+    let current_noise = s.num("current_noise", Bound::Positive, "A")?;
+    let has = |e: Estimator| estimators.contains(&e);
+    let semera = s
+        .sub_section(
+            "semera",
+            "observer.semera",
+            has(Estimator::Semera),
+            "\"semera\"",
+        )?
+        .map(|t| parse_semera(&t))
+        .transpose()?;
+    let integral = s
+        .sub_section(
+            "integral",
+            "observer.integral",
+            has(Estimator::Integral),
+            "\"integral\"",
+        )?
+        .map(|t| parse_integral(&t, supply))
+        .transpose()?;
+    let kalman = s
+        .sub_section(
+            "kalman",
+            "observer.kalman",
+            has(Estimator::Ekf) || has(Estimator::Ukf),
+            "\"ekf\" or \"ukf\"",
+        )?
+        .map(|t| parse_kalman(&t, core_sect, core))
+        .transpose()?;
+    Ok(Observer {
+        estimators,
         sample_period,
         floats,
+        voltage_noise,
+        current_noise,
+        semera,
+        integral,
+        kalman,
+    })
+}
+
+/// `[observer.semera]`: semera Table II / Table V.
+fn parse_semera(s: &Sect) -> Res<SemeraSettings> {
+    s.check_keys(&SEMERA_KEYS, "in [observer.semera]")?;
+    Ok(SemeraSettings {
+        initial_resistance: s.num("initial_resistance", Bound::Positive, "Ω")?,
+        initial_resistance_std: s.num("initial_resistance_std", Bound::Positive, "Ω")?,
+        initial_inductance: s.num("initial_inductance", Bound::Positive, "H")?,
+        initial_inductance_std: s.num("initial_inductance_std", Bound::Positive, "H")?,
+        resistance_rate_std: s.num("resistance_rate_std", Bound::NonNegative, "Ω/s")?,
+        inductance_accel_std: s.num("inductance_accel_std", Bound::NonNegative, "H/s²")?,
+        ci_sigmas: s.num("ci_sigmas", Bound::Positive, "-")?,
+    })
+}
+
+/// `[observer.integral]`: what semera Algorithm 2 needs.
+fn parse_integral(s: &Sect, supply: &Supply) -> Res<IntegralSettings> {
+    s.check_keys(&INTEGRAL_KEYS, "in [observer.integral]")?;
+    let initial_resistance = s.num("initial_resistance", Bound::Positive, "Ω")?;
+    let initial_inductance = s.num("initial_inductance", Bound::Positive, "H")?;
+    let initial_flux_linkage = s.num_or("initial_flux_linkage", Bound::Any, "Wb", 0.0)?;
+    let ci_sigmas = s.num("ci_sigmas", Bound::Positive, "-")?;
+    let default_threshold =
+        (supply.drive == Drive::Voltage && supply.u_max > 0.0).then_some(0.5 * supply.u_max);
+    let energize_threshold = match default_threshold {
+        Some(d) => s.num_or("energize_threshold", Bound::Positive, "V", d)?,
+        None => s
+            .opt_num("energize_threshold", Bound::Positive, "V")?
+            .ok_or_else(|| {
+                s.missing(
+                    "energize_threshold",
+                    "a number > 0 [V]: the coil voltage above which an energizing operation \
+                     starts (it has no default unless supply.drive = \"voltage\" with \
+                     supply.u_max > 0, where it is u_max/2)",
+                )
+            })?,
+    };
+    Ok(IntegralSettings {
+        initial_resistance,
+        initial_inductance,
+        initial_flux_linkage,
+        ci_sigmas,
+        energize_threshold,
+    })
+}
+
+/// `[observer.kalman]`: `process_hc` and `initial_hc_std` exist exactly with a
+/// Jiles–Atherton core (whose state has H_c).
+fn parse_kalman(s: &Sect, core_sect: &Sect, core: &Core) -> Res<KalmanSection> {
+    s.check_keys(&KALMAN_KEYS, "in [observer.kalman]")?;
+    let process_z = s.num("process_z", Bound::Positive, "m")?;
+    let process_phi = s.num("process_phi", Bound::Positive, "Wb")?;
+    let ja = matches!(core, Core::JilesAtherton(_));
+    let hc = |key: &str| -> Res<Option<f64>> {
+        if ja {
+            let what = "a number > 0 [A/m] (the \"jiles-atherton\" core adds the state H_c)";
+            return s
+                .opt_num(key, Bound::Positive, "A/m")?
+                .map(Some)
+                .ok_or_else(|| s.missing(key, what));
+        }
+        if s.entry(key).is_some() {
+            let model = core_sect
+                .entry("model")
+                .and_then(|(_, v)| v.get_ref().as_str().map(str::to_owned))
+                .unwrap_or_default();
+            let msg = format!(
+                "only allowed with core.model = \"jiles-atherton\" \
+                 (the state has no H_c with core.model = \"{model}\"); remove it"
+            );
+            return Err(s.err(key, msg, "no H_c in this model"));
+        }
+        Ok(None)
+    };
+    let process_hc = hc("process_hc")?;
+    let initial_z_std = s.num("initial_z_std", Bound::Positive, "m")?;
+    let initial_phi_std = s.num("initial_phi_std", Bound::Positive, "Wb")?;
+    let initial_hc_std = hc("initial_hc_std")?;
+    Ok(KalmanSection {
+        process_z,
+        process_phi,
+        process_hc,
+        initial_z_std,
+        initial_phi_std,
+        initial_hc_std,
+        ukf_alpha: s.num_or("ukf_alpha", Bound::UnitLeftOpen, "-", 1.0)?,
+        ukf_beta: s.num_or("ukf_beta", Bound::NonNegative, "-", 2.0)?,
+        ukf_kappa: s.num_or("ukf_kappa", Bound::Any, "-", 0.0)?,
     })
 }
 
@@ -600,6 +795,8 @@ enum Bound {
     Unit,
     /// In [0, 1).
     UnitOpen,
+    /// In (0, 1].
+    UnitLeftOpen,
     /// Strictly above another key's value.
     Above(&'static str, f64),
 }
@@ -613,6 +810,7 @@ impl Bound {
             Bound::NonNegative => x >= 0.0,
             Bound::Unit => (0.0..=1.0).contains(&x),
             Bound::UnitOpen => (0.0..1.0).contains(&x),
+            Bound::UnitLeftOpen => x > 0.0 && x <= 1.0,
             Bound::Above(_, lower) => x > lower,
         }
     }
@@ -625,6 +823,7 @@ impl Bound {
             Bound::NonNegative => "a number >= 0".into(),
             Bound::Unit => "a number in [0, 1]".into(),
             Bound::UnitOpen => "a number in [0, 1)".into(),
+            Bound::UnitLeftOpen => "a number in (0, 1]".into(),
             Bound::Above(other, lower) => format!("a number > {other} (= {lower})"),
         }
     }
@@ -800,6 +999,49 @@ impl<'a> Sect<'a> {
             table,
             span: value.span(),
         })
+    }
+
+    /// The sub-table `key` of this section, named `full` in messages, which
+    /// must be present iff `required` (`needed_by` says which entries of
+    /// `estimators` ask for it).
+    fn sub_section(
+        &self,
+        key: &str,
+        full: &'static str,
+        required: bool,
+        needed_by: &str,
+    ) -> Res<Option<Sect<'a>>> {
+        let Some((_, value)) = self.entry(key) else {
+            if !required {
+                return Ok(None);
+            }
+            let msg = format!(
+                "missing required section [{full}]: {}.estimators lists {needed_by}, which \
+                 needs its parameters (see the README)",
+                self.name
+            );
+            return Err(self
+                .ctx
+                .err(full.to_string(), self.span.clone(), msg, "section missing"));
+        };
+        let Some(table) = value.get_ref().as_table() else {
+            let msg = format!("expected a table [{full}], found {}", self.ctx.found(value));
+            return Err(self.err(key, msg, "expected a table"));
+        };
+        if !required {
+            let msg = format!(
+                "section [{full}] is given but {}.estimators does not list {needed_by}: \
+                 add it there or remove the section",
+                self.name
+            );
+            return Err(self.err(key, msg, "not used by any estimator"));
+        }
+        Ok(Some(Sect {
+            ctx: self.ctx,
+            name: full,
+            table,
+            span: value.span(),
+        }))
     }
 
     /// The optional sub-table `name` of the root.
