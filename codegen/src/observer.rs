@@ -37,7 +37,7 @@ use quote::{format_ident, quote};
 use crate::emit::{function_tokens, FunctionSpec, Param};
 use crate::error::EmitError;
 use crate::float::Float;
-use crate::format::{comment_lets, format_items};
+use crate::format::{comment_lets, format_items, space_items};
 use crate::names::const_name;
 
 /// Everything [`emit_ekf`] and [`emit_ukf`] need.
@@ -1206,33 +1206,6 @@ fn comment_lines(text: &str, comments: &[(&str, &str)]) -> String {
             }
         }
         out.push_str(line);
-    }
-    out
-}
-
-/// A blank line between consecutive items of the same block (prettyplease
-/// writes none): before a line opening an item (`///`, `#[`, `pub `, `fn `,
-/// `impl `) that follows a line closing one (`;` or `}`) at the same indent.
-fn space_items(text: &str) -> String {
-    let mut out = String::with_capacity(text.len() + text.len() / 16);
-    let mut prev: Option<&str> = None;
-    for line in text.split_inclusive('\n') {
-        let trimmed = line.trim_start();
-        let indent = line.len() - trimmed.len();
-        let opens = ["///", "#[", "pub ", "fn ", "impl "]
-            .iter()
-            .any(|p| trimmed.starts_with(p));
-        if let Some(p) = prev {
-            let p_trimmed = p.trim_start();
-            let p_indent = p.len() - p_trimmed.len();
-            let closes = p_trimmed.trim_end().ends_with(';') || p_trimmed.trim_end().ends_with('}');
-            let comment = p_trimmed.starts_with("//") || p_trimmed.starts_with("#[");
-            if opens && closes && !comment && p_indent == indent {
-                out.push('\n');
-            }
-        }
-        out.push_str(line);
-        prev = Some(line);
     }
     out
 }
