@@ -7,11 +7,13 @@
 //! | `integral.rs` | the integral estimator with resistance update (semera Algorithm 2, (47)) |
 //! | `observability.rs` | the observability determinant (32) over a recorded current |
 //! | `discrete.rs` | the discretised model of jiles-atherton-actuator-model (84)–(87) |
+//! | `filter.rs` | state and steps the EKF and UKF share (input, projection, Q, restart) |
 //! | `ekf.rs` | extended Kalman filter on the discretised model (symbolic Jacobians) |
 //! | `ukf.rs` | unscented Kalman filter on the discretised model |
 
 pub mod discrete;
 pub mod ekf;
+mod filter;
 pub mod integral;
 pub mod observability;
 pub mod semera;

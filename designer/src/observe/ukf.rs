@@ -32,12 +32,11 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::model::Model;
-use crate::sim::Mode;
 
 use super::discrete::{
-    dense, mode_of, project, resting_stop, DiscreteModel, DiscreteTapes, Estimate, KalmanError,
-    KalmanSettings, UnscentedWeights,
+    dense, resting_stop, DiscreteModel, Estimate, KalmanError, KalmanSettings, UnscentedWeights,
 };
+use super::filter::FilterCore;
 
 /// Relative diagonal jitter of the first repair of a failed factorisation
 /// (f64; the emitted f32 filter uses [`REPAIR_JITTER_F32`]).
@@ -51,60 +50,19 @@ const MAX_POINTS: usize = 9;
 /// The f64 reference UKF.
 #[derive(Clone, Debug)]
 pub struct Ukf {
-    tapes: DiscreteTapes,
-    n: usize,
+    core: FilterCore,
     weights: UnscentedWeights,
-    ts: f64,
-    z_min: f64,
-    z_max: f64,
-    mode_band: f64,
-    input_var: f64,
-    measurement_var: f64,
-    process: [f64; 4],
-    x0: [f64; 4],
-    p0: [[f64; 4]; 4],
     /// chol P₀ (P₀ is positive definite by construction).
     l0: [[f64; 4]; 4],
-    has_field: bool,
-    uses_time: bool,
-    /// Prior mean x_{k|k−1}.
-    x: [f64; 4],
-    /// Prior covariance.
-    p: [[f64; 4]; 4],
-    u_last: f64,
-    time: f64,
-    skipped: usize,
-    repairs: usize,
 }
 
 impl Ukf {
     /// A filter at its initial state (at rest at z_max, φ = 0, H_c = 0).
     pub fn new(discrete: &DiscreteModel) -> Ukf {
-        let n = discrete.dim();
-        let x0 = discrete.initial_state();
-        let p0 = discrete.initial_covariance();
         Ukf {
-            tapes: discrete.tapes(),
-            n,
-            weights: discrete.settings.unscented(n),
-            ts: discrete.settings.sample_period,
-            z_min: discrete.z_min,
-            z_max: discrete.z_max,
-            mode_band: discrete.mode_band,
-            input_var: discrete.input_noise * discrete.input_noise,
-            measurement_var: discrete.measurement_noise * discrete.measurement_noise,
-            process: discrete.process_variance(),
-            x0,
-            p0,
+            core: FilterCore::new(discrete),
+            weights: discrete.settings.unscented(discrete.dim()),
             l0: discrete.initial_factor(),
-            has_field: discrete.has_field_state(),
-            uses_time: discrete.uses_time,
-            x: x0,
-            p: p0,
-            u_last: 0.0,
-            time: 0.0,
-            skipped: 0,
-            repairs: 0,
         }
     }
 
@@ -116,27 +74,28 @@ impl Ukf {
     /// The lower Cholesky factor of P, repairing P if it fails (see the
     /// module docs).
     fn factor(&mut self) -> dense::M4 {
-        let n = self.n;
-        if let Some(l) = dense::cholesky(n, &self.p) {
+        let c = &mut self.core;
+        let n = c.n;
+        if let Some(l) = dense::cholesky(n, &c.p) {
             return l;
         }
-        self.repairs += 1;
-        let mut q = self.p;
+        c.repairs += 1;
+        let mut q = c.p;
         for i in 0..n {
-            q[i][i] += REPAIR_JITTER * (q[i][i].abs() + self.p0[i][i]);
+            q[i][i] += REPAIR_JITTER * (q[i][i].abs() + c.p0[i][i]);
         }
         if let Some(l) = dense::cholesky(n, &q) {
-            self.p = q;
+            c.p = q;
             return l;
         }
-        self.p = self.p0;
+        c.p = c.p0;
         self.l0
     }
 
     /// The 2n + 1 sigma points of (x, L).
     fn sigma_points(&self, l: &dense::M4) -> [[f64; 4]; MAX_POINTS] {
-        let n = self.n;
-        let mut pts = [self.x; MAX_POINTS];
+        let n = self.core.n;
+        let mut pts = [self.core.x; MAX_POINTS];
         let lt = dense::transpose(n, l);
         let g = self.weights.gamma;
         for j in 0..n {
@@ -164,24 +123,20 @@ impl Ukf {
 
     /// One sample: update with (u, y), report the posterior, predict.
     pub fn step(&mut self, u: f64, y: f64) -> Estimate {
-        let n = self.n;
+        let n = self.core.n;
         let m = 2 * n + 1;
-        let u_ok = u.is_finite();
-        if u_ok {
-            self.u_last = u;
-        }
-        let u = self.u_last;
-        let t = if self.uses_time { self.time } else { 0.0 };
+        let input = self.core.input(u);
+        let (u, t) = (input.u, input.t);
 
         // measurement update
         let mut updated = false;
-        if u_ok && y.is_finite() {
+        if input.u_ok && y.is_finite() {
             let l = self.factor();
             let pts = self.sigma_points(&l);
             let mut ys = [0.0; MAX_POINTS];
             let mut dy_du = 0.0;
             for k in 0..m {
-                let e = self.tapes.measure(&pts[k], u, t);
+                let e = self.core.tapes.measure(&pts[k], u, t);
                 ys[k] = e.y;
                 if k == 0 {
                     dy_du = e.dy_du;
@@ -196,35 +151,22 @@ impl Ukf {
                 let d = ys[k] - y_mean;
                 s += self.weight_cov(k) * (d * d);
             }
-            let r = self.measurement_var + self.input_var * (dy_du * dy_du);
-            let s = s + r;
+            let s = s + self.core.output_variance(dy_du);
             let mut pxy = [0.0; 4];
             for k in 0..m {
                 let dy = self.weight_cov(k) * (ys[k] - y_mean);
                 for i in 0..n {
-                    pxy[i] += (pts[k][i] - self.x[i]) * dy;
+                    pxy[i] += (pts[k][i] - self.core.x[i]) * dy;
                 }
             }
-            let innovation = y - y_mean;
-            if innovation.is_finite() && s.is_finite() && s > 0.0 {
-                let mut k = [0.0; 4];
-                for i in 0..n {
-                    k[i] = pxy[i] / s;
-                }
-                dense::axpy(n, &mut self.x, innovation, &k);
-                dense::rank1_update(n, &mut self.p, -s, &k);
+            if let Some(k) = self.core.correct(y - y_mean, s, &pxy) {
+                dense::rank1_update(n, &mut self.core.p, -s, &k);
                 updated = true;
             }
         }
-        if !updated {
-            self.skipped += 1;
-        }
 
         // projection, the estimate
-        self.x[0] = project(self.x[0], self.z_min, self.z_max);
-        self.x[1] = project(self.x[1], self.z_min, self.z_max);
-        let [z, z_prev, phi, hc] = self.x;
-        let mode = mode_of(z, self.z_min, self.z_max, self.mode_band);
+        let post = self.core.project(updated);
 
         // prediction
         let l = self.factor();
@@ -232,27 +174,20 @@ impl Ukf {
         let mut next = [[0.0; 4]; MAX_POINTS];
         let mut accel = 0.0;
         for k in 0..m {
-            let pr = self.tapes.predict(&pts[k], u, t);
+            let pr = self.core.tapes.predict(&pts[k], u, t);
             next[k] = pr.next;
             if k == 0 {
                 accel = pr.acceleration;
             }
         }
         // the centre point is the posterior mean
-        let resting = resting_stop(mode, accel, next[0][0], self.z_min, self.z_max);
-        if let Some(stop) = resting {
+        let c = &self.core;
+        if let Some(stop) = resting_stop(post.mode, accel, next[0][0], c.z_min, c.z_max) {
             for pt in next.iter_mut().take(m) {
                 pt[0] = stop;
             }
         }
-        let estimate = Estimate {
-            z,
-            v: (z - z_prev) / self.ts,
-            a: if mode == Mode::Free { accel } else { 0.0 },
-            phi,
-            hc: self.has_field.then_some(hc),
-            mode,
-        };
+        let estimate = c.estimate(&post, accel);
         let mut mean = [0.0; 4];
         for k in 0..m {
             dense::axpy(n, &mut mean, self.weight_mean(k), &next[k]);
@@ -263,44 +198,34 @@ impl Ukf {
             dense::axpy(n, &mut d, -1.0, &mean);
             dense::rank1_update(n, &mut p, self.weight_cov(k), &d);
         }
-        for i in 0..n {
-            p[i][i] += self.process[i];
-        }
-        let gain = self.tapes.input_gain(&self.x, u, t);
-        dense::rank1_update(n, &mut p, self.input_var, &gain);
-        if dense::all_finite(n, &mean) && dense::all_finite_matrix(n, &p) {
-            self.x = mean;
-            self.p = p;
-        } else {
-            self.x = self.x0;
-            self.p = self.p0;
-            self.repairs += 1;
-        }
-        self.time += self.ts;
+        let c = &mut self.core;
+        let gain = c.tapes.input_gain(&c.x, u, t);
+        c.add_process_noise(&mut p, &gain);
+        c.accept(mean, p);
         estimate
     }
 
     /// The prior mean x_{k+1|k} (first `dim` entries).
     pub fn state(&self) -> [f64; 4] {
-        self.x
+        self.core.x
     }
 
     /// The prior covariance (leading `dim`×`dim` block).
     pub fn covariance(&self) -> [[f64; 4]; 4] {
-        self.p
+        self.core.p
     }
 
     pub fn dim(&self) -> usize {
-        self.n
+        self.core.n
     }
 
     /// Samples whose measurement update was skipped (non-finite data).
     pub fn skipped(&self) -> usize {
-        self.skipped
+        self.core.skipped
     }
 
     /// Repaired factorisations and restarts after a non-finite prediction.
     pub fn repairs(&self) -> usize {
-        self.repairs
+        self.core.repairs
     }
 }
