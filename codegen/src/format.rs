@@ -50,7 +50,8 @@ pub(crate) fn comment_lets(text: &str, function: &str, comments: &[(&str, &str)]
 
 /// A blank line between consecutive items of the same block (prettyplease
 /// writes none): before a line opening an item (`///`, `#[`, `pub `, `fn `,
-/// `impl `) that follows a line closing one (`;` or `}`) at the same indent.
+/// `impl `) that follows a line closing one (`;` or `}`) at the same or a
+/// deeper indent (an item may end on a continuation line, e.g. a long const).
 pub(crate) fn space_items(text: &str) -> String {
     let mut out = String::with_capacity(text.len() + text.len() / 16);
     let mut prev: Option<&str> = None;
@@ -65,7 +66,7 @@ pub(crate) fn space_items(text: &str) -> String {
             let p_indent = p.len() - p_trimmed.len();
             let closes = p_trimmed.trim_end().ends_with(';') || p_trimmed.trim_end().ends_with('}');
             let comment = p_trimmed.starts_with("//") || p_trimmed.starts_with("#[");
-            if opens && closes && !comment && p_indent == indent {
+            if opens && closes && !comment && p_indent >= indent {
                 out.push('\n');
             }
         }

@@ -31,7 +31,7 @@ use quote::{format_ident, quote};
 
 use crate::error::EmitError;
 use crate::float::Float;
-use crate::format::format_items;
+use crate::format::{format_items, space_items};
 
 /// Everything [`emit_semera`] needs.
 #[derive(Debug, Clone, PartialEq)]
@@ -740,33 +740,4 @@ fn integral_tokens(float: Float) -> TokenStream {
             }
         }
     }
-}
-
-/// A blank line between consecutive items of the same block (prettyplease
-/// writes none): before a line opening an item (`///`, `#[`, `pub `, `fn `,
-/// `impl `) that follows a line closing one (`;` or `}`) at the same or a
-/// deeper indent.
-fn space_items(text: &str) -> String {
-    let mut out = String::with_capacity(text.len() + text.len() / 16);
-    let mut prev: Option<&str> = None;
-    for line in text.split_inclusive('\n') {
-        let trimmed = line.trim_start();
-        let indent = line.len() - trimmed.len();
-        let opens = ["///", "#[", "pub ", "fn ", "impl "]
-            .iter()
-            .any(|p| trimmed.starts_with(p));
-        if let Some(p) = prev {
-            let p_trimmed = p.trim_start();
-            let p_indent = p.len() - p_trimmed.len();
-            let closes = p_trimmed.trim_end().ends_with(';') || p_trimmed.trim_end().ends_with('}');
-            let comment = p_trimmed.starts_with("//") || p_trimmed.starts_with("#[");
-            // `>=`: an item may end on a continuation line (a long const)
-            if opens && closes && !comment && p_indent >= indent {
-                out.push('\n');
-            }
-        }
-        out.push_str(line);
-        prev = Some(line);
-    }
-    out
 }
