@@ -9,9 +9,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use designer::description::{
-    parse_file, Description, Estimator, FloatType, KalmanSection, Operation, Shape,
-};
+use designer::description::{parse_file, Description, Estimator, FloatType, Operation, Shape};
 use designer::design::{
     check_feasibility, energy_optimal, fit_segments, DesignError, Feasibility, Linearization,
     OptimalSpec, OptimalTrajectory, Polynomial, Reference, SegmentTolerance, Segments,
@@ -232,10 +230,9 @@ fn design_kalman(
         .estimators
         .iter()
         .any(|e| matches!(e, Estimator::Ekf | Estimator::Ukf));
-    let (true, Some(k)) = (wanted, &o.kalman) else {
+    let (true, Some(settings)) = (wanted, KalmanSettings::from_observer(o)) else {
         return Ok(None);
     };
-    let settings = kalman_settings(o.sample_period, o.voltage_noise, o.current_noise, k);
     DiscreteModel::new(model, &settings)
         .map(Some)
         .map_err(|e| BuildError::Observer {
@@ -243,29 +240,6 @@ fn design_kalman(
             estimator: "ekf/ukf",
             message: e.to_string(),
         })
-}
-
-/// The designer's filter settings from the description's sections.
-pub fn kalman_settings(
-    sample_period: f64,
-    voltage_noise: f64,
-    current_noise: f64,
-    k: &KalmanSection,
-) -> KalmanSettings {
-    KalmanSettings {
-        sample_period,
-        voltage_noise,
-        current_noise,
-        process_z: k.process_z,
-        process_phi: k.process_phi,
-        process_hc: k.process_hc,
-        initial_z_std: k.initial_z_std,
-        initial_phi_std: k.initial_phi_std,
-        initial_hc_std: k.initial_hc_std,
-        ukf_alpha: k.ukf_alpha,
-        ukf_beta: k.ukf_beta,
-        ukf_kappa: k.ukf_kappa,
-    }
 }
 
 impl Design {

@@ -37,8 +37,8 @@ mod plan;
 mod semera;
 
 pub use build::{
-    build_file, compile, kalman_settings, operation_name, write_if_changed, BuildError,
-    ControllerDesign, Design, DesignedOperation,
+    build_file, compile, operation_name, write_if_changed, BuildError, ControllerDesign, Design,
+    DesignedOperation,
 };
 pub use controller::{
     emit_controller, gains, triple_pole_settling_product, ControllerError, ControllerInput,

@@ -152,10 +152,11 @@ fn observer(filter: Filter, ts: f64) -> Observer {
                 designer::description::parse_file(&root().join("tests/data/sensorless-valve.toml"))
                     .unwrap_or_else(|e| panic!("{e}"));
             let o = d.observer.as_ref().expect("[observer]");
-            let k = o.kalman.as_ref().expect("[observer.kalman]");
             // the example's process noise, scaled ∝ T_s as it was tuned
             let r = ts / o.sample_period;
-            let mut settings = codegen::kalman_settings(ts, o.voltage_noise, o.current_noise, k);
+            let mut settings = designer::observe::discrete::KalmanSettings::from_observer(o)
+                .expect("[observer.kalman]");
+            settings.sample_period = ts;
             settings.process_z *= r;
             settings.process_phi *= r;
             let model = Model::build(&d);

@@ -126,6 +126,26 @@ pub enum KalmanError {
 }
 
 impl KalmanSettings {
+    /// The settings of the description's `[observer]` and
+    /// `[observer.kalman]`; `None` without a kalman section.
+    pub fn from_observer(o: &crate::description::Observer) -> Option<KalmanSettings> {
+        let k = o.kalman.as_ref()?;
+        Some(KalmanSettings {
+            sample_period: o.sample_period,
+            voltage_noise: o.voltage_noise,
+            current_noise: o.current_noise,
+            process_z: k.process_z,
+            process_phi: k.process_phi,
+            process_hc: k.process_hc,
+            initial_z_std: k.initial_z_std,
+            initial_phi_std: k.initial_phi_std,
+            initial_hc_std: k.initial_hc_std,
+            ukf_alpha: k.ukf_alpha,
+            ukf_beta: k.ukf_beta,
+            ukf_kappa: k.ukf_kappa,
+        })
+    }
+
     /// Checks every value (with or without the H_c state).
     pub fn validate(&self, has_field_state: bool) -> Result<(), KalmanError> {
         let check = |name: &'static str, value: f64, ok: bool, expected: &'static str| {
