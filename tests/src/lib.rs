@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use designer::description::{parse_file, parse_str, Description};
 use designer::model::Model;
+use designer::sim::{Event, EventKind, Limit};
 
 /// The workspace root.
 pub fn root() -> PathBuf {
@@ -89,4 +90,23 @@ pub fn random_state(d: &Description, rng: &mut Rng) -> [f64; 4] {
         rng.uniform(-phi_max, phi_max),
         rng.uniform(-2000.0, 2000.0),
     ]
+}
+
+/// The impacts at `limit` with `after < t < before`, as (speed before, speed
+/// after) — `v_after = 0` when the armature sticks.
+pub fn impacts(
+    events: &[Event],
+    limit: Limit,
+    after: f64,
+    before: f64,
+) -> impl Iterator<Item = (f64, f64)> + '_ {
+    events.iter().filter_map(move |e| match e.kind {
+        EventKind::Impact {
+            limit: at,
+            v_before,
+            v_after,
+            ..
+        } if at == limit && e.t > after && e.t < before => Some((v_before.abs(), v_after.abs())),
+        _ => None,
+    })
 }

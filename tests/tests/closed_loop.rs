@@ -4,9 +4,9 @@
 //! settling time (perfect-tracking-soft-landing §5).
 
 use designer::model::{Model, ModelPlant};
-use designer::sim::{simulate_sampled, EventKind, Limit, Measurement, Mode, Options};
+use designer::sim::{simulate_sampled, Limit, Measurement, Mode, Options};
 use reldesign_generated::perfect_tracking_valve::{f32 as c32, f64 as c64};
-use reldesign_tests::example;
+use reldesign_tests::{example, impacts};
 
 /// RMSE of z during the motion (perfect-tracking-soft-landing (69), with the
 /// square root of the errata), the equivalent impact velocity v_eq (70), the
@@ -91,20 +91,10 @@ fn run(closing: bool, ts: f64, law: Law) -> Outcome {
     }
     let destination = if closing { Limit::Min } else { Limit::Max };
     let (mut v2, mut landing_speed, mut bounces) = (0.0, 0.0f64, 0);
-    for e in &tr.events {
-        if let EventKind::Impact {
-            limit,
-            v_before,
-            v_after,
-            ..
-        } = e.kind
-        {
-            if limit == destination && e.t > T0 {
-                v2 += v_before * v_before;
-                landing_speed = landing_speed.max(v_before.abs());
-                bounces += usize::from(v_after != 0.0);
-            }
-        }
+    for (v_before, v_after) in impacts(&tr.events, destination, T0, f64::INFINITY) {
+        v2 += v_before * v_before;
+        landing_speed = landing_speed.max(v_before);
+        bounces += usize::from(v_after != 0.0);
     }
     Outcome {
         rmse_z: (sum / n as f64).sqrt(),

@@ -14,7 +14,7 @@
 use designer::description::parse_str;
 use designer::description::Description;
 use designer::model::{Model, ModelPlant};
-use designer::sim::{simulate_sampled, EventKind, Limit, Measurement, Mode, Options, State};
+use designer::sim::{simulate_sampled, Event, Limit, Measurement, Mode, Options, State};
 /// The sensorless design: `tests/data/sensorless-valve.toml` (the
 /// perfect-tracking valve with a 2.5 ms settling time and EKF/UKF at 10 µs),
 /// emitted by `tests/build.rs` through `codegen::compile`.
@@ -23,7 +23,7 @@ mod sensorless_valve {
     include!(concat!(env!("OUT_DIR"), "/sensorless_valve.rs"));
 }
 use reldesign_generated::perfect_tracking_valve::f64 as example64;
-use reldesign_tests::{root, Rng};
+use reldesign_tests::{impacts, root, Rng};
 use sensorless_valve::f64 as c64;
 
 const VALVE: &str = "perfect-tracking-valve.toml";
@@ -72,24 +72,18 @@ fn mismatched_plant(ks_factor: f64, r_factor: f64) -> Description {
     parse_str(&plant, "mismatched-plant.toml").unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Impact speeds at the destination stop: (first impact, largest, bounces).
-fn landing(events: &[designer::sim::Event], destination: Limit, after: f64) -> (f64, usize) {
-    let (mut first, mut bounces) = (None, 0);
-    for e in events {
-        if let EventKind::Impact {
-            limit,
-            v_before,
-            v_after,
-            ..
-        } = e.kind
-        {
-            if limit == destination && e.t > after {
-                first.get_or_insert(v_before.abs());
-                bounces += usize::from(v_after != 0.0);
-            }
+/// The first impact speed at `destination` within (after, before), NaN if
+/// none, and the number of bounces there.
+fn landing(events: &[Event], destination: Limit, after: f64, before: f64) -> (f64, usize) {
+    let mut first = f64::NAN;
+    let mut bounces = 0;
+    for (v_before, v_after) in impacts(events, destination, after, before) {
+        if first.is_nan() {
+            first = v_before;
         }
+        bounces += usize::from(v_after != 0.0);
     }
-    (first.unwrap_or(f64::NAN), bounces)
+    (first, bounces)
 }
 
 /// Length of each half of the cycle: closing on [0, HALF), opening on [HALF, 2·HALF).
@@ -194,7 +188,7 @@ struct Cycle {
 fn cycle(d: &Description, ts: f64, drive: Drive) -> Cycle {
     let mut model = Model::build(d);
     let plant = ModelPlant::new(&mut model);
-    let (z_min, z_max) = (d.mechanics.z_min, d.mechanics.z_max);
+    let z_max = d.mechanics.z_max;
     let mut closing = c64::Controller::new(c64::Operation::Closing);
     let mut opening = c64::Controller::new(c64::Operation::Opening);
     opening.start(HALF);
@@ -253,10 +247,8 @@ fn cycle(d: &Description, ts: f64, drive: Drive) -> Cycle {
         &options,
     )
     .expect("simulation");
-    let closed: Vec<_> = tr.events.iter().filter(|e| e.t < HALF).cloned().collect();
-    let (closing_speed, b1) = landing(&closed, Limit::Min, 0.0);
-    let (opening_speed, b2) = landing(&tr.events, Limit::Max, HALF);
-    let _ = z_min;
+    let (closing_speed, b1) = landing(&tr.events, Limit::Min, 0.0, HALF);
+    let (opening_speed, b2) = landing(&tr.events, Limit::Max, HALF, f64::INFINITY);
     Cycle {
         closing: closing_speed,
         opening: opening_speed,
