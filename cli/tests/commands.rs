@@ -1347,4 +1347,18 @@ fn build_refuses_what_it_cannot_design() {
         "longer motion",
     ]);
     assert!(!out.exists());
+    // A [trajectory] with nothing to track it.
+    let text = std::fs::read_to_string(example("perfect-tracking-valve.toml")).unwrap();
+    let start = text.find("[controller]").unwrap();
+    let end = start + text[start..].find("\n\n").unwrap();
+    let model = dir.join("no-controller.toml");
+    std::fs::write(&model, format!("{}{}", &text[..start], &text[end..])).unwrap();
+    let run = exec(&[
+        OsStr::new("build"),
+        model.as_os_str(),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ]);
+    run.rejected(&["no-controller.toml", "[trajectory] alone", "[controller]"]);
+    assert!(!out.exists());
 }

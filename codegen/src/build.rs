@@ -32,8 +32,9 @@ pub enum BuildError {
         "{file}: nothing to build: add [trajectory] and [controller] sections, or an [observer] section (see the README)"
     )]
     NothingToBuild { file: String },
-    #[error("{file}: [controller] needs a [trajectory] section and [trajectory] a [controller] section (see the README)")]
-    HalfAController { file: String },
+    /// (`[controller]` without `[trajectory]` is refused by the parser.)
+    #[error("{file}: [trajectory] alone builds nothing: add a [controller] section to track it (see the README)")]
+    TrajectoryWithoutController { file: String },
     #[error("{file}: the {estimator} observer: {message}")]
     Observer {
         file: String,
@@ -113,7 +114,7 @@ impl Design {
         let controller = match (&description.trajectory, &description.controller) {
             (Some(_), Some(_)) => Some(design_controller(description, &mut model)?),
             (None, None) => None,
-            _ => return Err(BuildError::HalfAController { file }),
+            _ => return Err(BuildError::TrajectoryWithoutController { file }),
         };
         let kalman = design_kalman(description, &model)?;
         if controller.is_none() && description.observer.is_none() {
