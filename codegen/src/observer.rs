@@ -781,16 +781,37 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
             self.skipped
         }
     };
-    let estimate_value = quote! {
-        Estimate {
-            z,
-            v: (z - z_prev) / T_S,
-            a: if mode == 2 { o.accel } else { 0.0 },
-            phi,
-            #hc_init
-            mode,
+    // The estimate (85)–(87) with the predicted acceleration `accel`.
+    let estimate_of = |accel: TokenStream| {
+        quote! {
+            Estimate {
+                z,
+                v: (z - z_prev) / T_S,
+                a: if mode == 2 { #accel } else { 0.0 },
+                phi,
+                #hc_init
+                mode,
+            }
         }
     };
+    let estimate_value = estimate_of(quote!(o.accel));
+    let estimate_ukf = estimate_of(quote!(accel));
+    // The predicted prior if finite, else a restart from (x₀, P₀), counted.
+    let accept = |next: TokenStream| {
+        quote! {
+            if linalg::all_finite(&#next) && linalg::all_finite_matrix(&p) {
+                self.x = #next;
+                self.p = p;
+            } else {
+                self.x = INITIAL_STATE;
+                self.p = INITIAL_COVARIANCE;
+                self.repairs = self.repairs.saturating_add(1);
+            }
+            #time_advance
+        }
+    };
+    let accept_next = accept(quote!(next));
+    let accept_mean = accept(quote!(mean));
     let head = quote! {
         let u_ok = u.is_finite();
         if u_ok {
@@ -889,15 +910,7 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
                         let mut p = linalg::sandwich(&f, &self.p);
                         p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
                         linalg::rank1_update(&mut p, INPUT_VARIANCE, &#gain);
-                        if linalg::all_finite(&next) && linalg::all_finite_matrix(&p) {
-                            self.x = next;
-                            self.p = p;
-                        } else {
-                            self.x = INITIAL_STATE;
-                            self.p = INITIAL_COVARIANCE;
-                            self.repairs = self.repairs.saturating_add(1);
-                        }
-                        #time_advance
+                        #accept_next
                         estimate
                     }
 
@@ -1060,28 +1073,13 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
                                 *nk = [stop, #(#rest_next_pattern),*];
                             }
                         }
-                        let estimate = Estimate {
-                            z,
-                            v: (z - z_prev) / T_S,
-                            a: if mode == 2 { accel } else { 0.0 },
-                            phi,
-                            #hc_init
-                            mode,
-                        };
+                        let estimate = #estimate_ukf;
                         let mean = linalg::weighted_mean(&next, WEIGHT_MEAN0, WEIGHT);
                         let mut p = linalg::weighted_covariance(&next, &mean, WEIGHT_COV0, WEIGHT);
                         p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
                         #gain_call
                         linalg::rank1_update(&mut p, INPUT_VARIANCE, &#gain);
-                        if linalg::all_finite(&mean) && linalg::all_finite_matrix(&p) {
-                            self.x = mean;
-                            self.p = p;
-                        } else {
-                            self.x = INITIAL_STATE;
-                            self.p = INITIAL_COVARIANCE;
-                            self.repairs = self.repairs.saturating_add(1);
-                        }
-                        #time_advance
+                        #accept_mean
                         estimate
                     }
 
