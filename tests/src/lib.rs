@@ -1,6 +1,8 @@
 //! Shared helpers of the end-to-end tests: locating the bundled examples,
 //! loading models, deterministic pseudo-random states.
 
+pub mod hidden;
+
 use std::path::{Path, PathBuf};
 
 use designer::description::{parse_file, parse_str, Description};

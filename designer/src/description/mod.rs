@@ -5,6 +5,7 @@
 //! that names the file, the key, the line/column and what was expected.
 //! Everything downstream (model, simulator, designers) reads only these types.
 
+pub mod edit;
 mod error;
 mod parse;
 

@@ -1,0 +1,1 @@
+//! Where the current residual of a replay concentrates.

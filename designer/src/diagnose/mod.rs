@@ -1,0 +1,4 @@
+//! Model-discrepancy diagnosis (`reldesign diagnose`): replay, localise the
+//! residual, fit each extension of the vocabulary, rank, extend the model.
+
+pub mod localise;
