@@ -49,7 +49,7 @@ use designer::sym::{Graph, Id, Tape};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::emit::{function_tokens, FunctionSpec, Param};
+use crate::emit::{function_tokens_inline, FunctionSpec, Inline, Param};
 use crate::error::EmitError;
 use crate::float::Float;
 use crate::format::{comment_lets, format_items, space_items};
@@ -582,7 +582,8 @@ fn float_module(
         output_symbols: STAGED_OUTPUTS.into_iter().zip(law.staged).collect(),
         float,
     };
-    let law_fn = function_tokens(graph, &spec, &params)?;
+    // inlined into both `law` and `guarded_law` (one call, no stored outputs)
+    let law_fn = function_tokens_inline(graph, &spec, &params, Inline::Always)?;
 
     // design constants
     let [k1, k2, k3] = input.gains;
@@ -702,7 +703,7 @@ fn float_module(
                 if phi <= PHI_GUARD {
                     return #saturate(U_MAX, U_MIN, U_MAX);
                 }
-                #saturate(law(z, v, phi, zr, vr, ar, jr), U_MIN, U_MAX)
+                #saturate(law_terms(z, v, phi, zr, vr, ar, jr).u, U_MIN, U_MAX)
             }
 
             /// [z_r, v_r, a_r, j_r] of one table row at τ = t − t_k.

@@ -8,6 +8,7 @@ use quote::quote;
 
 use crate::error::EmitError;
 use crate::float::Float;
+use crate::fold::{fold, Folded};
 use crate::format::{comment_lets, format_items};
 use crate::lower::Lowerer;
 use crate::names::{camel, const_name, ident, Namer};
@@ -115,7 +116,49 @@ pub fn function_tokens(
     spec: &FunctionSpec,
     params: &[Param],
 ) -> Result<TokenStream, EmitError> {
+    function_tokens_inline(graph, spec, params, Inline::Hint)
+}
+
+/// How an emitted function is offered to the inliner.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub(crate) enum Inline {
+    /// `#[inline]`: callers in other crates may inline it.
+    Hint,
+    /// `#[inline(always)]`: for a function whose callers (several, in the
+    /// same module) each want it inlined, where a plain hint would let the
+    /// compiler keep one out-of-line copy and pay a call and a store of every
+    /// output.
+    Always,
+}
+
+/// [`function_tokens`] with the given inlining attribute.
+pub(crate) fn function_tokens_inline(
+    graph: &Graph,
+    spec: &FunctionSpec,
+    params: &[Param],
+    inline: Inline,
+) -> Result<TokenStream, EmitError> {
     crate::names::check_local(spec.name)?;
+    let roots: Vec<Id> = spec
+        .outputs
+        .iter()
+        .map(|o| o.1)
+        .chain(spec.named.iter().map(|n| n.1))
+        .collect();
+    let folded = fold(graph, params, &roots)?;
+    let (graph, roots, params) = match &folded {
+        Some(f) => {
+            let mut all = params.to_vec();
+            all.extend(
+                f.derived
+                    .iter()
+                    .map(|d| (d.name.as_str(), d.symbol, d.value)),
+            );
+            (&f.graph, f.roots.clone(), all)
+        }
+        None => (graph, roots, params.to_vec()),
+    };
+    let params = params.as_slice();
     let const_by_id = const_names(graph, params)?;
     let mut namer = Namer::default();
     for &(name, _) in &spec.inputs {
@@ -135,12 +178,14 @@ pub fn function_tokens(
     let outputs: Vec<(String, Id)> = spec
         .outputs
         .iter()
-        .map(|&(n, id, _)| (n.to_owned(), id))
+        .zip(&roots)
+        .map(|(&(n, _, _), &id)| (n.to_owned(), id))
         .collect();
     let named: Vec<(String, Id)> = spec
         .named
         .iter()
-        .map(|&(n, id)| (n.to_owned(), id))
+        .zip(&roots[spec.outputs.len()..])
+        .map(|(&(n, _), &id)| (n.to_owned(), id))
         .collect();
     let output_symbols: Vec<(String, Id)> = spec
         .output_symbols
@@ -166,7 +211,7 @@ pub fn function_tokens(
         statics: HashMap::new(),
         defined: HashSet::new(),
     };
-    let mut body = TokenStream::new();
+    let mut body = derived_consts(folded.as_ref(), spec.float)?;
     for b in &plan.lets {
         let name = ident(&b.name);
         let rhs = lower.definition(b.id)?;
@@ -213,6 +258,10 @@ pub fn function_tokens(
     } else {
         quote!()
     };
+    let inline = match inline {
+        Inline::Hint => quote!(#[inline]),
+        Inline::Always => quote!(#[inline(always)]),
+    };
     Ok(quote! {
         #[doc = #struct_doc]
         #[derive(Clone, Copy, Debug, PartialEq)]
@@ -221,7 +270,7 @@ pub fn function_tokens(
         }
 
         #fn_doc
-        #[inline]
+        #inline
         #[must_use]
         #allow
         pub fn #fn_name(#(#args),*) -> #out_ty {
@@ -230,6 +279,30 @@ pub fn function_tokens(
             #out_ty { #(#field_names),* }
         }
     })
+}
+
+/// `const NAME: f32 = value;` per derived const of `folded` (see `fold.rs`),
+/// documented with the expression it stands for.
+fn derived_consts(folded: Option<&Folded>, float: Float) -> Result<TokenStream, EmitError> {
+    let mut items = TokenStream::new();
+    let ty = float.ty();
+    for d in folded.map_or(&[][..], |f| &f.derived) {
+        let cname = const_name(&d.name)?;
+        let lit = float
+            .unsuffixed_signed(d.value)
+            .ok_or_else(|| EmitError::NonFinite {
+                name: cname.clone(),
+                value: format!("{:?}", d.value),
+                float: float.name(),
+            })?;
+        let doc = format!(
+            " {} (parameters only: evaluated when generated, so it changes with them)",
+            d.formula
+        );
+        let cname = ident(&cname);
+        items.extend(quote!(#[doc = #doc] const #cname: #ty = #lit;));
+    }
+    Ok(items)
 }
 
 /// `#[doc = " line"]` per line (an empty text gives none).

@@ -16,6 +16,7 @@
 //! | `plan.rs` | which nodes become `let`s, in which order, under which names |
 //! | `lower.rs` | one expression → Rust tokens (subtractions, divisions, powers, `if`) |
 //! | `names.rs` | name validation, parameter const names, readable temporaries |
+//! | `fold.rs` | parameter-only subexpressions that need a math call, evaluated when generated |
 //! | `float.rs` | [`Float`] and shortest round-trip literals |
 //! | `format.rs` | `prettyplease` formatting and `//` comments |
 //! | `error.rs` | [`EmitError`] |
@@ -28,6 +29,7 @@ mod controller;
 mod emit;
 mod error;
 mod float;
+mod fold;
 mod format;
 mod header;
 mod lower;

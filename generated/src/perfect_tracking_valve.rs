@@ -769,7 +769,7 @@ pub mod f32 {
     /// The terms of the tracking law (50) at the state x = [z, v, φ] and the
     /// reference ξ_r = [z_r, v_r, a_r], z_r⁽³⁾ = j_r (not saturated, not guarded:
     /// φ = 0 makes β infinite, see [`guarded_law`]).
-    #[inline]
+    #[inline(always)]
     #[must_use]
     pub fn law_terms(
         z: f32,
@@ -781,18 +781,20 @@ pub mod f32 {
         jr: f32,
     ) -> LawTermsOutput {
         use reldesign_runtime::math::Real;
+
+        /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+        const INV_SQRT_A_GAP: f32 = 223.6068;
         let inv_m = 1.0_f32 / M;
         let inv_a_gap = 1.0_f32 / A_GAP;
+        let phi_sq = phi * phi;
         let t0 = 1.0_f32 / (z + 1e-9_f32);
         let ln = Real::ln(2.0_f32 * L_W * t0);
-        let inv_sqrt_a_gap = 1.0_f32 / Real::sqrt(A_GAP);
-        let t1 = inv_sqrt_a_gap * z * ln + 1.0_f32;
+        let t1 = INV_SQRT_A_GAP * z * ln + 1.0_f32;
         let inv_t1 = 1.0_f32 / t1;
-        let phi_sq = phi * phi;
         let t2 = ln - z * t0;
-        let t3 = 1.0_f32 - inv_sqrt_a_gap * z * inv_t1 * t2;
+        let t3 = 1.0_f32 - INV_SQRT_A_GAP * z * t2 * inv_t1;
         let t4 = -(F0 + K_S * z + C * v)
-            - 397887.34_f32 * inv_a_gap * inv_t1 * phi_sq * t3;
+            - 397887.34_f32 * inv_a_gap * phi_sq * inv_t1 * t3;
         // (41) ξ₃ = a(x) = L_f²h
         let xi3 = inv_m * t4;
         let t5 = N * N + R * K_E;
@@ -800,14 +802,14 @@ pub mod f32 {
         let lf3h = inv_m
             * (v
                 * (-K_S
-                    - 397887.34_f32 * inv_sqrt_a_gap * inv_a_gap * (inv_t1 * inv_t1)
-                        * phi_sq
-                        * (2.0_f32 * inv_sqrt_a_gap * z * inv_t1 * (t2 * t2)
+                    - 397887.34_f32 * INV_SQRT_A_GAP * inv_a_gap * phi_sq
+                        * (inv_t1 * inv_t1)
+                        * (2.0_f32 * INV_SQRT_A_GAP * z * (t2 * t2) * inv_t1
                             - z * t0 * (z * t0 - 2.0_f32) - 2.0_f32 * t2))
                 - C * inv_m * t4
-                + 795774.7_f32 * R * inv_a_gap / t5 * inv_t1 * phi_sq * t3
-                    * (795774.7_f32 * inv_a_gap * z * inv_t1
-                        + R_CORE0 / (1.0_f32 - 1.0_f32 / PHI_SAT * Real::abs(phi))));
+                + 795774.7_f32 * R * inv_a_gap / t5 * phi_sq * inv_t1 * t3
+                    * (R_CORE0 / (1.0_f32 - 1.0_f32 / PHI_SAT * Real::abs(phi))
+                        + 795774.7_f32 * inv_a_gap * z * inv_t1));
         // (32) β(x) = 1 / L_g L_f²h
         let beta = -1.256637e-6_f32 * A_GAP * M * t5 / N * t1 / (phi * t3);
         // (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
@@ -849,7 +851,7 @@ pub mod f32 {
         if phi <= PHI_GUARD {
             return saturate_f32(U_MAX, U_MIN, U_MAX);
         }
-        saturate_f32(law(z, v, phi, zr, vr, ar, jr), U_MIN, U_MAX)
+        saturate_f32(law_terms(z, v, phi, zr, vr, ar, jr).u, U_MIN, U_MAX)
     }
 
     /// [z_r, v_r, a_r, j_r] of one table row at τ = t − t_k.
@@ -1760,7 +1762,7 @@ pub mod f64 {
     /// The terms of the tracking law (50) at the state x = [z, v, φ] and the
     /// reference ξ_r = [z_r, v_r, a_r], z_r⁽³⁾ = j_r (not saturated, not guarded:
     /// φ = 0 makes β infinite, see [`guarded_law`]).
-    #[inline]
+    #[inline(always)]
     #[must_use]
     pub fn law_terms(
         z: f64,
@@ -1772,18 +1774,20 @@ pub mod f64 {
         jr: f64,
     ) -> LawTermsOutput {
         use reldesign_runtime::math::Real;
+
+        /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+        const INV_SQRT_A_GAP: f64 = 223.60679774997894;
         let inv_m = 1.0_f64 / M;
         let inv_a_gap = 1.0_f64 / A_GAP;
+        let phi_sq = phi * phi;
         let t0 = 1.0_f64 / (z + 1e-9_f64);
         let ln = Real::ln(2.0_f64 * L_W * t0);
-        let inv_sqrt_a_gap = 1.0_f64 / Real::sqrt(A_GAP);
-        let t1 = inv_sqrt_a_gap * z * ln + 1.0_f64;
+        let t1 = INV_SQRT_A_GAP * z * ln + 1.0_f64;
         let inv_t1 = 1.0_f64 / t1;
-        let phi_sq = phi * phi;
         let t2 = ln - z * t0;
-        let t3 = 1.0_f64 - inv_sqrt_a_gap * z * inv_t1 * t2;
+        let t3 = 1.0_f64 - INV_SQRT_A_GAP * z * t2 * inv_t1;
         let t4 = -(F0 + K_S * z + C * v)
-            - 397887.35772973835_f64 * inv_a_gap * inv_t1 * phi_sq * t3;
+            - 397887.35772973835_f64 * inv_a_gap * phi_sq * inv_t1 * t3;
         // (41) ξ₃ = a(x) = L_f²h
         let xi3 = inv_m * t4;
         let t5 = N * N + R * K_E;
@@ -1791,14 +1795,14 @@ pub mod f64 {
         let lf3h = inv_m
             * (v
                 * (-K_S
-                    - 397887.35772973835_f64 * inv_sqrt_a_gap * inv_a_gap
-                        * (inv_t1 * inv_t1) * phi_sq
-                        * (2.0_f64 * inv_sqrt_a_gap * z * inv_t1 * (t2 * t2)
+                    - 397887.35772973835_f64 * INV_SQRT_A_GAP * inv_a_gap * phi_sq
+                        * (inv_t1 * inv_t1)
+                        * (2.0_f64 * INV_SQRT_A_GAP * z * (t2 * t2) * inv_t1
                             - z * t0 * (z * t0 - 2.0_f64) - 2.0_f64 * t2))
                 - C * inv_m * t4
-                + 795774.7154594767_f64 * R * inv_a_gap / t5 * inv_t1 * phi_sq * t3
-                    * (795774.7154594767_f64 * inv_a_gap * z * inv_t1
-                        + R_CORE0 / (1.0_f64 - 1.0_f64 / PHI_SAT * Real::abs(phi))));
+                + 795774.7154594767_f64 * R * inv_a_gap / t5 * phi_sq * inv_t1 * t3
+                    * (R_CORE0 / (1.0_f64 - 1.0_f64 / PHI_SAT * Real::abs(phi))
+                        + 795774.7154594767_f64 * inv_a_gap * z * inv_t1));
         // (32) β(x) = 1 / L_g L_f²h
         let beta = -1.2566370614359173e-6_f64 * A_GAP * M * t5 / N * t1 / (phi * t3);
         // (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
@@ -1840,7 +1844,7 @@ pub mod f64 {
         if phi <= PHI_GUARD {
             return saturate(U_MAX, U_MIN, U_MAX);
         }
-        saturate(law(z, v, phi, zr, vr, ar, jr), U_MIN, U_MAX)
+        saturate(law_terms(z, v, phi, zr, vr, ar, jr).u, U_MIN, U_MAX)
     }
 
     /// [z_r, v_r, a_r, j_r] of one table row at τ = t − t_k.
@@ -2139,28 +2143,30 @@ pub mod ekf {
         #[must_use]
         pub fn transition(z: f32, z_prev: f32, phi: f32, u: f32) -> TransitionOutput {
             use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f32 = 223.6068;
             let inv_m = 1.0_f32 / M;
-            let inv_a_gap = 1.0_f32 / A_GAP;
-            let inv_sqrt_a_gap = 1.0_f32 / Real::sqrt(A_GAP);
+            let t_s_sq = T_S * T_S;
             let max = Real::max(z, Z_MIN);
             // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
             let zp_next = Real::min(max, Z_MAX);
-            let t0 = zp_next + 1e-9_f32;
-            let inv_t0 = 1.0_f32 / t0;
-            let ln = Real::ln(2.0_f32 * L_W * inv_t0);
-            let t1 = inv_sqrt_a_gap * zp_next * ln + 1.0_f32;
-            let inv_t1 = 1.0_f32 / t1;
-            let t2 = inv_sqrt_a_gap * ln - inv_sqrt_a_gap * zp_next * inv_t0;
-            let inv_t1_sq = inv_t1 * inv_t1;
-            let t3 = 795774.7_f32 * inv_a_gap * inv_t1
-                - 795774.7_f32 * inv_a_gap * zp_next * t2 * inv_t1_sq;
+            let inv_t_s = 1.0_f32 / T_S;
             let max_2 = Real::max(phi, -PHI_LIM);
             let min = Real::min(max_2, PHI_LIM);
             let min_sq = min * min;
-            let inv_t_s = 1.0_f32 / T_S;
-            let t4 = -0.5_f32 * t3 * min_sq
-                - (F0 + K_S * zp_next + C * inv_t_s * (z - z_prev));
-            let t_s_sq = T_S * T_S;
+            let inv_a_gap = 1.0_f32 / A_GAP;
+            let t0 = zp_next + 1e-9_f32;
+            let inv_t0 = 1.0_f32 / t0;
+            let ln = Real::ln(2.0_f32 * L_W * inv_t0);
+            let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f32;
+            let inv_t1 = 1.0_f32 / t1;
+            let t2 = INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * inv_t0;
+            let inv_t1_sq = inv_t1 * inv_t1;
+            let t3 = 795774.7_f32 * inv_a_gap * inv_t1
+                - 795774.7_f32 * inv_a_gap * zp_next * t2 * inv_t1_sq;
+            let t4 = -(F0 + K_S * zp_next + C * inv_t_s * (z - z_prev))
+                - 0.5_f32 * min_sq * t3;
             let t5 = inv_m * t_s_sq * t4;
             let max_3 = Real::max(2.0_f32 * z - z_prev + t5, Z_MIN);
             let t6 = 1.0_f32 / (N * N + R * K_E);
@@ -2168,23 +2174,23 @@ pub mod ekf {
             let t7 = 1.0_f32 - inv_phi_sat * Real::abs(min);
             let inv_t7 = 1.0_f32 / t7;
             let t8 = Z_MAX - max_3;
-            let t9 = 2.0_f32 * z - z_prev + t5 - Z_MIN;
+            let t9 = 2.0_f32 * z - z_prev - Z_MIN + t5;
             let sel = if z - Z_MIN >= 0.0_f32 { 1.0_f32 } else { 0.0_f32 };
             // ∂z_prev_{k+1}/∂z
             let dzp_dz = if Z_MAX - max >= 0.0_f32 { sel } else { 0.0_f32 };
-            let t10 = inv_sqrt_a_gap * ln * dzp_dz
-                - inv_sqrt_a_gap * zp_next * inv_t0 * dzp_dz;
+            let t10 = INV_SQRT_A_GAP * ln * dzp_dz
+                - INV_SQRT_A_GAP * zp_next * inv_t0 * dzp_dz;
             let sel_2 = if t9 >= 0.0_f32 {
                 inv_m * t_s_sq
-                    * (-0.5_f32 * min_sq
-                        * (1591549.4_f32 * inv_a_gap * zp_next * t2 * t10
-                            * (inv_t1_sq * inv_t1)
-                            - 795774.7_f32 * inv_a_gap * inv_t1_sq * t10
-                            - 795774.7_f32 * inv_a_gap * t2 * inv_t1_sq * dzp_dz
-                            - 795774.7_f32 * inv_a_gap * zp_next * inv_t1_sq
-                                * (inv_sqrt_a_gap * zp_next * dzp_dz * (inv_t0 * inv_t0)
-                                    - 2.0_f32 * inv_sqrt_a_gap * inv_t0 * dzp_dz))
-                        - (K_S * dzp_dz + C * inv_t_s)) + 2.0_f32
+                    * (-(K_S * dzp_dz + C * inv_t_s)
+                        - 0.5_f32 * min_sq
+                            * (1591549.4_f32 * inv_a_gap * zp_next * t2 * t10
+                                * (inv_t1_sq * inv_t1)
+                                - 795774.7_f32 * inv_a_gap * inv_t1_sq * t10
+                                - 795774.7_f32 * inv_a_gap * dzp_dz * t2 * inv_t1_sq
+                                - 795774.7_f32 * inv_a_gap * zp_next * inv_t1_sq
+                                    * (INV_SQRT_A_GAP * zp_next * dzp_dz * (inv_t0 * inv_t0)
+                                        - 2.0_f32 * INV_SQRT_A_GAP * inv_t0 * dzp_dz))) + 2.0_f32
             } else {
                 0.0_f32
             };
@@ -2192,7 +2198,7 @@ pub mod ekf {
             let sel_4 = if phi + PHI_LIM >= 0.0_f32 { 1.0_f32 } else { 0.0_f32 };
             let sel_5 = if PHI_LIM - max_2 >= 0.0_f32 { sel_4 } else { 0.0_f32 };
             let sel_6 = if t9 >= 0.0_f32 {
-                -inv_m * t_s_sq * min * t3 * sel_5
+                -inv_m * t_s_sq * min * sel_5 * t3
             } else {
                 0.0_f32
             };
@@ -2215,7 +2221,7 @@ pub mod ekf {
             let dz_dphi = if t8 >= 0.0_f32 { sel_6 } else { 0.0_f32 };
             // ∂φ_{k+1}/∂z
             let dphi_dz = -R * T_S * t6
-                * (795774.7_f32 * inv_a_gap * min * inv_t1 * dzp_dz
+                * (795774.7_f32 * inv_a_gap * min * dzp_dz * inv_t1
                     - 795774.7_f32 * inv_a_gap * zp_next * min * inv_t1_sq * t10);
             // ∂φ_{k+1}/∂φ
             let dphi_dphi = 1.0_f32
@@ -2223,7 +2229,7 @@ pub mod ekf {
                     * (R_CORE0 * inv_t7 * sel_5
                         + R_CORE0 * inv_phi_sat * min * sel_5 * Real::signum0(min)
                             * (inv_t7 * inv_t7)
-                        + 795774.7_f32 * inv_a_gap * zp_next * inv_t1 * sel_5);
+                        + 795774.7_f32 * inv_a_gap * zp_next * sel_5 * inv_t1);
             // g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
             let dphi_du = N * T_S * t6;
             TransitionOutput {
@@ -2260,6 +2266,9 @@ pub mod ekf {
         #[must_use]
         pub fn measurement(z: f32, _z_prev: f32, phi: f32, u: f32) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f32 = 223.6068;
             let t0 = 1.0_f32 / (N * N + R * K_E);
             let max = Real::max(phi, -PHI_LIM);
             let min = Real::min(max, PHI_LIM);
@@ -2269,10 +2278,9 @@ pub mod ekf {
             let inv_a_gap = 1.0_f32 / A_GAP;
             let max_2 = Real::max(z, Z_MIN);
             let min_2 = Real::min(max_2, Z_MAX);
-            let inv_sqrt_a_gap = 1.0_f32 / Real::sqrt(A_GAP);
             let t2 = 1.0_f32 / (min_2 + 1e-9_f32);
             let ln = Real::ln(2.0_f32 * L_W * t2);
-            let t3 = inv_sqrt_a_gap * min_2 * ln + 1.0_f32;
+            let t3 = INV_SQRT_A_GAP * min_2 * ln + 1.0_f32;
             let inv_t3 = 1.0_f32 / t3;
             let sel = if z - Z_MIN >= 0.0_f32 { 1.0_f32 } else { 0.0_f32 };
             let sel_2 = if Z_MAX - max_2 >= 0.0_f32 { sel } else { 0.0_f32 };
@@ -2288,16 +2296,16 @@ pub mod ekf {
             let di_du = K_E * t0;
             // H = ∂i/∂z
             let di_dz = N * t0
-                * (795774.7_f32 * inv_a_gap * min * inv_t3 * sel_2
+                * (795774.7_f32 * inv_a_gap * min * sel_2 * inv_t3
                     - 795774.7_f32 * inv_a_gap * min_2 * min * (inv_t3 * inv_t3)
-                        * (inv_sqrt_a_gap * ln * sel_2
-                            - inv_sqrt_a_gap * min_2 * t2 * sel_2));
+                        * (INV_SQRT_A_GAP * ln * sel_2
+                            - INV_SQRT_A_GAP * min_2 * t2 * sel_2));
             // H = ∂i/∂φ
             let di_dphi = N * t0
                 * (R_CORE0 * inv_t1 * sel_4
                     + R_CORE0 * inv_phi_sat * min * sel_4 * Real::signum0(min)
                         * (inv_t1 * inv_t1)
-                    + 795774.7_f32 * inv_a_gap * min_2 * inv_t3 * sel_4);
+                    + 795774.7_f32 * inv_a_gap * min_2 * sel_4 * inv_t3);
             MeasurementOutput {
                 i,
                 di_du,
@@ -2633,28 +2641,30 @@ pub mod ekf {
         #[must_use]
         pub fn transition(z: f64, z_prev: f64, phi: f64, u: f64) -> TransitionOutput {
             use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
             let inv_m = 1.0_f64 / M;
-            let inv_a_gap = 1.0_f64 / A_GAP;
-            let inv_sqrt_a_gap = 1.0_f64 / Real::sqrt(A_GAP);
+            let t_s_sq = T_S * T_S;
             let max = Real::max(z, Z_MIN);
             // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
             let zp_next = Real::min(max, Z_MAX);
-            let t0 = zp_next + 1e-9_f64;
-            let inv_t0 = 1.0_f64 / t0;
-            let ln = Real::ln(2.0_f64 * L_W * inv_t0);
-            let t1 = inv_sqrt_a_gap * zp_next * ln + 1.0_f64;
-            let inv_t1 = 1.0_f64 / t1;
-            let t2 = inv_sqrt_a_gap * ln - inv_sqrt_a_gap * zp_next * inv_t0;
-            let inv_t1_sq = inv_t1 * inv_t1;
-            let t3 = 795774.7154594767_f64 * inv_a_gap * inv_t1
-                - 795774.7154594767_f64 * inv_a_gap * zp_next * t2 * inv_t1_sq;
+            let inv_t_s = 1.0_f64 / T_S;
             let max_2 = Real::max(phi, -PHI_LIM);
             let min = Real::min(max_2, PHI_LIM);
             let min_sq = min * min;
-            let inv_t_s = 1.0_f64 / T_S;
-            let t4 = -0.5_f64 * t3 * min_sq
-                - (F0 + K_S * zp_next + C * inv_t_s * (z - z_prev));
-            let t_s_sq = T_S * T_S;
+            let inv_a_gap = 1.0_f64 / A_GAP;
+            let t0 = zp_next + 1e-9_f64;
+            let inv_t0 = 1.0_f64 / t0;
+            let ln = Real::ln(2.0_f64 * L_W * inv_t0);
+            let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f64;
+            let inv_t1 = 1.0_f64 / t1;
+            let t2 = INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * inv_t0;
+            let inv_t1_sq = inv_t1 * inv_t1;
+            let t3 = 795774.7154594767_f64 * inv_a_gap * inv_t1
+                - 795774.7154594767_f64 * inv_a_gap * zp_next * t2 * inv_t1_sq;
+            let t4 = -(F0 + K_S * zp_next + C * inv_t_s * (z - z_prev))
+                - 0.5_f64 * min_sq * t3;
             let t5 = inv_m * t_s_sq * t4;
             let max_3 = Real::max(2.0_f64 * z - z_prev + t5, Z_MIN);
             let t6 = 1.0_f64 / (N * N + R * K_E);
@@ -2662,23 +2672,23 @@ pub mod ekf {
             let t7 = 1.0_f64 - inv_phi_sat * Real::abs(min);
             let inv_t7 = 1.0_f64 / t7;
             let t8 = Z_MAX - max_3;
-            let t9 = 2.0_f64 * z - z_prev + t5 - Z_MIN;
+            let t9 = 2.0_f64 * z - z_prev - Z_MIN + t5;
             let sel = if z - Z_MIN >= 0.0_f64 { 1.0_f64 } else { 0.0_f64 };
             // ∂z_prev_{k+1}/∂z
             let dzp_dz = if Z_MAX - max >= 0.0_f64 { sel } else { 0.0_f64 };
-            let t10 = inv_sqrt_a_gap * ln * dzp_dz
-                - inv_sqrt_a_gap * zp_next * inv_t0 * dzp_dz;
+            let t10 = INV_SQRT_A_GAP * ln * dzp_dz
+                - INV_SQRT_A_GAP * zp_next * inv_t0 * dzp_dz;
             let sel_2 = if t9 >= 0.0_f64 {
                 inv_m * t_s_sq
-                    * (-0.5_f64 * min_sq
-                        * (1591549.4309189534_f64 * inv_a_gap * zp_next * t2 * t10
-                            * (inv_t1_sq * inv_t1)
-                            - 795774.7154594767_f64 * inv_a_gap * inv_t1_sq * t10
-                            - 795774.7154594767_f64 * inv_a_gap * t2 * inv_t1_sq * dzp_dz
-                            - 795774.7154594767_f64 * inv_a_gap * zp_next * inv_t1_sq
-                                * (inv_sqrt_a_gap * zp_next * dzp_dz * (inv_t0 * inv_t0)
-                                    - 2.0_f64 * inv_sqrt_a_gap * inv_t0 * dzp_dz))
-                        - (K_S * dzp_dz + C * inv_t_s)) + 2.0_f64
+                    * (-(K_S * dzp_dz + C * inv_t_s)
+                        - 0.5_f64 * min_sq
+                            * (1591549.4309189534_f64 * inv_a_gap * zp_next * t2 * t10
+                                * (inv_t1_sq * inv_t1)
+                                - 795774.7154594767_f64 * inv_a_gap * inv_t1_sq * t10
+                                - 795774.7154594767_f64 * inv_a_gap * dzp_dz * t2 * inv_t1_sq
+                                - 795774.7154594767_f64 * inv_a_gap * zp_next * inv_t1_sq
+                                    * (INV_SQRT_A_GAP * zp_next * dzp_dz * (inv_t0 * inv_t0)
+                                        - 2.0_f64 * INV_SQRT_A_GAP * inv_t0 * dzp_dz))) + 2.0_f64
             } else {
                 0.0_f64
             };
@@ -2686,7 +2696,7 @@ pub mod ekf {
             let sel_4 = if phi + PHI_LIM >= 0.0_f64 { 1.0_f64 } else { 0.0_f64 };
             let sel_5 = if PHI_LIM - max_2 >= 0.0_f64 { sel_4 } else { 0.0_f64 };
             let sel_6 = if t9 >= 0.0_f64 {
-                -inv_m * t_s_sq * min * t3 * sel_5
+                -inv_m * t_s_sq * min * sel_5 * t3
             } else {
                 0.0_f64
             };
@@ -2710,7 +2720,7 @@ pub mod ekf {
             let dz_dphi = if t8 >= 0.0_f64 { sel_6 } else { 0.0_f64 };
             // ∂φ_{k+1}/∂z
             let dphi_dz = -R * T_S * t6
-                * (795774.7154594767_f64 * inv_a_gap * min * inv_t1 * dzp_dz
+                * (795774.7154594767_f64 * inv_a_gap * min * dzp_dz * inv_t1
                     - 795774.7154594767_f64 * inv_a_gap * zp_next * min * inv_t1_sq * t10);
             // ∂φ_{k+1}/∂φ
             let dphi_dphi = 1.0_f64
@@ -2718,7 +2728,7 @@ pub mod ekf {
                     * (R_CORE0 * inv_t7 * sel_5
                         + R_CORE0 * inv_phi_sat * min * sel_5 * Real::signum0(min)
                             * (inv_t7 * inv_t7)
-                        + 795774.7154594767_f64 * inv_a_gap * zp_next * inv_t1 * sel_5);
+                        + 795774.7154594767_f64 * inv_a_gap * zp_next * sel_5 * inv_t1);
             // g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
             let dphi_du = N * T_S * t6;
             TransitionOutput {
@@ -2755,6 +2765,9 @@ pub mod ekf {
         #[must_use]
         pub fn measurement(z: f64, _z_prev: f64, phi: f64, u: f64) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
             let t0 = 1.0_f64 / (N * N + R * K_E);
             let max = Real::max(phi, -PHI_LIM);
             let min = Real::min(max, PHI_LIM);
@@ -2764,10 +2777,9 @@ pub mod ekf {
             let inv_a_gap = 1.0_f64 / A_GAP;
             let max_2 = Real::max(z, Z_MIN);
             let min_2 = Real::min(max_2, Z_MAX);
-            let inv_sqrt_a_gap = 1.0_f64 / Real::sqrt(A_GAP);
             let t2 = 1.0_f64 / (min_2 + 1e-9_f64);
             let ln = Real::ln(2.0_f64 * L_W * t2);
-            let t3 = inv_sqrt_a_gap * min_2 * ln + 1.0_f64;
+            let t3 = INV_SQRT_A_GAP * min_2 * ln + 1.0_f64;
             let inv_t3 = 1.0_f64 / t3;
             let sel = if z - Z_MIN >= 0.0_f64 { 1.0_f64 } else { 0.0_f64 };
             let sel_2 = if Z_MAX - max_2 >= 0.0_f64 { sel } else { 0.0_f64 };
@@ -2783,16 +2795,16 @@ pub mod ekf {
             let di_du = K_E * t0;
             // H = ∂i/∂z
             let di_dz = N * t0
-                * (795774.7154594767_f64 * inv_a_gap * min * inv_t3 * sel_2
+                * (795774.7154594767_f64 * inv_a_gap * min * sel_2 * inv_t3
                     - 795774.7154594767_f64 * inv_a_gap * min_2 * min * (inv_t3 * inv_t3)
-                        * (inv_sqrt_a_gap * ln * sel_2
-                            - inv_sqrt_a_gap * min_2 * t2 * sel_2));
+                        * (INV_SQRT_A_GAP * ln * sel_2
+                            - INV_SQRT_A_GAP * min_2 * t2 * sel_2));
             // H = ∂i/∂φ
             let di_dphi = N * t0
                 * (R_CORE0 * inv_t1 * sel_4
                     + R_CORE0 * inv_phi_sat * min * sel_4 * Real::signum0(min)
                         * (inv_t1 * inv_t1)
-                    + 795774.7154594767_f64 * inv_a_gap * min_2 * inv_t3 * sel_4);
+                    + 795774.7154594767_f64 * inv_a_gap * min_2 * sel_4 * inv_t3);
             MeasurementOutput {
                 i,
                 di_du,
@@ -3151,22 +3163,24 @@ pub mod ukf {
         #[must_use]
         pub fn transition(z: f32, z_prev: f32, phi: f32, u: f32) -> TransitionOutput {
             use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f32 = 223.6068;
             let inv_m = 1.0_f32 / M;
-            let inv_a_gap = 1.0_f32 / A_GAP;
-            let inv_sqrt_a_gap = 1.0_f32 / Real::sqrt(A_GAP);
             // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
             let zp_next = Real::min(Real::max(z, Z_MIN), Z_MAX);
+            let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
+            let inv_a_gap = 1.0_f32 / A_GAP;
             let t0 = 1.0_f32 / (zp_next + 1e-9_f32);
             let ln = Real::ln(2.0_f32 * L_W * t0);
-            let t1 = inv_sqrt_a_gap * zp_next * ln + 1.0_f32;
+            let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f32;
             let inv_t1 = 1.0_f32 / t1;
-            let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-            let t2 = -0.5_f32
-                * (795774.7_f32 * inv_a_gap * inv_t1
-                    - 795774.7_f32 * inv_a_gap * zp_next
-                        * (inv_sqrt_a_gap * ln - inv_sqrt_a_gap * zp_next * t0)
-                        * (inv_t1 * inv_t1)) * (min * min)
-                - (F0 + K_S * zp_next + C / T_S * (z - z_prev));
+            let t2 = -(F0 + K_S * zp_next + C / T_S * (z - z_prev))
+                - 0.5_f32 * (min * min)
+                    * (795774.7_f32 * inv_a_gap * inv_t1
+                        - 795774.7_f32 * inv_a_gap * zp_next
+                            * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * t0)
+                            * (inv_t1 * inv_t1));
             // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
             let z_next = Real::min(
                 Real::max(2.0_f32 * z - z_prev + inv_m * (T_S * T_S) * t2, Z_MIN),
@@ -3203,6 +3217,9 @@ pub mod ukf {
         #[must_use]
         pub fn measurement(z: f32, _z_prev: f32, phi: f32, u: f32) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f32 = 223.6068;
             let t0 = 1.0_f32 / (N * N + R * K_E);
             let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
             let min_2 = Real::min(Real::max(z, Z_MIN), Z_MAX);
@@ -3212,7 +3229,7 @@ pub mod ukf {
                     + N
                         * (R_CORE0 * min / (1.0_f32 - 1.0_f32 / PHI_SAT * Real::abs(min))
                             + 795774.7_f32 / A_GAP * min_2 * min
-                                / (1.0_f32 / Real::sqrt(A_GAP) * min_2
+                                / (INV_SQRT_A_GAP * min_2
                                     * Real::ln(2.0_f32 * L_W / (min_2 + 1e-9_f32)) + 1.0_f32)));
             // ∂i/∂u (the input's noise in the measurement variance)
             let di_du = K_E * t0;
@@ -3645,22 +3662,24 @@ pub mod ukf {
         #[must_use]
         pub fn transition(z: f64, z_prev: f64, phi: f64, u: f64) -> TransitionOutput {
             use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
             let inv_m = 1.0_f64 / M;
-            let inv_a_gap = 1.0_f64 / A_GAP;
-            let inv_sqrt_a_gap = 1.0_f64 / Real::sqrt(A_GAP);
             // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
             let zp_next = Real::min(Real::max(z, Z_MIN), Z_MAX);
+            let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
+            let inv_a_gap = 1.0_f64 / A_GAP;
             let t0 = 1.0_f64 / (zp_next + 1e-9_f64);
             let ln = Real::ln(2.0_f64 * L_W * t0);
-            let t1 = inv_sqrt_a_gap * zp_next * ln + 1.0_f64;
+            let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f64;
             let inv_t1 = 1.0_f64 / t1;
-            let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-            let t2 = -0.5_f64
-                * (795774.7154594767_f64 * inv_a_gap * inv_t1
-                    - 795774.7154594767_f64 * inv_a_gap * zp_next
-                        * (inv_sqrt_a_gap * ln - inv_sqrt_a_gap * zp_next * t0)
-                        * (inv_t1 * inv_t1)) * (min * min)
-                - (F0 + K_S * zp_next + C / T_S * (z - z_prev));
+            let t2 = -(F0 + K_S * zp_next + C / T_S * (z - z_prev))
+                - 0.5_f64 * (min * min)
+                    * (795774.7154594767_f64 * inv_a_gap * inv_t1
+                        - 795774.7154594767_f64 * inv_a_gap * zp_next
+                            * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * t0)
+                            * (inv_t1 * inv_t1));
             // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
             let z_next = Real::min(
                 Real::max(2.0_f64 * z - z_prev + inv_m * (T_S * T_S) * t2, Z_MIN),
@@ -3698,6 +3717,9 @@ pub mod ukf {
         #[must_use]
         pub fn measurement(z: f64, _z_prev: f64, phi: f64, u: f64) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
             let t0 = 1.0_f64 / (N * N + R * K_E);
             let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
             let min_2 = Real::min(Real::max(z, Z_MIN), Z_MAX);
@@ -3707,7 +3729,7 @@ pub mod ukf {
                     + N
                         * (R_CORE0 * min / (1.0_f64 - 1.0_f64 / PHI_SAT * Real::abs(min))
                             + 795774.7154594767_f64 / A_GAP * min_2 * min
-                                / (1.0_f64 / Real::sqrt(A_GAP) * min_2
+                                / (INV_SQRT_A_GAP * min_2
                                     * Real::ln(2.0_f64 * L_W / (min_2 + 1e-9_f64)) + 1.0_f64)));
             // ∂i/∂u (the input's noise in the measurement variance)
             let di_du = K_E * t0;

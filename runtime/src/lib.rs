@@ -54,7 +54,8 @@ pub mod math {
                 fn exp(x: $t) -> $t {
                     libm::$exp(x)
                 }
-                #[inline]
+                // always: `ln` (f64) is inlined whole, see ln.rs
+                #[inline(always)]
                 fn ln(x: $t) -> $t {
                     crate::ln::$ln(x)
                 }
@@ -122,34 +123,28 @@ pub mod math {
     real_impl!(f32, sqrtf, expf, logf, tanhf, powf, fabsf, fminf, fmaxf);
 }
 
-/// Clamps `u` to `[lo, hi]`; a NaN input maps to `lo`'s side of zero-safe
-/// behaviour: it returns the bound closest to zero, so a numerical failure
-/// never commands full voltage.
-#[inline]
-pub fn saturate(u: f64, lo: f64, hi: f64) -> f64 {
-    if u.is_nan() {
-        return if lo <= 0.0 && hi >= 0.0 {
-            0.0
-        } else if lo > 0.0 {
-            lo
-        } else {
-            hi
-        };
-    }
-    if u < lo {
-        lo
-    } else if u > hi {
-        hi
-    } else {
-        u
-    }
+macro_rules! saturate_impl {
+    ($name:ident, $t:ty) => {
+        /// Clamps `u` to `[lo, hi]` (lo ≤ hi); a NaN input gives the bound
+        /// closest to zero (0 when lo ≤ 0 ≤ hi), so a numerical failure never
+        /// commands full voltage. Without branches: NaN → 0, then the clamp,
+        /// which takes that 0 to the bound nearest zero (on x86-64 a compare-and-mask,
+        /// `max` and `min`).
+        #[inline]
+        pub fn $name(u: $t, lo: $t, hi: $t) -> $t {
+            let u = if u.is_nan() { 0.0 } else { u };
+            let u = if u > lo { u } else { lo };
+            if u < hi {
+                u
+            } else {
+                hi
+            }
+        }
+    };
 }
 
-/// f32 version of [`saturate`].
-#[inline]
-pub fn saturate_f32(u: f32, lo: f32, hi: f32) -> f32 {
-    saturate(u as f64, lo as f64, hi as f64) as f32
-}
+saturate_impl!(saturate, f64);
+saturate_impl!(saturate_f32, f32);
 
 /// One sample of the measured state of a single-coil actuator: position z
 /// [m], velocity v [m/s] and magnetic flux φ [Wb] (the state of the
@@ -186,6 +181,13 @@ mod tests {
         assert_eq!(saturate(f64::NAN, 1.0, 24.0), 1.0);
         assert_eq!(saturate(f64::NAN, -24.0, -1.0), -1.0);
         assert_eq!(saturate_f32(f32::NAN, -24.0, 24.0), 0.0);
+        assert_eq!(saturate_f32(f32::NAN, 1.0, 24.0), 1.0);
+        assert_eq!(saturate_f32(f32::NAN, -24.0, -1.0), -1.0);
+        assert_eq!(saturate_f32(-30.0, -24.0, 24.0), -24.0);
+        assert_eq!(saturate(f64::INFINITY, -24.0, 24.0), 24.0);
+        assert_eq!(saturate(f64::NEG_INFINITY, -24.0, 24.0), -24.0);
+        assert_eq!(saturate(-24.0, -24.0, 24.0), -24.0);
+        assert_eq!(saturate(24.0, -24.0, 24.0), 24.0);
     }
 
     #[test]
