@@ -1,2 +1,28 @@
 //! Identification from measured data (`reldesign fit`): parameters of a
 //! description fitted to a bench recording (jiles-atherton-actuator-model §4–5).
+//!
+//! - [`measured`]: the recording (t, v, i and optional z, φ, λ).
+//! - [`weighted`]: the |φ̇|-weighted NRMSE (81), its weights and the flux
+//!   estimated from the data.
+//! - [`params`]: description parameters addressed by TOML key path.
+//! - [`lm`]: a bounded Levenberg–Marquardt least-squares solver.
+//! - [`em_fit`]: the fit of (80) by replaying the measured voltage.
+//! - [`identifiability`]: what the data can and cannot separate (SVD of the
+//!   scaled Jacobian), and the reduced model's parameters (55), (57), (60).
+//! - [`gap_fit`]: the gap model fitted to a reluctance table (75)–(77).
+
+pub mod em_fit;
+pub mod gap_fit;
+pub mod identifiability;
+pub mod lm;
+pub mod measured;
+pub mod params;
+pub mod weighted;
+
+pub use em_fit::{
+    current_wnrmse, fit, simulate_outputs, FitError, FitOptions, FitParam, FitProgress, FitReport,
+    SimOutputs,
+};
+pub use identifiability::{reduced_parameters, ReducedParameters, Sensitivity};
+pub use measured::Measured;
+pub use weighted::{flux_from_data, flux_rate_weights, wnrmse};

@@ -1,0 +1,554 @@
+//! The electromagnetic fit of jiles-atherton-actuator-model §5.2: parameters
+//! of a description chosen to minimise (80),
+//!
+//! ```text
+//! wNRMSE²(i) + wNRMSE²(φ) [+ NRMSE²(z)]
+//! ```
+//!
+//! where each simulated signal comes from replaying the measured voltage
+//! (linear between samples, as `reldesign simulate --input` does) through the
+//! hybrid model from rest. The weights are |φ̇| estimated from the data
+//! ([`weighted`](super::weighted)) with the starting description's R and N,
+//! fixed for the whole fit (weights that moved with θ would let the fit lower
+//! its error by reweighting). The flux term is used when asked: against the
+//! data's flux column, or else the flux integrated from v − R·i with each
+//! candidate's own R and N; the position term, normalised by the stroke,
+//! whenever the data has `z`.
+//! Residuals are √w·(sim − exp)/‖exp‖_w so that ‖r‖² is the objective.
+//!
+//! Sensitivities are forward differences of whole replays (no sensitivity
+//! equations): the replays run at a tight tolerance ([`FitOptions::rtol`]) so
+//! that a relative step of [`FitOptions::fd_step`] sees a smooth function.
+//! Several starts ([`FitOptions::starts`]) are drawn deterministically from
+//! the bounds (log-uniform for positive parameters spanning a decade or more);
+//! the best fit is kept.
+
+use crate::description::{Core, Description, Drive};
+use crate::model::{Model, ModelPlant};
+use crate::replay::{replay_plant, Replay};
+use crate::sim::{Options, PiecewiseLinear};
+
+use super::identifiability::Sensitivity;
+use super::lm::{self, LmError, Status};
+use super::measured::Measured;
+use super::params::{self, ParamError};
+use super::weighted::{flux_from_data, flux_rate_weights, has_measured_flux, wnrmse};
+
+/// One parameter to fit, by TOML key path, with its bounds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitParam {
+    pub path: String,
+    pub lower: f64,
+    pub upper: f64,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitOptions {
+    /// Number of starts: the description's values, then `starts − 1` drawn
+    /// from the bounds.
+    pub starts: usize,
+    /// Levenberg–Marquardt iterations per start.
+    pub max_iterations: usize,
+    /// Include the flux term of (80).
+    pub use_flux: bool,
+    /// Include NRMSE²(z) when the data has a `z` column.
+    pub use_position: bool,
+    /// Seed of the drawn starts.
+    pub seed: u64,
+    /// Relative tolerance of the replays.
+    pub rtol: f64,
+    /// Forward-difference step (relative, in the solver's scaled variables).
+    pub fd_step: f64,
+    /// Relative decrease of the objective below which a start stops.
+    pub ftol: f64,
+    /// Integration steps (accepted and rejected) a replay may take per
+    /// sample of the record: a trial parameter set that makes the model so
+    /// stiff that it needs more fails fast, and the solver shrinks its step.
+    pub max_steps_per_sample: usize,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self {
+            starts: 1,
+            max_iterations: 50,
+            use_flux: true,
+            use_position: true,
+            seed: 1,
+            rtol: 1e-10,
+            fd_step: 1e-6,
+            ftol: 1e-8,
+            max_steps_per_sample: 200,
+        }
+    }
+}
+
+/// Reported after every iteration of every start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitProgress {
+    /// 0-based start index.
+    pub start: usize,
+    pub starts: usize,
+    pub iteration: usize,
+    /// The objective (80) at the current iterate.
+    pub objective: f64,
+}
+
+#[derive(Debug, Clone)]
+pub struct FitReport {
+    /// The description with the fitted values.
+    pub description: Description,
+    /// (path, fitted value), in the order of the fitted parameters.
+    pub values: Vec<(String, f64)>,
+    /// (81) for the current, after the fit.
+    pub wnrmse_current: f64,
+    /// (81) for the flux, after the fit (when a flux reference exists).
+    pub wnrmse_flux: Option<f64>,
+    /// RMS position error over the stroke (when the data has `z`).
+    pub nrmse_position: Option<f64>,
+    /// The objective (80) minimised: the sum of the squared errors used.
+    pub cost: f64,
+    /// Solver iterations, all starts.
+    pub iterations: usize,
+    /// Replays, all starts, finite differences included.
+    pub simulations: usize,
+    /// Why the best start stopped.
+    pub status: Status,
+    /// Which start gave the best fit (0 = the description's values).
+    pub best_start: usize,
+    pub sensitivity: Sensitivity,
+}
+
+/// Simulated signals at the data's sample times.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimOutputs {
+    pub t: Vec<f64>,
+    pub current: Vec<f64>,
+    pub voltage: Vec<f64>,
+    pub z: Vec<f64>,
+    pub phi: Vec<f64>,
+    /// H_c (Jiles–Atherton core only).
+    pub h_c: Option<Vec<f64>>,
+    /// Automaton mode 1, 2, 3 (stuck at z_min, free, stuck at z_max).
+    pub mode: Vec<u8>,
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FitError {
+    #[error(transparent)]
+    Param(#[from] ParamError),
+    #[error("{model}: fitting replays the measured voltage, but supply.drive = \"current\"; use drive = \"voltage\"")]
+    CurrentDrive { model: String },
+    #[error("{file}: the voltage column cannot be replayed: {message}")]
+    Input { file: String, message: String },
+    #[error("{file}: the replay through {model} failed: {message}")]
+    Simulation {
+        file: String,
+        model: String,
+        message: String,
+    },
+    #[error("no parameter to fit: give at least one")]
+    NoParameters,
+    #[error("parameter `{path}` is given twice")]
+    Duplicate { path: String },
+    #[error("parameter `{path}`: bounds [{lower:e}, {upper:e}] must satisfy lower < upper within the parameter's domain")]
+    Bounds {
+        path: String,
+        lower: f64,
+        upper: f64,
+    },
+    #[error(
+        "{file}: the measured current is zero wherever the flux changes: wNRMSE (81) has no scale"
+    )]
+    NoScale { file: String },
+    #[error("{file}: no start point could be simulated: {message}")]
+    Solver { file: String, message: String },
+}
+
+/// (81) of the current for one replay of `d` (the diagnose baseline).
+pub fn current_wnrmse(d: &Description, data: &Measured) -> Result<f64, FitError> {
+    let out = simulate_outputs(d, data)?;
+    let w = flux_rate_weights(data, d.coil.turns, d.coil.resistance);
+    Ok(wnrmse(&out.current, &data.i, &w))
+}
+
+/// Replays the measured voltage through `d` (default fit tolerance).
+pub fn simulate_outputs(d: &Description, data: &Measured) -> Result<SimOutputs, FitError> {
+    simulate_with(d, data, &Budget::of(&FitOptions::default()))
+}
+
+/// Accuracy and effort of one replay.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Budget {
+    rtol: f64,
+    max_steps_per_sample: usize,
+}
+
+impl Budget {
+    fn of(options: &FitOptions) -> Budget {
+        Budget {
+            rtol: options.rtol,
+            max_steps_per_sample: options.max_steps_per_sample,
+        }
+    }
+}
+
+fn simulate_with(
+    d: &Description,
+    data: &Measured,
+    budget: &Budget,
+) -> Result<SimOutputs, FitError> {
+    let replay = replay(d, data, budget)?;
+    let tr = &replay.trajectory;
+    let field = matches!(d.core, Core::JilesAtherton(_));
+    Ok(SimOutputs {
+        t: tr.t.clone(),
+        current: replay.current.clone(),
+        voltage: replay.voltage.clone(),
+        z: tr.x.iter().map(|x| x[0]).collect(),
+        phi: tr.x.iter().map(|x| x[2]).collect(),
+        h_c: field.then(|| tr.x.iter().map(|x| x[3]).collect()),
+        mode: tr.mode.iter().map(|m| m.number()).collect(),
+    })
+}
+
+/// The measured voltage replayed through `d` from rest.
+fn replay(d: &Description, data: &Measured, budget: &Budget) -> Result<Replay, FitError> {
+    if d.supply.drive == Drive::Current {
+        return Err(FitError::CurrentDrive {
+            model: d.source.file_name.clone(),
+        });
+    }
+    let input =
+        PiecewiseLinear::new(data.t.clone(), data.v.clone()).map_err(|e| FitError::Input {
+            file: data.file_name.clone(),
+            message: e.to_string(),
+        })?;
+    let mut model = Model::build(d);
+    let plant = ModelPlant::new(&mut model);
+    let options = Options {
+        rtol: budget.rtol,
+        max_steps: budget
+            .max_steps_per_sample
+            .saturating_mul(data.t.len())
+            .max(10_000),
+        ..Options::default()
+    };
+    replay_plant(&plant, &model, &input, &data.t, &options).map_err(|e| FitError::Simulation {
+        file: data.file_name.clone(),
+        model: d.source.file_name.clone(),
+        message: e.to_string(),
+    })
+}
+
+/// The measured references of (80) and their weights.
+struct Objective<'a> {
+    data: &'a Measured,
+    weights: Vec<f64>,
+    /// √(Σ w·i²)
+    current_norm: f64,
+    /// The flux reference, when the flux term is used.
+    flux: Option<FluxReference>,
+    /// Stroke·√n, when the position is used.
+    position_norm: Option<f64>,
+    budget: Budget,
+}
+
+/// The φ of the flux term: measured, or integrated from v − R·i with the
+/// candidate's own R and N (the integral drifts with a wrong R, so a
+/// reference fixed at the start's R would pull R away from the truth).
+enum FluxReference {
+    Measured(Vec<f64>),
+    Integrated,
+}
+
+/// The errors of one replay.
+struct Errors {
+    current: f64,
+    flux: Option<f64>,
+    position: Option<f64>,
+}
+
+impl<'a> Objective<'a> {
+    fn new(d: &Description, data: &'a Measured, options: &FitOptions) -> Result<Self, FitError> {
+        let (turns, resistance) = (d.coil.turns, d.coil.resistance);
+        let weights = flux_rate_weights(data, turns, resistance);
+        let weighted_norm = |x: &[f64]| {
+            x.iter()
+                .zip(&weights)
+                .map(|(x, w)| w * x * x)
+                .sum::<f64>()
+                .sqrt()
+        };
+        let current_norm = weighted_norm(&data.i);
+        if !(current_norm > 0.0) {
+            return Err(FitError::NoScale {
+                file: data.file_name.clone(),
+            });
+        }
+        let flux = options.use_flux.then(|| match has_measured_flux(data) {
+            true => FluxReference::Measured(flux_from_data(data, turns, resistance)),
+            false => FluxReference::Integrated,
+        });
+        let stroke = d.mechanics.z_max - d.mechanics.z_min;
+        let position_norm = match (&data.z, options.use_position) {
+            (Some(z), true) => Some(stroke * (z.len() as f64).sqrt()),
+            _ => None,
+        };
+        Ok(Objective {
+            data,
+            weights,
+            current_norm,
+            flux,
+            position_norm,
+            budget: Budget::of(options),
+        })
+    }
+
+    /// The flux reference for `d` and its weighted norm √(Σ w·φ²) (none
+    /// when not used or identically zero).
+    fn flux_reference(&self, d: &Description) -> Option<(Vec<f64>, f64)> {
+        let phi = match self.flux.as_ref()? {
+            FluxReference::Measured(phi) => phi.clone(),
+            FluxReference::Integrated => flux_from_data(self.data, d.coil.turns, d.coil.resistance),
+        };
+        let norm = phi
+            .iter()
+            .zip(&self.weights)
+            .map(|(x, w)| w * x * x)
+            .sum::<f64>()
+            .sqrt();
+        (norm > 0.0).then_some((phi, norm))
+    }
+
+    /// Residuals √w·(sim − exp)/norm: ‖r‖² is the objective (80).
+    fn residuals(&self, d: &Description) -> Result<Vec<f64>, FitError> {
+        let out = simulate_with(d, self.data, &self.budget)?;
+        let sw: Vec<f64> = self.weights.iter().map(|w| w.sqrt()).collect();
+        let mut r: Vec<f64> = (0..self.data.len())
+            .map(|k| sw[k] * (out.current[k] - self.data.i[k]) / self.current_norm)
+            .collect();
+        if let Some((phi, norm)) = self.flux_reference(d) {
+            r.extend((0..phi.len()).map(|k| sw[k] * (out.phi[k] - phi[k]) / norm));
+        }
+        if let (Some(norm), Some(z)) = (self.position_norm, &self.data.z) {
+            r.extend(z.iter().zip(&out.z).map(|(e, s)| (s - e) / norm));
+        }
+        Ok(r)
+    }
+
+    fn errors(&self, d: &Description) -> Result<Errors, FitError> {
+        let out = simulate_with(d, self.data, &self.budget)?;
+        Ok(Errors {
+            current: wnrmse(&out.current, &self.data.i, &self.weights),
+            flux: self
+                .flux_reference(d)
+                .map(|(phi, _)| wnrmse(&out.phi, &phi, &self.weights)),
+            position: match (self.position_norm, &self.data.z) {
+                (Some(norm), Some(z)) => Some(
+                    z.iter()
+                        .zip(&out.z)
+                        .map(|(e, s)| (s - e).powi(2))
+                        .sum::<f64>()
+                        .sqrt()
+                        / norm,
+                ),
+                _ => None,
+            },
+        })
+    }
+}
+
+/// `d` with the parameters `paths` set to `theta`.
+fn with_values(
+    d: &Description,
+    paths: &[FitParam],
+    theta: &[f64],
+) -> Result<Description, ParamError> {
+    let mut d = d.clone();
+    for (p, &x) in paths.iter().zip(theta) {
+        params::set(&mut d, &p.path, x)?;
+    }
+    Ok(d)
+}
+
+/// Fits `params` of `description` to `data` (see the module docs).
+pub fn fit(
+    description: &Description,
+    data: &Measured,
+    params: &[FitParam],
+    options: &FitOptions,
+    progress: &(dyn Fn(FitProgress) + Sync),
+) -> Result<FitReport, FitError> {
+    let start0 = check_params(description, params)?;
+    let objective = Objective::new(description, data, options)?;
+    let bounds: Vec<(f64, f64)> = params.iter().map(|p| (p.lower, p.upper)).collect();
+    let residual = |theta: &[f64]| {
+        let d = with_values(description, params, theta).ok()?;
+        objective.residuals(&d).ok()
+    };
+    let lm_options = lm::Options {
+        max_iterations: options.max_iterations,
+        ftol: options.ftol,
+        fd_step: options.fd_step,
+        ..lm::Options::default()
+    };
+    let starts = options.starts.max(1);
+    let mut best: Option<(usize, lm::Report)> = None;
+    let (mut iterations, mut simulations) = (0, 0);
+    let mut last_error = None;
+    for (k, x0) in start_points(&start0, params, starts, options.seed)
+        .iter()
+        .enumerate()
+    {
+        let mut monitor = |it: &lm::Iteration| {
+            progress(FitProgress {
+                start: k,
+                starts,
+                iteration: it.iteration,
+                objective: 2.0 * it.cost,
+            })
+        };
+        match lm::minimize(residual, x0, &bounds, &lm_options, &mut monitor) {
+            Ok(report) => {
+                iterations += report.iterations;
+                simulations += report.evaluations;
+                if best.as_ref().is_none_or(|(_, b)| report.cost < b.cost) {
+                    best = Some((k, report));
+                }
+            }
+            Err(e) => last_error = Some(e),
+        }
+    }
+    let (best_start, report) = best.ok_or_else(|| FitError::Solver {
+        file: data.file_name.clone(),
+        message: last_error.map_or_else(String::new, |e: LmError| e.to_string()),
+    })?;
+    let fitted = with_values(description, params, &report.theta)?;
+    let errors = objective.errors(&fitted)?;
+    let names: Vec<String> = params.iter().map(|p| p.path.clone()).collect();
+    Ok(FitReport {
+        sensitivity: Sensitivity::from_jacobian(
+            &names,
+            &report.jacobian,
+            &report.theta,
+            &report.residuals,
+        ),
+        values: names
+            .iter()
+            .cloned()
+            .zip(report.theta.iter().copied())
+            .collect(),
+        description: fitted,
+        wnrmse_current: errors.current,
+        wnrmse_flux: errors.flux,
+        nrmse_position: errors.position,
+        cost: 2.0 * report.cost,
+        iterations,
+        simulations: simulations + 1,
+        status: report.status,
+        best_start,
+    })
+}
+
+/// The sensitivity report of `params` at the description's values (no fit).
+pub fn sensitivity_at(
+    description: &Description,
+    data: &Measured,
+    params: &[FitParam],
+    options: &FitOptions,
+) -> Result<Sensitivity, FitError> {
+    let x0 = check_params(description, params)?;
+    let objective = Objective::new(description, data, options)?;
+    let bounds: Vec<(f64, f64)> = params.iter().map(|p| (p.lower, p.upper)).collect();
+    let residual = |theta: &[f64]| {
+        let d = with_values(description, params, theta).ok()?;
+        objective.residuals(&d).ok()
+    };
+    let lm_options = lm::Options {
+        max_iterations: 0,
+        fd_step: options.fd_step,
+        ..lm::Options::default()
+    };
+    let report = lm::minimize(residual, &x0, &bounds, &lm_options, &mut |_| {}).map_err(|e| {
+        FitError::Solver {
+            file: data.file_name.clone(),
+            message: e.to_string(),
+        }
+    })?;
+    let names: Vec<String> = params.iter().map(|p| p.path.clone()).collect();
+    Ok(Sensitivity::from_jacobian(
+        &names,
+        &report.jacobian,
+        &report.theta,
+        &report.residuals,
+    ))
+}
+
+/// Checks paths, duplicates and bounds; returns the start values (the
+/// description's, clamped into the bounds).
+fn check_params(d: &Description, params: &[FitParam]) -> Result<Vec<f64>, FitError> {
+    if params.is_empty() {
+        return Err(FitError::NoParameters);
+    }
+    let mut x0 = Vec::with_capacity(params.len());
+    for (k, p) in params.iter().enumerate() {
+        if params[..k].iter().any(|q| q.path == p.path) {
+            return Err(FitError::Duplicate {
+                path: p.path.clone(),
+            });
+        }
+        let value = params::get(d, &p.path)?;
+        let domain = params::domain(d, &p.path)?;
+        let inside = |x: f64| domain.contains(x);
+        if !(p.lower < p.upper) || !inside(p.lower) || !inside(p.upper) {
+            return Err(FitError::Bounds {
+                path: p.path.clone(),
+                lower: p.lower,
+                upper: p.upper,
+            });
+        }
+        x0.push(value.clamp(p.lower, p.upper));
+    }
+    Ok(x0)
+}
+
+/// The start points: `x0`, then points drawn from the bounds.
+fn start_points(x0: &[f64], params: &[FitParam], starts: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = SplitMix64(seed);
+    let mut points = vec![x0.to_vec()];
+    for _ in 1..starts {
+        points.push(
+            params
+                .iter()
+                .map(|p| {
+                    let u = rng.uniform();
+                    if p.lower > 0.0 && p.upper >= 10.0 * p.lower {
+                        (p.lower.ln() + u * (p.upper / p.lower).ln()).exp()
+                    } else {
+                        p.lower + u * (p.upper - p.lower)
+                    }
+                })
+                .collect(),
+        );
+    }
+    points
+}
+
+/// SplitMix64: a small deterministic generator for the start points.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in (0, 1).
+    fn uniform(&mut self) -> f64 {
+        ((self.next() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+}

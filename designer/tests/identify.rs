@@ -1,0 +1,406 @@
+//! Identification against synthetic bench data: a bundled example is
+//! simulated with a square-wave voltage, seeded Gaussian noise is added
+//! (σ_v = 15 mV, σ_i = 1 mA), the parameters to fit are perturbed by 20–50 %,
+//! and `identify::fit` must recover them and bring the weighted error down
+//! to the noise floor (the error of the true description on the same data).
+
+use std::path::Path;
+use std::time::Instant;
+
+use designer::description::{parse_file, Description};
+use designer::identify::gap_fit::{fit_gap, reluctance_and_slope, GapModel, GapTable};
+use designer::identify::{
+    current_wnrmse, fit, params, reduced_parameters, simulate_outputs, FitOptions, FitParam,
+    Measured,
+};
+
+fn example(name: &str) -> Description {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples")
+        .join(name);
+    parse_file(&path).unwrap()
+}
+
+/// SplitMix64 and Box–Muller: seeded standard normal samples.
+struct Noise(u64);
+
+impl Noise {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        (((z ^ (z >> 31)) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    fn normal(&mut self) -> f64 {
+        let (u1, u2) = (self.uniform(), self.uniform());
+        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+    }
+}
+
+/// A square wave `high`/`low` of `period` (duty ½) sampled every `dt`, each
+/// edge a one-sample ramp (the replay is linear between samples).
+fn square(high: f64, low: f64, period: f64, dt: f64, n: usize) -> (Vec<f64>, Vec<f64>) {
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+    let v = t
+        .iter()
+        .map(|t| {
+            if (t / period).fract() < 0.5 {
+                high
+            } else {
+                low
+            }
+        })
+        .collect();
+    (t, v)
+}
+
+/// The description `truth` driven by `v`, measured with noise.
+fn synthetic(truth: &Description, t: Vec<f64>, v: Vec<f64>, seed: u64) -> Measured {
+    let dt = t[1] - t[0];
+    let clean = Measured {
+        i: vec![0.0; t.len()],
+        z: None,
+        phi: None,
+        lambda: None,
+        dt,
+        file_name: "synthetic.csv".into(),
+        t,
+        v,
+    };
+    let sim = simulate_outputs(truth, &clean).unwrap();
+    let mut noise = Noise(seed);
+    Measured {
+        v: clean.v.iter().map(|v| v + 15e-3 * noise.normal()).collect(),
+        i: sim
+            .current
+            .iter()
+            .map(|i| i + 1e-3 * noise.normal())
+            .collect(),
+        ..clean
+    }
+}
+
+fn perturbed(d: &Description, changes: &[(&str, f64)]) -> Description {
+    let mut d = d.clone();
+    for (path, factor) in changes {
+        let x = params::get(&d, path).unwrap();
+        params::set(&mut d, path, x * factor).unwrap();
+    }
+    d
+}
+
+fn bounds(d: &Description, path: &str, below: f64, above: f64) -> FitParam {
+    let x = params::get(d, path).unwrap();
+    FitParam {
+        path: path.into(),
+        lower: x / below,
+        upper: x * above,
+    }
+}
+
+#[test]
+fn saturating_valve_parameters_are_recovered_from_noisy_data() {
+    let truth = example("semera-valve.toml");
+    // 30 ms at 20 µs: the valve closes and opens once (0/30 V, period 20 ms).
+    let (t, v) = square(30.0, 0.0, 20e-3, 20e-6, 1500);
+    let data = synthetic(&truth, t, v, 7);
+    let changes = [
+        ("coil.resistance", 1.3),
+        ("core.phi_sat", 0.7),
+        ("core.r0", 1.5),
+        ("gap.slope", 0.75),
+    ];
+    let start = perturbed(&truth, &changes);
+    let fitted: Vec<FitParam> = changes
+        .iter()
+        .map(|(p, _)| bounds(&truth, p, 3.0, 3.0))
+        .collect();
+    let floor = current_wnrmse(&truth, &data).unwrap();
+    let before = current_wnrmse(&start, &data).unwrap();
+    let clock = Instant::now();
+    let report = fit(&start, &data, &fitted, &FitOptions::default(), &|_| {}).unwrap();
+    let seconds = clock.elapsed().as_secs_f64();
+    eprintln!(
+        "saturating fit: {:?}, {seconds:.2} s, {} iterations, {} replays, wNRMSE {before:.4} → {:.5} (floor {floor:.5})\n{}",
+        report.status, report.iterations, report.simulations, report.wnrmse_current, report.sensitivity
+    );
+    // Tolerances: R 0.5 %, φ_sat 3 %, R_core0 and the gap slope 3 %.
+    for ((path, value), tol) in report.values.iter().zip([5e-3, 3e-2, 3e-2, 3e-2]) {
+        let want = params::get(&truth, path).unwrap();
+        assert!(
+            (value / want - 1.0).abs() < tol,
+            "{path}: {value:e} vs {want:e}"
+        );
+    }
+    assert!(
+        before > 5.0 * floor,
+        "the perturbation must matter: {before} vs {floor}"
+    );
+    assert!(
+        report.wnrmse_current < 1.02 * floor,
+        "{} vs floor {floor}",
+        report.wnrmse_current
+    );
+    assert!(report.status.converged(), "{:?}", report.status);
+}
+
+/// The five Jiles–Atherton parameters (79) on the JA valve: ±24 V, 10 µs
+/// samples, so that the plunger closes and the core saturates.
+fn ja_case(n: usize) -> (Description, Description, Measured, Vec<FitParam>) {
+    let truth = example("jiles-atherton-valve.toml");
+    let (t, v) = square(24.0, -24.0, 20e-3, 10e-6, n);
+    let data = synthetic(&truth, t, v, 11);
+    let changes = [
+        ("core.m_sat", 1.3),
+        ("core.b", 0.7),
+        ("core.c", 0.8),
+        ("core.kappa", 1.4),
+        ("core.alpha", 1.25),
+    ];
+    let start = perturbed(&truth, &changes);
+    let mut fitted: Vec<FitParam> = changes
+        .iter()
+        .map(|(p, _)| bounds(&truth, p, 3.0, 3.0))
+        .collect();
+    fitted[2] = FitParam {
+        path: "core.c".into(),
+        lower: 0.3,
+        upper: 0.95,
+    };
+    (truth, start, data, fitted)
+}
+
+fn check_ja_fit(n: usize, tolerance: f64) {
+    let (truth, start, data, fitted) = ja_case(n);
+    let floor = current_wnrmse(&truth, &data).unwrap();
+    let before = current_wnrmse(&start, &data).unwrap();
+    let clock = Instant::now();
+    let report = fit(&start, &data, &fitted, &FitOptions::default(), &|_| {}).unwrap();
+    let seconds = clock.elapsed().as_secs_f64();
+    eprintln!(
+        "JA fit, {n} samples: {:?}, {seconds:.2} s, {} iterations, {} replays, wNRMSE {before:.4} → {:.5} (floor {floor:.5})\n{}",
+        report.status, report.iterations, report.simulations, report.wnrmse_current, report.sensitivity
+    );
+    for (path, value) in &report.values {
+        let want = params::get(&truth, path).unwrap();
+        eprintln!(
+            "  {path}: {value:e} (true {want:e}, {:+.3} %)",
+            100.0 * (value / want - 1.0)
+        );
+    }
+    // M_sat is pinned hardest (saturation), κ least (its relative standard
+    // error is the largest): tolerances 1 %, b, c, α `tolerance`, κ 2·`tolerance`.
+    for (path, value) in &report.values {
+        let want = params::get(&truth, path).unwrap();
+        let tol = match path.as_str() {
+            "core.m_sat" => 0.01,
+            "core.kappa" => 2.0 * tolerance,
+            _ => tolerance,
+        };
+        assert!(
+            (value / want - 1.0).abs() < tol,
+            "{path}: {value:e} vs {want:e}"
+        );
+    }
+    assert!(
+        before > 3.0 * floor,
+        "the perturbation must matter: {before} vs {floor}"
+    );
+    assert!(
+        report.wnrmse_current < 1.02 * floor,
+        "{} vs floor {floor}",
+        report.wnrmse_current
+    );
+}
+
+#[test]
+fn jiles_atherton_parameters_are_recovered_from_a_short_record() {
+    check_ja_fit(4000, 0.04);
+}
+
+/// The benchmark case: 40 000 samples (0.4 s at 10 µs). Slow; run
+/// by `benches/fit.sh`, which prints the time.
+#[test]
+#[ignore]
+fn jiles_atherton_parameters_are_recovered_from_40000_samples() {
+    check_ja_fit(40_000, 0.04);
+}
+
+/// The description with N → s·N, l_c → p·l_c, A_c → p·A_c and the other
+/// parameters moved so that every reduced parameter (55), (57), (60) stays.
+fn same_reduced_model(d: &Description, s: f64, p: f64) -> Description {
+    let mut e = d.clone();
+    let get = |path: &str| params::get(d, path).unwrap();
+    let mut set = |path: &str, x: f64| params::set(&mut e, path, x).unwrap();
+    let vacuum = get("core.length") / (designer::model::MU0 * get("core.area"));
+    set("coil.turns", s * get("coil.turns"));
+    set("coil.eddy", s * s * get("coil.eddy"));
+    set("gap.r0_prime", s * s * get("gap.r0_prime"));
+    // (57): R_g0 + l_c/(μ0·A_c) scales by s²; l_c/(μ0·A_c) is unchanged for p = q.
+    set("gap.r0", s * s * (get("gap.r0") + vacuum) - vacuum);
+    set("core.length", p * get("core.length"));
+    set("core.area", p * get("core.area"));
+    set("core.m_sat", get("core.m_sat") * s / p);
+    set("core.b", get("core.b") / (s * p));
+    set("core.kappa", get("core.kappa") / (s * p));
+    set("core.alpha", 1.0 - (1.0 - get("core.alpha")) / (s * s));
+    e
+}
+
+#[test]
+fn descriptions_with_the_same_reduced_parameters_give_the_same_current() {
+    let a = example("jiles-atherton-valve.toml");
+    let b = same_reduced_model(&a, 1.1, 1.2);
+    let (ra, rb) = (
+        reduced_parameters(&a).unwrap(),
+        reduced_parameters(&b).unwrap(),
+    );
+    let fields = |r: designer::identify::ReducedParameters| {
+        [
+            r.k_e,
+            r.r_g0,
+            r.r_g0_prime,
+            r.m_sat,
+            r.b,
+            r.kappa,
+            r.alpha,
+            r.c,
+            r.resistance,
+        ]
+    };
+    for (x, y) in fields(ra).iter().zip(fields(rb)) {
+        assert!((x / y - 1.0).abs() < 1e-12, "{ra:?} vs {rb:?}");
+    }
+    assert_ne!(
+        params::get(&a, "core.m_sat").unwrap(),
+        params::get(&b, "core.m_sat").unwrap()
+    );
+    let (t, v) = square(24.0, -24.0, 20e-3, 10e-6, 3000);
+    let data = synthetic(&a, t, v, 3);
+    let (ia, ib) = (
+        simulate_outputs(&a, &data).unwrap(),
+        simulate_outputs(&b, &data).unwrap(),
+    );
+    let peak = ia.current.iter().fold(0.0f64, |m, i| m.max(i.abs()));
+    let worst = ia
+        .current
+        .iter()
+        .zip(&ib.current)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(
+        worst < 1e-6 * peak,
+        "currents differ by {worst:e} A (peak {peak:e} A)"
+    );
+    let zs =
+        ia.z.iter()
+            .zip(&ib.z)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(zs < 1e-9, "positions differ by {zs:e} m");
+    // A perturbation off the invariant manifold does change the current.
+    let c = perturbed(&a, &[("core.m_sat", 1.01)]);
+    let ic = simulate_outputs(&c, &data).unwrap();
+    let moved = ia
+        .current
+        .iter()
+        .zip(&ic.current)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(moved > 1e3 * worst.max(1e-12), "{moved:e}");
+}
+
+#[test]
+fn the_sensitivity_report_flags_the_over_parameterisation() {
+    // With s = 1 the invariance is l_c, A_c ∝ p and M_sat, b, κ ∝ 1/p: in
+    // ln θ the direction (1, 1, −1, −1, −1)/√5.
+    let truth = example("jiles-atherton-valve.toml");
+    let (t, v) = square(24.0, -24.0, 20e-3, 10e-6, 3000);
+    let data = synthetic(&truth, t, v, 5);
+    let paths = [
+        "core.length",
+        "core.area",
+        "core.m_sat",
+        "core.b",
+        "core.kappa",
+    ];
+    let fitted: Vec<FitParam> = paths.iter().map(|p| bounds(&truth, p, 3.0, 3.0)).collect();
+    let s =
+        designer::identify::em_fit::sensitivity_at(&truth, &data, &fitted, &FitOptions::default())
+            .unwrap();
+    eprintln!("{s}");
+    assert_eq!(s.weak_directions.len(), 1, "{s}");
+    let want = [1.0, 1.0, -1.0, -1.0, -1.0].map(|x: f64| x / 5f64.sqrt());
+    for (name, c) in &s.weak_directions[0] {
+        let k = paths.iter().position(|p| p == name).unwrap();
+        assert!((c - want[k]).abs() < 1e-3, "{s}");
+    }
+    assert!(s.to_string().contains("cannot separate"));
+    // Without A_c the remaining four are separated.
+    let s4 = designer::identify::em_fit::sensitivity_at(
+        &truth,
+        &data,
+        &[
+            fitted[0].clone(),
+            fitted[2].clone(),
+            fitted[3].clone(),
+            fitted[4].clone(),
+        ],
+        &FitOptions::default(),
+    )
+    .unwrap();
+    assert!(s4.identifiable(), "{s4}");
+}
+
+/// A McLyman-fit table generated by the model itself, with 0.2 % noise.
+fn gap_table(theta: [f64; 4], with_slope: bool) -> GapTable {
+    let mut noise = Noise(17);
+    let z: Vec<f64> = (0..30).map(|k| 1e-5 + k as f64 * 3e-5).collect();
+    let eval: Vec<(f64, f64)> = z.iter().map(|&z| reluctance_and_slope(theta, z)).collect();
+    GapTable {
+        r: eval
+            .iter()
+            .map(|e| e.0 * (1.0 + 2e-3 * noise.normal()))
+            .collect(),
+        r_prime: with_slope.then(|| {
+            eval.iter()
+                .map(|e| e.1 * (1.0 + 2e-3 * noise.normal()))
+                .collect()
+        }),
+        z,
+        file_name: "gap.csv".into(),
+    }
+}
+
+#[test]
+fn gap_fit_recovers_mclyman_fit_parameters() {
+    let theta = [2.41e6, 7.94e10, 1350.0, 9.95e-3];
+    let fit = fit_gap(&gap_table(theta, true), GapModel::McLymanFit).unwrap();
+    eprintln!("{fit:?}");
+    // Tolerances: r0' 1 %, r0 5 %, k1 10 %, k2 25 % (k2 enters through a logarithm).
+    for ((name, got), (want, tol)) in fit
+        .values
+        .iter()
+        .zip(theta.iter().zip([0.05, 0.01, 0.1, 0.25]))
+    {
+        assert!(
+            (got / want - 1.0).abs() < tol,
+            "{name}: {got:e} vs {want:e}"
+        );
+    }
+    assert!(
+        fit.nrmse_r < 3e-3 && fit.nrmse_r_prime.unwrap() < 3e-3,
+        "{fit:?}"
+    );
+}
+
+#[test]
+fn gap_fit_recovers_mclyman_area_and_winding_length() {
+    let (area, lw) = (20e-6, 15e-3);
+    let mu0 = designer::model::MU0;
+    let theta = [0.0, 1.0 / (mu0 * area), 1.0 / area.sqrt(), 2.0 * lw];
+    let fit = fit_gap(&gap_table(theta, false), GapModel::McLyman).unwrap();
+    eprintln!("{fit:?}");
+    assert!((fit.values[0].1 / area - 1.0).abs() < 0.01, "{fit:?}");
+    assert!((fit.values[1].1 / lw - 1.0).abs() < 0.1, "{fit:?}");
+    assert!(fit.nrmse_r < 3e-3 && fit.nrmse_r_prime.is_none());
+}
