@@ -6,7 +6,10 @@
 mod atomic;
 mod build;
 mod check;
+mod diagnose;
+mod diagnose_plot;
 mod eval;
+mod fit;
 mod observe;
 mod plot;
 mod simulate;
@@ -48,6 +51,10 @@ enum Command {
     Build(build::Args),
     /// Run the model-free estimators of [observer] over a recording (semera, integral).
     Observe(observe::Args),
+    /// Fit description parameters to a recording (--param PATH[=LO:HI]), or the gap model to a reluctance table (--gap).
+    Fit(fit::Args),
+    /// Replay a recording, name what the model gets wrong, write the extended model and plots.
+    Diagnose(diagnose::Args),
 }
 
 fn main() -> ExitCode {
@@ -63,6 +70,8 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(&args),
         Command::Build(args) => build::run(&args),
         Command::Observe(args) => observe::run(&args),
+        Command::Fit(args) => fit::run(&args),
+        Command::Diagnose(args) => diagnose::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

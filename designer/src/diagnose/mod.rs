@@ -1,7 +1,319 @@
-//! Model-discrepancy diagnosis (`reldesign diagnose`): replay, localise the
-//! residual, fit each extension of the vocabulary, rank, extend the model.
+//! Model-discrepancy diagnosis (`reldesign diagnose`, `shared/spec/measured-data.md`):
+//! replay the measured voltage through the model, measure the |φ̇|-weighted
+//! current error (eq. 81), fit every extension of the vocabulary on the first
+//! part of the record, rank them by BIC against the baseline's own best
+//! (its resistance refitted), and check the winner on the held-out rest.
+//!
+//! Only the two inputs are read: the description and the recording.
 
+pub mod candidate;
 pub mod cause;
 pub mod localise;
+pub mod rank;
 
+pub use candidate::{Candidate, NotApplicable, Scales};
 pub use cause::Cause;
+
+use rayon::prelude::*;
+
+use crate::description::Description;
+use crate::identify::{
+    self, flux_rate_weights, wnrmse, FitError, FitOptions, FitReport, Measured, SimOutputs,
+};
+
+/// Settings of a diagnosis.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Fraction of the record (at its end) kept out of the fits, in [0, 0.5].
+    pub holdout: f64,
+    /// The causes to try (default: the whole vocabulary).
+    pub causes: Vec<Cause>,
+    /// Iteration cap of each fit.
+    pub max_iterations: usize,
+    /// An extension must bring the error this far above the noise floor to
+    /// count (the baseline explains data within `floor_factor`× its floor).
+    pub floor_factor: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            holdout: 0.25,
+            causes: Cause::EXTENSIONS.to_vec(),
+            max_iterations: 40,
+            floor_factor: 1.25,
+        }
+    }
+}
+
+/// One candidate's fit and score.
+#[derive(Debug, Clone)]
+pub struct Scored {
+    pub cause: Cause,
+    /// The fitted extended description, or why the fit failed.
+    pub fit: Result<FitReport, String>,
+    /// Free parameters (the extension's and the refitted baseline ones).
+    pub parameters: usize,
+    /// wNRMSE of the current on the fitted part of the record.
+    pub wnrmse_fit: f64,
+    /// BIC on the fitted part (lower is better).
+    pub bic: f64,
+}
+
+/// Errors of the baseline and of the extended model on a part of the record.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Gain {
+    pub baseline_wnrmse: f64,
+    pub extended_wnrmse: f64,
+    /// 1 − extended/baseline.
+    pub gain: f64,
+}
+
+impl Gain {
+    fn new(baseline_wnrmse: f64, extended_wnrmse: f64) -> Gain {
+        let gain = if baseline_wnrmse > 0.0 {
+            1.0 - extended_wnrmse / baseline_wnrmse
+        } else {
+            0.0
+        };
+        Gain {
+            baseline_wnrmse,
+            extended_wnrmse,
+            gain,
+        }
+    }
+}
+
+/// The outcome of a diagnosis.
+#[derive(Debug, Clone)]
+pub struct Diagnosis {
+    pub cause: Cause,
+    /// On the whole record.
+    pub whole: Gain,
+    /// On the held-out end of the record (not used by any fit).
+    pub held_out: Option<Gain>,
+    /// wNRMSE that the current's measurement noise alone gives.
+    pub noise_floor: f64,
+    /// Estimated standard deviation of the current noise [A].
+    pub current_noise: f64,
+    /// The winner's description (the baseline's when the cause is `none`).
+    pub extended: Description,
+    /// Every candidate, best first.
+    pub ranking: Vec<Scored>,
+    pub not_applicable: Vec<NotApplicable>,
+    /// Replays of the baseline and of the extended model over the whole record.
+    pub baseline_replay: SimOutputs,
+    pub extended_replay: SimOutputs,
+    /// The |φ̇| weights of eq. 81, from the data.
+    pub weights: Vec<f64>,
+    /// Samples of the record used by the fits (the rest is held out).
+    pub fitted_samples: usize,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum DiagnoseError {
+    #[error("{file}: the model cannot replay this record: {source}")]
+    Replay {
+        file: String,
+        #[source]
+        source: FitError,
+    },
+    #[error("{file}: the record has {rows} rows; a diagnosis needs at least {needed}")]
+    TooShort {
+        file: String,
+        rows: usize,
+        needed: usize,
+    },
+    #[error(
+        "{file}: the current carries no flux change (all |φ̇| weights are zero): nothing to compare"
+    )]
+    NoExcitation { file: String },
+}
+
+/// Fewest samples a diagnosis accepts (fits of up to seven parameters).
+pub const MIN_SAMPLES: usize = 200;
+
+/// Diagnoses `baseline` against `data`.
+pub fn diagnose(
+    baseline: &Description,
+    data: &Measured,
+    options: &Options,
+) -> Result<Diagnosis, DiagnoseError> {
+    let file = data.file_name.clone();
+    let n = data.t.len();
+    if n < MIN_SAMPLES {
+        return Err(DiagnoseError::TooShort {
+            file,
+            rows: n,
+            needed: MIN_SAMPLES,
+        });
+    }
+    let weights = flux_rate_weights(data, baseline.coil.turns, baseline.coil.resistance);
+    if weights.iter().all(|w| *w <= 0.0) {
+        return Err(DiagnoseError::NoExcitation { file });
+    }
+    let replay = |d: &Description| {
+        identify::simulate_outputs(d, data).map_err(|source| DiagnoseError::Replay {
+            file: file.clone(),
+            source,
+        })
+    };
+    let baseline_replay = replay(baseline)?;
+    let current_noise = rank::noise_std(&data.i);
+    let noise_floor = rank::noise_floor(current_noise, &data.i, &weights);
+
+    let fitted_samples = fitted_samples(n, options.holdout);
+    let fit_data = data.head(fitted_samples);
+    let fit_weights = &weights[..fitted_samples];
+    let n_eff = rank::effective_samples(fit_weights);
+    let scales = Scales {
+        peak_flux: peak_abs(&baseline_replay.phi),
+        duration: data.t[n - 1] - data.t[0],
+    };
+    let (candidates, not_applicable) = candidates(baseline, &options.causes, scales);
+    let fit_options = FitOptions {
+        max_iterations: options.max_iterations,
+        // The ranking is by the current's error: fit that (and z when
+        // measured), not the flux integrated from v − R·i, which a drifting
+        // resistance would corrupt.
+        use_flux: false,
+        rtol: 1e-8,
+        fd_step: 1e-5,
+        ftol: 1e-5,
+        max_steps_per_sample: 20,
+        ..FitOptions::default()
+    };
+    let mut ranking: Vec<Scored> = candidates
+        .par_iter()
+        .map(|c| score(c, &fit_data, &fit_options, n_eff))
+        .collect();
+    ranking.sort_by(|a, b| a.bic.total_cmp(&b.bic).then(a.cause.cmp(&b.cause)));
+
+    let winner = choose(&ranking, noise_floor, options.floor_factor);
+    let extended = ranking
+        .iter()
+        .find(|s| s.cause == winner)
+        .and_then(|s| s.fit.as_ref().ok())
+        .map_or_else(|| baseline.clone(), |f| f.description.clone());
+    let extended_replay = replay(&extended)?;
+    let whole = Gain::new(
+        wnrmse(&baseline_replay.current, &data.i, &weights),
+        wnrmse(&extended_replay.current, &data.i, &weights),
+    );
+    let held_out = (fitted_samples < n).then(|| {
+        let k = fitted_samples;
+        Gain::new(
+            wnrmse(&baseline_replay.current[k..], &data.i[k..], &weights[k..]),
+            wnrmse(&extended_replay.current[k..], &data.i[k..], &weights[k..]),
+        )
+    });
+    Ok(Diagnosis {
+        cause: winner,
+        whole,
+        held_out,
+        noise_floor,
+        current_noise,
+        extended,
+        ranking,
+        not_applicable,
+        baseline_replay,
+        extended_replay,
+        weights,
+        fitted_samples,
+    })
+}
+
+/// Samples used by the fits: all but the held-out fraction at the end.
+fn fitted_samples(n: usize, holdout: f64) -> usize {
+    let keep = 1.0 - holdout.clamp(0.0, 0.5);
+    ((n as f64 * keep).round() as usize).clamp(MIN_SAMPLES.min(n), n)
+}
+
+fn peak_abs(x: &[f64]) -> f64 {
+    x.iter().fold(0.0, |m: f64, v| m.max(v.abs()))
+}
+
+/// The `none` candidate and one per applicable cause.
+fn candidates(
+    baseline: &Description,
+    causes: &[Cause],
+    scales: Scales,
+) -> (Vec<Candidate>, Vec<NotApplicable>) {
+    let mut ok = Vec::new();
+    let mut not = Vec::new();
+    let all =
+        std::iter::once(Cause::None).chain(causes.iter().copied().filter(|c| *c != Cause::None));
+    for cause in all {
+        match candidate::candidate(baseline, cause, scales) {
+            Ok(c) => ok.push(c),
+            Err(e) => not.push(e),
+        }
+    }
+    (ok, not)
+}
+
+/// Fits one candidate on `data` and scores it.
+fn score(c: &Candidate, data: &Measured, options: &FitOptions, n_eff: f64) -> Scored {
+    let options = FitOptions {
+        starts: c.starts,
+        ..options.clone()
+    };
+    let fit = identify::fit(&c.start, data, &c.params, &options, &|_| {});
+    let parameters = c.params.len();
+    match fit {
+        Ok(report) => {
+            let e = report.wnrmse_current;
+            Scored {
+                cause: c.cause,
+                parameters,
+                wnrmse_fit: e,
+                bic: rank::bic(e, parameters, n_eff),
+                fit: Ok(report),
+            }
+        }
+        Err(e) => Scored {
+            cause: c.cause,
+            parameters,
+            wnrmse_fit: f64::INFINITY,
+            bic: f64::INFINITY,
+            fit: Err(e.to_string()),
+        },
+    }
+}
+
+/// The best-ranked extension when it beats the baseline's own best (`none`)
+/// by BIC and the baseline's error stands clear of the noise floor.
+fn choose(ranking: &[Scored], noise_floor: f64, floor_factor: f64) -> Cause {
+    let Some(none) = ranking.iter().find(|s| s.cause == Cause::None) else {
+        return Cause::None;
+    };
+    let explained = none.wnrmse_fit <= floor_factor * noise_floor;
+    match ranking.first() {
+        Some(best) if best.cause != Cause::None && best.bic < none.bic && !explained => best.cause,
+        _ => Cause::None,
+    }
+}
+
+/// Whether the simulated armature is in free motion at each sample (mode 2).
+pub fn moving(replay: &SimOutputs) -> Vec<bool> {
+    replay
+        .mode
+        .iter()
+        .map(|m| *m == crate::sim::Mode::Free.number())
+        .collect()
+}
+
+/// Times at which the simulated armature arrives at a limit (impacts and
+/// the returns of its bounces): the distance to the nearer limit falls below
+/// 0.1 % of the stroke after being above it.
+pub fn impacts(replay: &SimOutputs, z_min: f64, z_max: f64) -> Vec<f64> {
+    let tol = 1e-3 * (z_max - z_min);
+    let near = |z: f64| (z - z_min).min(z_max - z) <= tol;
+    replay
+        .z
+        .windows(2)
+        .zip(&replay.t[1..])
+        .filter(|(w, _)| !near(w[0]) && near(w[1]))
+        .map(|(_, t)| *t)
+        .collect()
+}

@@ -1,0 +1,349 @@
+//! `reldesign diagnose MODEL.toml DATA.csv [--json] [--out DIR]`
+//! (`shared/spec/measured-data.md`): replays the recording through the model,
+//! shows where the current error concentrates, names the cause from the
+//! vocabulary, writes the extended description and plots, and reports the
+//! gain on the whole record and on its held-out end.
+//!
+//! Files (written together, atomically): `<DATA>.extended.toml` and the
+//! plots `<DATA>.current.svg`, `<DATA>.residual.svg`, `<DATA>.loop.svg`,
+//! next to the data or in `--out DIR`. With `--json`, stdout carries exactly
+//! one JSON object; otherwise a readable report.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use designer::description::edit::{annotate, write_physics};
+use designer::diagnose::localise::{localise, Localisation, Signals};
+use designer::diagnose::{diagnose, Cause, Diagnosis, Options};
+use designer::identify::{flux_from_data, Measured, SimOutputs};
+use miette::Report;
+use serde_json::{json, Value};
+
+use crate::{diagnose_plot, fail};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The actuator description (valve.toml)
+    model: PathBuf,
+    /// The recording: CSV with columns t, v, i and optionally z, phi, lambda
+    data: PathBuf,
+    /// Print one JSON object on stdout (the spec's fields and more)
+    #[arg(long)]
+    json: bool,
+    /// Directory for the extended model and the plots (default: next to the data)
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Fraction of the record, at its end, kept out of every fit
+    #[arg(long, default_value_t = 0.25)]
+    holdout: f64,
+    /// Try only these causes (comma-separated names of the vocabulary)
+    #[arg(long, value_delimiter = ',')]
+    causes: Vec<Cause>,
+}
+
+/// Paths of everything `diagnose` writes.
+struct Outputs {
+    extended: PathBuf,
+    current: PathBuf,
+    residual: PathBuf,
+    flux_loop: PathBuf,
+}
+
+impl Outputs {
+    fn new(args: &Args) -> Outputs {
+        let dir = match &args.out {
+            Some(dir) => dir.clone(),
+            None => args
+                .data
+                .parent()
+                .map(Path::to_path_buf)
+                .unwrap_or_default(),
+        };
+        let stem = args
+            .data
+            .file_stem()
+            .map_or_else(|| "data".to_owned(), |s| s.to_string_lossy().into_owned());
+        let file = |suffix: &str| dir.join(format!("{stem}.{suffix}"));
+        Outputs {
+            extended: file("extended.toml"),
+            current: file("current.svg"),
+            residual: file("residual.svg"),
+            flux_loop: file("loop.svg"),
+        }
+    }
+}
+
+pub fn run(args: &Args) -> Result<(), Report> {
+    if !(0.0..=0.5).contains(&args.holdout) {
+        return Err(fail(format!(
+            "--holdout {}: expected a fraction in [0, 0.5]",
+            args.holdout
+        )));
+    }
+    let description = crate::load(&args.model)?;
+    let data = Measured::read(&args.data).map_err(fail)?;
+    let mut options = Options {
+        holdout: args.holdout,
+        ..Options::default()
+    };
+    if !args.causes.is_empty() {
+        options.causes = args.causes.clone();
+    }
+    let d = diagnose(&description, &data, &options).map_err(fail)?;
+    let localisation = localisation(&d, &data);
+
+    let outputs = Outputs::new(args);
+    let toml = extended_toml(&description, &d)?;
+    let plots = plots(&d, &data, &localisation, &description)?;
+    crate::atomic::write_all(&[
+        (&outputs.extended, toml.as_bytes()),
+        (&outputs.current, plots[0].as_bytes()),
+        (&outputs.residual, plots[1].as_bytes()),
+        (&outputs.flux_loop, plots[2].as_bytes()),
+    ])
+    .map_err(fail)?;
+
+    if args.json {
+        println!("{}", json_report(&d, &outputs, &localisation));
+    } else {
+        print!("{}", text_report(args, &data, &d, &localisation, &outputs));
+    }
+    Ok(())
+}
+
+/// The winner written over the original text, comments kept.
+fn extended_toml(description: &Description, d: &Diagnosis) -> Result<String, Report> {
+    let source = &description.source;
+    let text = write_physics(&source.text, &source.file_name, &d.extended).map_err(fail)?;
+    let header = format!(
+        "extended by reldesign diagnose: cause = {}, current wNRMSE {:.3} % -> {:.3} % \
+         (gain {:.1} %)",
+        d.cause,
+        100.0 * d.whole.baseline_wnrmse,
+        100.0 * d.whole.extended_wnrmse,
+        100.0 * d.whole.gain
+    );
+    Ok(annotate(&text, &header))
+}
+
+use designer::description::Description;
+
+fn signals<'a>(
+    d: &'a Diagnosis,
+    data: &'a Measured,
+    replay: &'a SimOutputs,
+    moving: &'a [bool],
+    impacts: &'a [f64],
+) -> Signals<'a> {
+    Signals {
+        t: &data.t,
+        v: &data.v,
+        i_measured: &data.i,
+        i_simulated: &replay.current,
+        weight: &d.weights,
+        z_simulated: &replay.z,
+        moving,
+        impacts,
+        flux_simulated: &replay.phi,
+        z_measured: data.z.as_deref(),
+    }
+}
+
+/// Where the baseline's current error concentrates.
+fn localisation(d: &Diagnosis, data: &Measured) -> Localisation {
+    let replay = &d.baseline_replay;
+    let moving = designer::diagnose::moving(replay);
+    let m = &d.extended.mechanics;
+    let impacts = designer::diagnose::impacts(replay, m.z_min, m.z_max);
+    localise(&signals(d, data, replay, &moving, &impacts))
+}
+
+/// The three plots: measured vs simulated, residual, λ–i loop.
+fn plots(
+    d: &Diagnosis,
+    data: &Measured,
+    localisation: &Localisation,
+    description: &Description,
+) -> Result<[String; 3], Report> {
+    let base = &d.baseline_replay;
+    let ext = &d.extended_replay;
+    let mut measured: Vec<(&str, &[f64])> = vec![("current i [A]", &data.i)];
+    let mut simulated: Vec<(&str, &[f64])> = vec![("current i [A]", &base.current)];
+    let extended_label = format!("current i [A], extended ({})", d.cause);
+    simulated.push((&extended_label, &ext.current));
+    if let Some(z) = &data.z {
+        measured.push(("position z [m]", z));
+        simulated.push(("position z [m]", &base.z));
+    }
+    let title = format!("{}: measured vs simulated", data.file_name);
+    let comparison =
+        diagnose_plot::comparison_svg(&title, &data.t, &measured, &simulated).map_err(fail)?;
+
+    let residual: Vec<f64> = base
+        .current
+        .iter()
+        .zip(&data.i)
+        .map(|(s, m)| s - m)
+        .collect();
+    let regions = localisation.marked_windows();
+    let marked: Vec<(f64, f64, &str)> = regions
+        .iter()
+        .map(|(a, b, l)| (*a, *b, l.as_str()))
+        .collect();
+    let residual_svg = diagnose_plot::residual_svg(
+        "current residual (baseline − measured)",
+        &data.t,
+        &residual,
+        &marked,
+    )
+    .map_err(fail)?;
+
+    let turns = description.coil.turns;
+    let lambda_data: Vec<f64> = flux_from_data(data, turns, description.coil.resistance)
+        .iter()
+        .map(|phi| turns * phi)
+        .collect();
+    let lambda_sim: Vec<f64> = base.phi.iter().map(|phi| turns * phi).collect();
+    let flux_loop = diagnose_plot::flux_current_loop_svg(
+        "flux linkage vs current",
+        &data.i,
+        &lambda_data,
+        &base.current,
+        &lambda_sim,
+    )
+    .map_err(fail)?;
+    Ok([comparison, residual_svg, flux_loop])
+}
+
+fn percent(x: f64) -> String {
+    format!("{:.3} %", 100.0 * x)
+}
+
+fn text_report(
+    args: &Args,
+    data: &Measured,
+    d: &Diagnosis,
+    loc: &Localisation,
+    out: &Outputs,
+) -> String {
+    let mut s = String::new();
+    let n = data.t.len();
+    let _ = writeln!(
+        s,
+        "diagnose {} against {} ({n} samples, Δ = {:e} s)",
+        args.model.display(),
+        args.data.display(),
+        data.dt
+    );
+    let _ = writeln!(
+        s,
+        "current noise σ_i ≈ {:.3} mA: noise floor of the weighted error {}",
+        1e3 * d.current_noise,
+        percent(d.noise_floor)
+    );
+    let _ = writeln!(
+        s,
+        "baseline current wNRMSE (eq. 81): {}",
+        percent(d.whole.baseline_wnrmse)
+    );
+    let _ = writeln!(s, "where the error concentrates:\n{loc}");
+    let _ = writeln!(
+        s,
+        "candidates (fitted on the first {} samples, ranked by BIC):",
+        d.fitted_samples
+    );
+    for c in &d.ranking {
+        match &c.fit {
+            Ok(f) => {
+                let values: Vec<String> = f
+                    .values
+                    .iter()
+                    .map(|(k, v)| format!("{k} = {v:.4e}"))
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    "  {:<17} k = {}  wNRMSE {:>9}  BIC {:>12.1}  {}",
+                    c.cause.name(),
+                    c.parameters,
+                    percent(c.wnrmse_fit),
+                    c.bic,
+                    values.join(", ")
+                );
+            }
+            Err(e) => {
+                let _ = writeln!(s, "  {:<17} fit failed: {e}", c.cause.name());
+            }
+        }
+    }
+    for na in &d.not_applicable {
+        let _ = writeln!(s, "  {:<17} not tried: {}", na.cause.name(), na.reason);
+    }
+    let _ = writeln!(s, "cause: {}", d.cause);
+    let _ = writeln!(s, "extended model: {}", out.extended.display());
+    let _ = writeln!(
+        s,
+        "gain = 1 − extended/baseline: {:.1} % on the whole record ({} → {})",
+        100.0 * d.whole.gain,
+        percent(d.whole.baseline_wnrmse),
+        percent(d.whole.extended_wnrmse)
+    );
+    if let Some(h) = d.held_out {
+        let _ = writeln!(
+            s,
+            "held-out last {} samples: {:.1} % ({} → {})",
+            n - d.fitted_samples,
+            100.0 * h.gain,
+            percent(h.baseline_wnrmse),
+            percent(h.extended_wnrmse)
+        );
+    }
+    let _ = writeln!(
+        s,
+        "plots: {}, {}, {}",
+        out.current.display(),
+        out.residual.display(),
+        out.flux_loop.display()
+    );
+    s
+}
+
+fn json_report(d: &Diagnosis, out: &Outputs, loc: &Localisation) -> Value {
+    let candidates: Vec<Value> = d
+        .ranking
+        .iter()
+        .map(|c| match &c.fit {
+            Ok(f) => json!({
+                "cause": c.cause.name(),
+                "parameters": c.parameters,
+                "wnrmse": c.wnrmse_fit,
+                "bic": c.bic,
+                "values": f.values.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
+            }),
+            Err(e) => json!({"cause": c.cause.name(), "error": e}),
+        })
+        .collect();
+    let not_tried: Vec<Value> = d
+        .not_applicable
+        .iter()
+        .map(|n| json!({"cause": n.cause.name(), "reason": n.reason}))
+        .collect();
+    json!({
+        "cause": d.cause.name(),
+        "baseline_wnrmse": d.whole.baseline_wnrmse,
+        "extended_wnrmse": d.whole.extended_wnrmse,
+        "gain": d.whole.gain,
+        "extended_model": out.extended.display().to_string(),
+        "held_out": d.held_out.map(|h| json!({
+            "baseline_wnrmse": h.baseline_wnrmse,
+            "extended_wnrmse": h.extended_wnrmse,
+            "gain": h.gain,
+        })),
+        "noise_floor": d.noise_floor,
+        "current_noise": d.current_noise,
+        "fitted_samples": d.fitted_samples,
+        "candidates": candidates,
+        "not_tried": not_tried,
+        "localisation": loc.to_string(),
+        "plots": [out.current.display().to_string(), out.residual.display().to_string(), out.flux_loop.display().to_string()],
+    })
+}

@@ -1,0 +1,211 @@
+//! One candidate explanation per cause: the baseline extended by one entry of
+//! the vocabulary, with starting values, and the parameters to fit — the
+//! extension's own and the few baseline parameters it interacts with.
+//!
+//! Every candidate refits the coil resistance: it sets the steady-state current
+//! and would otherwise absorb part of any effect in an unfair way. The `none`
+//! candidate refits only the resistance, so the ranking compares each
+//! extension with the best the baseline itself can do.
+
+use crate::description::{Core, Description, Gap, JilesAtherton};
+use crate::identify::FitParam;
+use crate::model::MU0;
+
+use super::Cause;
+
+/// What the data tells about the scale of the experiment (for starting values).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scales {
+    /// Peak |φ| of the baseline's replay [Wb].
+    pub peak_flux: f64,
+    /// Duration of the record [s].
+    pub duration: f64,
+}
+
+/// A cause, its extended description at the starting point, and what to fit.
+#[derive(Debug, Clone)]
+pub struct Candidate {
+    pub cause: Cause,
+    pub start: Description,
+    pub params: Vec<FitParam>,
+    /// Starts of the multi-start fit (1 = the starting point only).
+    pub starts: usize,
+}
+
+/// Why a cause cannot extend this baseline (it is already in the model).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NotApplicable {
+    pub cause: Cause,
+    pub reason: String,
+}
+
+/// The candidate of `cause` for `baseline`, or why there is none.
+pub fn candidate(
+    baseline: &Description,
+    cause: Cause,
+    scales: Scales,
+) -> Result<Candidate, NotApplicable> {
+    let mut start = baseline.clone();
+    let mut params = vec![resistance(baseline)];
+    let mut starts = 1;
+    let not = |reason: &str| NotApplicable {
+        cause,
+        reason: reason.to_owned(),
+    };
+    match cause {
+        Cause::None => {}
+        Cause::EddyCurrents => {
+            if baseline.coil.eddy > 0.0 {
+                return Err(not("coil.eddy is already > 0"));
+            }
+            // k_e comparable with N²/R doubles the electrical time constant.
+            let n2_r = baseline.coil.turns.powi(2) / baseline.coil.resistance;
+            start.coil.eddy = 0.1 * n2_r;
+            params.push(param("coil.eddy", 1e-4 * n2_r, 10.0 * n2_r));
+        }
+        Cause::Saturation => {
+            let Core::Linear { r0 } = baseline.core else {
+                return Err(not("core.model is not \"linear\""));
+            };
+            // The flux never reaches φ_sat (R_core grows without bound), so
+            // φ_sat may lie below the linear model's peak flux.
+            let phi_sat = 1.5 * scales.peak_flux;
+            start.core = Core::Saturating { r0, phi_sat };
+            params.push(param("core.r0", 0.1 * r0, 10.0 * r0));
+            params.push(param(
+                "core.phi_sat",
+                0.1 * scales.peak_flux,
+                50.0 * scales.peak_flux,
+            ));
+            starts = 3;
+        }
+        Cause::Hysteresis => {
+            if matches!(baseline.core, Core::JilesAtherton(_)) {
+                return Err(not("core.model is already \"jiles-atherton\""));
+            }
+            let ja = hysteresis_start(baseline, scales);
+            start.core = Core::JilesAtherton(ja.clone());
+            params.push(param("core.m_sat", 0.05 * ja.m_sat, 20.0 * ja.m_sat));
+            params.push(param("core.b", 0.02 * ja.b, 50.0 * ja.b));
+            params.push(param("core.c", 0.02, 0.98));
+            params.push(param("core.kappa", 0.02 * ja.kappa, 50.0 * ja.kappa));
+            params.push(param("core.length", 0.05 * ja.length, 20.0 * ja.length));
+            starts = 2;
+        }
+        Cause::Fringing => {
+            let Gap::Linear { slope, offset } = baseline.gap else {
+                return Err(not("gap.model is not \"linear\""));
+            };
+            // McLyman's small-gap slope 1/(μ0·A) equals the linear slope; the
+            // linear offset moves into the core (R_core + R_gap stays put at z = 0).
+            let area = 1.0 / (MU0 * slope);
+            let winding_length = 20.0 * baseline.mechanics.z_max.max(1e-4);
+            start.gap = Gap::McLyman {
+                area,
+                winding_length,
+            };
+            shift_core_reluctance(&mut start, offset);
+            params.push(param("gap.area", 0.05 * area, 20.0 * area));
+            params.push(param(
+                "gap.winding_length",
+                0.5 * baseline.mechanics.z_max.max(1e-5),
+                1.0,
+            ));
+            params.push(core_reluctance_param(&start));
+            starts = 3;
+        }
+        Cause::ResistanceDrift => {
+            if baseline.coil.resistance_drift != 0.0 {
+                return Err(not("coil.resistance_drift is already ≠ 0"));
+            }
+            // Up to the resistance itself over the record (far beyond self-heating).
+            let bound = baseline.coil.resistance / scales.duration.max(1e-6);
+            start.coil.resistance_drift = 0.0;
+            params.push(param("coil.resistance_drift", -bound, bound));
+        }
+        Cause::Bouncing => {
+            if baseline.mechanics.restitution > 0.0 {
+                return Err(not("mechanics.restitution is already > 0"));
+            }
+            start.mechanics.restitution = 0.5;
+            params.push(param("mechanics.restitution", 0.0, 0.95));
+            starts = 4;
+        }
+    }
+    Ok(Candidate {
+        cause,
+        start,
+        params,
+        starts,
+    })
+}
+
+fn param(path: &str, lower: f64, upper: f64) -> FitParam {
+    FitParam {
+        path: path.to_owned(),
+        lower,
+        upper,
+    }
+}
+
+/// R within ±30 % of the description's value.
+fn resistance(d: &Description) -> FitParam {
+    let r = d.coil.resistance;
+    param("coil.resistance", 0.7 * r, 1.3 * r)
+}
+
+/// Adds `offset` [H⁻¹] to the core's reluctance at φ = 0 (linear/saturating).
+fn shift_core_reluctance(d: &mut Description, offset: f64) {
+    match &mut d.core {
+        Core::Linear { r0 } | Core::Saturating { r0, .. } => *r0 = (*r0 + offset).max(1.0),
+        Core::JilesAtherton(_) => {}
+    }
+}
+
+/// The core's φ = 0 reluctance as a fit parameter, when the core has one.
+fn core_reluctance_param(d: &Description) -> FitParam {
+    match d.core {
+        Core::Linear { r0 } | Core::Saturating { r0, .. } => param("core.r0", 0.05 * r0, 20.0 * r0),
+        // A Jiles–Atherton core: its length sets the reluctance.
+        Core::JilesAtherton(ref ja) => param("core.length", 0.05 * ja.length, 20.0 * ja.length),
+    }
+}
+
+/// A Jiles–Atherton core that starts close to the baseline's linear one.
+///
+/// The material's shape parameters (c, κ, α, and b relative to μ0·M_sat) are
+/// those the JA paper fitted for a valve's steel (Table 2); the pole area is
+/// the gap's (A = 1/(μ0·slope) for a linear gap, else 10 mm²); M_sat puts the
+/// record's peak flux density at 60 % of saturation, and the path length
+/// makes the initial reluctance l_c/(μ0·μ_i·A_c) equal to the baseline's r0.
+fn hysteresis_start(baseline: &Description, scales: Scales) -> JilesAtherton {
+    let area = match baseline.gap {
+        Gap::Linear { slope, .. } if slope > 0.0 => 1.0 / (MU0 * slope),
+        Gap::McLyman { area, .. } => area,
+        _ => 1e-5,
+    };
+    let r0 = match baseline.core {
+        Core::Linear { r0 } | Core::Saturating { r0, .. } => r0,
+        Core::JilesAtherton(_) => 1e6,
+    };
+    // Table 2: μ0·M_sat = 1.822 T, b = 2.45 mT, c = 0.736, κ = 943 A/m, α = 3.66e-3.
+    let b_peak: f64 = (scales.peak_flux / area).max(1e-3);
+    let m_sat = b_peak / 0.6 / MU0;
+    let b = 2.45e-3 * (MU0 * m_sat) / 1.822;
+    let (c, kappa, alpha) = (0.736, 943.0, 3.66e-3);
+    // Initial (anhysteretic, mean-field) relative permeability 1 + χ,
+    // χ = χ_an / (1 − α·χ_an) with χ_an = μ0·M_sat/(3b).
+    let chi_an = MU0 * m_sat / (3.0 * b);
+    let chi = chi_an / (1.0 - alpha * chi_an).max(0.05);
+    let length = r0 * MU0 * (1.0 + chi) * area;
+    JilesAtherton {
+        length,
+        area,
+        m_sat,
+        b,
+        c,
+        kappa,
+        alpha,
+        epsilon: 1e-3,
+    }
+}

@@ -1,0 +1,155 @@
+//! Tests that hide an effect (issue 5 §3): a bundled example, one extension of
+//! the vocabulary added in secret (`reldesign_tests::hidden`), a simulated
+//! noisy experiment; `diagnose` sees only the baseline model and the data
+//! and must name the cause, with gain ≥ 50 % on the whole record and on its
+//! held-out end. Data from the baseline itself must give `none`.
+//!
+//! The CI matrix covers every cause on at least two actuators, both
+//! excitations, with and without the `z` column; `full_matrix` (ignored:
+//! `cargo test --release -p reldesign-tests --test diagnose -- --ignored`)
+//! runs every cause × actuator × excitation × column combination.
+
+use designer::description::parse_str;
+use designer::diagnose::{diagnose, Cause, Diagnosis, Options};
+use designer::identify::Measured;
+use designer::record::Record;
+use reldesign_tests::hidden::{hidden_case, Excitation, HiddenCase};
+
+#[derive(Debug, Clone, Copy)]
+enum Drive {
+    Square,
+    Pulses,
+}
+
+/// (example, cause, drive, with z column, seed)
+type Case = (&'static str, Cause, Drive, bool, u64);
+
+const SEMERA: &str = "semera-valve.toml";
+const TRACKING: &str = "perfect-tracking-valve.toml";
+const SLIDING: &str = "sliding-mode-valve.toml";
+const TABLE: &str = "table-gap-valve.toml";
+
+const CI_CASES: &[Case] = &[
+    (SEMERA, Cause::EddyCurrents, Drive::Square, false, 1),
+    (TRACKING, Cause::EddyCurrents, Drive::Pulses, true, 2),
+    (SEMERA, Cause::Saturation, Drive::Pulses, false, 3),
+    (SLIDING, Cause::Saturation, Drive::Square, true, 4),
+    (TABLE, Cause::Hysteresis, Drive::Pulses, false, 5),
+    (SEMERA, Cause::Hysteresis, Drive::Square, true, 6),
+    (SLIDING, Cause::Fringing, Drive::Square, false, 7),
+    (SEMERA, Cause::Fringing, Drive::Pulses, true, 8),
+    (TRACKING, Cause::ResistanceDrift, Drive::Square, false, 9),
+    (SLIDING, Cause::ResistanceDrift, Drive::Pulses, true, 10),
+    (SEMERA, Cause::Bouncing, Drive::Square, true, 11),
+    (TRACKING, Cause::Bouncing, Drive::Pulses, false, 12),
+    (SEMERA, Cause::None, Drive::Square, false, 13),
+    (SLIDING, Cause::None, Drive::Pulses, true, 14),
+];
+
+fn excitation(example: &str, drive: Drive) -> Excitation {
+    let path = reldesign_tests::root().join("examples").join(example);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let desc = parse_str(&text, example).unwrap_or_else(|e| panic!("{e}"));
+    let base = reldesign_tests::hidden::baseline(&desc);
+    match drive {
+        Drive::Square => Excitation::square_wave(&base),
+        Drive::Pulses => Excitation::pulses(&base),
+    }
+}
+
+/// Diagnoses a case from its two texts only (as the CLI would read the files).
+fn run(case: &HiddenCase) -> Diagnosis {
+    let model = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
+    let record = Record::parse(&case.data_csv, "data.csv").unwrap_or_else(|e| panic!("{e}"));
+    let data = Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
+    diagnose(&model, &data, &Options::default()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The held-out part carries the effect when the baseline's error there
+/// exceeds this multiple of the noise floor.
+const HELD_OUT_VISIBLE: f64 = 3.0;
+
+/// What went wrong with one case, or nothing.
+fn check(&(example, cause, drive, with_z, seed): &Case) -> Option<String> {
+    let case = hidden_case(example, cause, &excitation(example, drive), with_z, seed);
+    let d = run(&case);
+    let held = d.held_out.map_or(f64::NAN, |h| h.gain);
+    let summary = format!(
+        "{example} {cause} {drive:?} z={with_z} seed={seed}: answered {} (gain {:.1} %, held-out {:.1} %; \
+         baseline {:.3} %, extended {:.3} %, floor {:.3} %; ranking {})",
+        d.cause,
+        100.0 * d.whole.gain,
+        100.0 * held,
+        100.0 * d.whole.baseline_wnrmse,
+        100.0 * d.whole.extended_wnrmse,
+        100.0 * d.noise_floor,
+        d.ranking
+            .iter()
+            .map(|s| format!("{}:{:.3}%", s.cause, 100.0 * s.wnrmse_fit))
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    eprintln!("{summary}");
+    let right = d.cause == cause;
+    // The held-out end shows the effect only when the baseline misses it
+    // there (a bounce or a fringing error may fall in the fitted part only).
+    let held_shows_effect = d
+        .held_out
+        .is_some_and(|h| h.baseline_wnrmse > HELD_OUT_VISIBLE * d.noise_floor);
+    let held_ok = !held_shows_effect || held >= 0.5;
+    let gained = cause == Cause::None || (d.whole.gain >= 0.5 && held_ok);
+    (!right || !gained).then_some(summary)
+}
+
+fn check_all(cases: &[Case]) {
+    let failures: Vec<String> = cases.iter().filter_map(check).collect();
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases failed:\n{}",
+        failures.len(),
+        cases.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn every_cause_is_found_on_two_actuators() {
+    check_all(CI_CASES);
+}
+
+#[test]
+#[ignore = "slow: every cause × actuator × excitation × z column"]
+fn full_matrix() {
+    let mut cases = Vec::new();
+    let mut seed = 100;
+    for example in [SEMERA, TRACKING, SLIDING, TABLE] {
+        for cause in Cause::EXTENSIONS.into_iter().chain([Cause::None]) {
+            if example == TRACKING && cause == Cause::Hysteresis {
+                // Its [controller] needs a core the design supports (not JA).
+                continue;
+            }
+            for drive in [Drive::Square, Drive::Pulses] {
+                for with_z in [false, true] {
+                    seed += 1;
+                    cases.push((example, cause, drive, with_z, seed));
+                }
+            }
+        }
+    }
+    check_all(&cases);
+}
+
+/// Writes the CI cases as files for the command line:
+/// `DIAGNOSE_CASES=/tmp/cases cargo test -p reldesign-tests --test diagnose write_cases -- --ignored`.
+#[test]
+#[ignore = "writes files for manual runs of `reldesign diagnose`"]
+fn write_cases() {
+    let Ok(dir) = std::env::var("DIAGNOSE_CASES") else {
+        return;
+    };
+    for &(example, cause, drive, with_z, seed) in CI_CASES {
+        let case = hidden_case(example, cause, &excitation(example, drive), with_z, seed);
+        let name = format!("{}-{cause}-{seed}", example.trim_end_matches(".toml"));
+        reldesign_tests::hidden::write_case(&std::path::Path::new(&dir).join(name), &case);
+    }
+}
