@@ -53,8 +53,11 @@ impl Statics {
                 voltage: d.coil.resistance * current,
             }
         };
-        let pull_in = if passive_at_max >= 0.0 {
+        let pull_in = if passive_at_max > 0.0 {
             Err(format!("at zero flux the passive force ({passive_at_max:.4} N) already pushes the armature away from z_max"))
+        } else if passive_at_max == 0.0 {
+            // No spring holds it at z_max: any flux pulls it in.
+            Ok(point(z_max, 0.0))
         } else {
             let flux = (-2.0 * passive_at_max / gap.slope(z_max)).sqrt();
             match core.flux_limit() {
