@@ -15,7 +15,7 @@ use designer::design::{
     OptimalSpec, OptimalTrajectory, Polynomial, Reference, SegmentTolerance, Segments,
 };
 use designer::model::Model;
-use designer::observe::discrete::{DiscreteModel, KalmanSettings};
+use designer::observe::discrete::{DiscreteModel, KalmanSettings, ResistanceSettings};
 
 use crate::controller::{emit_controller, gains, ControllerError, ControllerInput, OperationTable};
 use crate::header::Header;
@@ -234,7 +234,7 @@ fn design_kalman(
     let (true, Some(settings)) = (wanted, KalmanSettings::from_observer(o)) else {
         return Ok(None);
     };
-    DiscreteModel::new(model, &settings)
+    DiscreteModel::with_resistance(model, &settings, ResistanceSettings::from_observer(o))
         .map(Some)
         .map_err(|e| BuildError::Observer {
             file: description.source.file_name.clone(),

@@ -28,7 +28,7 @@
 //! non-finite prediction restarts the filter from its initial state.
 
 use designer::description::Drive;
-use designer::observe::discrete::{DiscreteModel, MODE_BAND_SIGMAS};
+use designer::observe::discrete::{DiscreteModel, StateKind, MODE_BAND_SIGMAS};
 use designer::observe::ukf::{REPAIR_JITTER, REPAIR_JITTER_F32};
 use designer::sym::{Graph, Id};
 use proc_macro2::{Ident, Literal, TokenStream};
@@ -110,12 +110,29 @@ enum Kind {
     Ukf,
 }
 
-/// Rust names of the states (function arguments) and their short forms
-/// (in output names).
-const STATE_NAMES: [&str; 4] = ["z", "z_prev", "phi", "hc"];
-const STATE_SHORT: [&str; 4] = ["z", "zp", "phi", "hc"];
-/// How the states read in docs.
-const STATE_DOC: [&str; 4] = ["z", "z_prev", "φ", "H_c"];
+/// How a state is named: the Rust name (function arguments), its short form
+/// (in output names) and how it reads in docs.
+struct StateName {
+    name: &'static str,
+    short: &'static str,
+    doc: &'static str,
+}
+
+fn state_name(kind: StateKind) -> StateName {
+    let (name, short, doc) = match kind {
+        StateKind::Position => ("z", "z", "z"),
+        StateKind::PreviousPosition => ("z_prev", "zp", "z_prev"),
+        StateKind::Flux => ("phi", "phi", "φ"),
+        StateKind::CoreField => ("hc", "hc", "H_c"),
+        StateKind::Resistance => ("r", "r", "R"),
+    };
+    StateName { name, short, doc }
+}
+
+/// The names of the discretised model's states, in order.
+fn state_names(dm: &DiscreteModel) -> Vec<StateName> {
+    dm.kinds.iter().map(|&k| state_name(k)).collect()
+}
 
 /// Consts the module defines besides the parameters.
 const OBSERVER_CONSTS: &[&str] = &[
@@ -128,6 +145,9 @@ const OBSERVER_CONSTS: &[&str] = &[
     "INITIAL_Z_STD",
     "INITIAL_PHI_STD",
     "INITIAL_HC_STD",
+    "RESISTANCE_RATE_STD",
+    "INITIAL_RESISTANCE_STD",
+    "INITIAL_RESISTANCE",
     "UKF_ALPHA",
     "UKF_BETA",
     "UKF_KAPPA",
@@ -188,10 +208,10 @@ impl Function {
         params: &[Param],
         float: Float,
     ) -> Result<TokenStream, EmitError> {
-        let mut inputs: Vec<(&str, Id)> = STATE_NAMES
+        let mut inputs: Vec<(&str, Id)> = state_names(dm)
             .iter()
             .zip(&dm.states)
-            .map(|(&n, &id)| (n, id))
+            .map(|(n, &id)| (n.name, id))
             .collect();
         inputs.push(("u", dm.input));
         if dm.uses_time {
@@ -269,18 +289,22 @@ impl Layout {
         let n = dm.dim();
         let voltage_drive = dm.drive == Drive::Voltage;
         let y = if voltage_drive { "i" } else { "u_coil" }.to_owned();
-        let next_docs = [
-            "(84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)",
-            "(84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)",
-            "(84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)",
-            "(84d) H_c,{k+1} = H_c + T_s·f_Hc(z, φ, H_c, u)",
-        ];
+        let names = state_names(dm);
+        let next_doc = |k: StateKind| {
+            match k {
+            StateKind::Position => "(84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)",
+            StateKind::PreviousPosition => "(84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)",
+            StateKind::Flux => "(84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)",
+            StateKind::CoreField => "(84d) H_c,{k+1} = H_c + T_s·f_Hc(z, φ, H_c, u)",
+            StateKind::Resistance => "R_{k+1} = R (random walk)",
+        }
+        };
         let mut outputs = Vec::new();
         for i in 0..n {
             outputs.push((
-                format!("{}_next", STATE_SHORT[i]),
+                format!("{}_next", names[i].short),
                 dm.transition[i],
-                next_docs[i].to_owned(),
+                next_doc(dm.kinds[i]).to_owned(),
             ));
         }
         outputs.push((
@@ -298,9 +322,9 @@ impl Layout {
                     row.push(entry(
                         g,
                         &mut outputs,
-                        format!("d{}_d{}", STATE_SHORT[i], STATE_SHORT[j]),
+                        format!("d{}_d{}", names[i].short, names[j].short),
                         dm.transition_jacobian[i][j],
-                        format!("∂{}_{{k+1}}/∂{}", STATE_DOC[i], STATE_DOC[j]),
+                        format!("∂{}_{{k+1}}/∂{}", names[i].doc, names[j].doc),
                     ));
                 }
                 jacobian.push(row);
@@ -317,11 +341,11 @@ impl Layout {
                 gain.push(entry(
                     g,
                     target,
-                    format!("d{}_du", STATE_SHORT[i]),
+                    format!("d{}_du", names[i].short),
                     dm.input_gain[i],
                     format!(
                         "g = ∂{}_{{k+1}}/∂u (maps the input's noise into Q)",
-                        STATE_DOC[i]
+                        names[i].doc
                     ),
                 ));
             }
@@ -368,9 +392,9 @@ impl Layout {
                 h_row.push(entry(
                     g,
                     &mut m_outputs,
-                    format!("d{y}_d{}", STATE_SHORT[j]),
+                    format!("d{y}_d{}", names[j].short),
                     dm.measurement_jacobian[j],
-                    format!("H = ∂{y}/∂{}", STATE_DOC[j]),
+                    format!("H = ∂{y}/∂{}", names[j].doc),
                 ));
             }
         }
@@ -488,6 +512,23 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
     if let Some(h) = s.initial_hc_std {
         settings.push(("INITIAL_HC_STD", h, "Initial σ of H_c [A/m]."));
     }
+    if let Some(r) = dm.resistance {
+        settings.push((
+            "RESISTANCE_RATE_STD",
+            r.rate_std,
+            "σ_Ṙ [Ω/s]: the resistance's random walk, w_R of σ = σ_Ṙ·T_s per sample.",
+        ));
+        settings.push((
+            "INITIAL_RESISTANCE_STD",
+            r.initial_std,
+            "Initial σ of R [Ω].",
+        ));
+        settings.push((
+            "INITIAL_RESISTANCE",
+            dm.nominal_resistance,
+            "R₀ [Ω]: the description's coil resistance, R's initial estimate.",
+        ));
+    }
     if kind == Kind::Ukf {
         settings.push((
             "UKF_ALPHA",
@@ -513,34 +554,51 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
         (quote!(CURRENT_NOISE), quote!(VOLTAGE_NOISE))
     };
     let zero = quote!(0.0);
-    let process: Vec<TokenStream> = (0..n)
-        .map(|i| match i {
-            0 => quote!(PROCESS_Z * PROCESS_Z),
-            2 => quote!(PROCESS_PHI * PROCESS_PHI),
-            3 => quote!(PROCESS_HC * PROCESS_HC),
-            _ => zero.clone(),
+    let kinds = &dm.kinds;
+    let process: Vec<TokenStream> = kinds
+        .iter()
+        .map(|k| match k {
+            StateKind::Position => quote!(PROCESS_Z * PROCESS_Z),
+            StateKind::Flux => quote!(PROCESS_PHI * PROCESS_PHI),
+            StateKind::CoreField => quote!(PROCESS_HC * PROCESS_HC),
+            StateKind::Resistance => {
+                quote!((RESISTANCE_RATE_STD * T_S) * (RESISTANCE_RATE_STD * T_S))
+            }
+            StateKind::PreviousPosition => zero.clone(),
         })
         .collect();
-    let x0: Vec<TokenStream> = (0..n)
-        .map(|i| if i < 2 { quote!(Z_MAX) } else { zero.clone() })
+    let x0: Vec<TokenStream> = kinds
+        .iter()
+        .map(|k| match k {
+            StateKind::Position | StateKind::PreviousPosition => quote!(Z_MAX),
+            StateKind::Resistance => quote!(INITIAL_RESISTANCE),
+            StateKind::Flux | StateKind::CoreField => zero.clone(),
+        })
         .collect();
     let mut p0_rows = Vec::new();
     for i in 0..n {
         let row: Vec<TokenStream> = (0..n)
-            .map(|j| match (i, j) {
-                (0, 0) | (1, 1) => {
+            .map(|j| match (i, j, kinds[i]) {
+                (0, 0, _) | (1, 1, _) => {
                     quote!(INITIAL_Z_STD * INITIAL_Z_STD + PROCESS_Z * PROCESS_Z)
                 }
-                (0, 1) | (1, 0) => quote!(INITIAL_Z_STD * INITIAL_Z_STD),
-                (2, 2) => quote!(INITIAL_PHI_STD * INITIAL_PHI_STD),
-                (3, 3) => quote!(INITIAL_HC_STD * INITIAL_HC_STD),
+                (0, 1, _) | (1, 0, _) => quote!(INITIAL_Z_STD * INITIAL_Z_STD),
+                (i, j, StateKind::Flux) if i == j => quote!(INITIAL_PHI_STD * INITIAL_PHI_STD),
+                (i, j, StateKind::CoreField) if i == j => quote!(INITIAL_HC_STD * INITIAL_HC_STD),
+                (i, j, StateKind::Resistance) if i == j => {
+                    quote!(INITIAL_RESISTANCE_STD * INITIAL_RESISTANCE_STD)
+                }
                 _ => zero.clone(),
             })
             .collect();
         p0_rows.push(quote!([#(#row),*]));
     }
     let band_sigmas = lit(float, "MODE_BAND_SIGMAS", MODE_BAND_SIGMAS)?;
-    let state_doc = STATE_DOC[..n].join(", ");
+    let state_doc = state_names(dm)
+        .iter()
+        .map(|s| s.doc)
+        .collect::<Vec<_>>()
+        .join(", ");
     let dim_doc = format!(" Number of states: x = [{state_doc}].");
     items.extend(quote! {
         #[doc = #dim_doc]
@@ -629,9 +687,9 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
     }
 
     // ---- estimate, helpers, filter
-    let names: Vec<Ident> = STATE_NAMES[..n]
+    let names: Vec<Ident> = state_names(dm)
         .iter()
-        .map(|s| format_ident!("{s}"))
+        .map(|s| format_ident!("{}", s.name))
         .collect();
     let time_arg = if dm.uses_time { quote!(, t) } else { quote!() };
     let time_field = if dm.uses_time {
@@ -666,6 +724,16 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
         quote!()
     };
     let hc_init = if has_field { quote!(hc,) } else { quote!() };
+    let has_r = dm.resistance_index().is_some();
+    let r_field = if has_r {
+        quote!(
+            /// R [Ω], the estimated coil resistance
+            pub r: #ty,
+        )
+    } else {
+        quote!()
+    };
+    let r_init = if has_r { quote!(r,) } else { quote!() };
     let y = format_ident!("{}", layout.y);
     let y_doc = if voltage_drive {
         "the measured coil current [A]"
@@ -705,6 +773,7 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
             /// φ [Wb]
             pub phi: #ty,
             #hc_field
+            #r_field
             /// q of (86): 1 at z_min, 2 moving, 3 at z_max (within `MODE_BAND` of a stop)
             pub mode: u8,
         }
@@ -754,10 +823,10 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
     let o = format_ident!("o");
     let mo = format_ident!("m");
     let go = format_ident!("gain_out");
-    let next_fields: Vec<TokenStream> = STATE_SHORT[..n]
+    let next_fields: Vec<TokenStream> = state_names(dm)
         .iter()
         .map(|s| {
-            let f = format_ident!("{s}_next");
+            let f = format_ident!("{}_next", s.short);
             quote!(o.#f)
         })
         .collect();
@@ -790,6 +859,7 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
                 a: if mode == 2 { #accel } else { 0.0 },
                 phi,
                 #hc_init
+                #r_init
                 mode,
             }
         }
@@ -936,7 +1006,7 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
             let gain = vector_tokens(&layout.gain, &go, float)?;
             let rest_next_pattern: Vec<TokenStream> = (1..n)
                 .map(|i| {
-                    let v = format_ident!("{}", STATE_SHORT[i]);
+                    let v = format_ident!("{}", state_names(dm)[i].short);
                     quote!(#v)
                 })
                 .collect();

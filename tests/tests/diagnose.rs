@@ -153,3 +153,38 @@ fn write_cases() {
         reldesign_tests::hidden::write_case(&std::path::Path::new(&dir).join(name), &case);
     }
 }
+
+/// Samples of the benchmark's long records (issue 5 §5: 40 000).
+const LONG_SAMPLES: usize = 40_000;
+
+/// Writes one long record per cause (and one of the baseline itself) of the
+/// SEMERA valve for `benches/diagnose.sh`: the square-wave preset repeated
+/// until the record has at least [`LONG_SAMPLES`] samples at
+/// `hidden::SAMPLE_PERIOD`, default noise, no `z` column:
+/// `DIAGNOSE_LONG_CASES=/tmp/long cargo test --release -p reldesign-tests --test diagnose write_long_case -- --ignored`.
+#[test]
+#[ignore = "writes files for the diagnose benchmark"]
+fn write_long_case() {
+    let Ok(dir) = std::env::var("DIAGNOSE_LONG_CASES") else {
+        return;
+    };
+    let once = excitation(SEMERA, Drive::Square);
+    let per_run = once.duration() / reldesign_tests::hidden::SAMPLE_PERIOD;
+    let long = once.repeated((LONG_SAMPLES as f64 / per_run).ceil() as usize);
+    for (k, cause) in Cause::EXTENSIONS
+        .into_iter()
+        .chain([Cause::None])
+        .enumerate()
+    {
+        let case = hidden_case(SEMERA, cause, &long, false, 500 + k as u64);
+        let rows = case
+            .data_csv
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .count()
+            - 1;
+        assert!(rows >= LONG_SAMPLES, "{cause}: only {rows} samples");
+        let name = format!("{}-{cause}-long", SEMERA.trim_end_matches(".toml"));
+        reldesign_tests::hidden::write_case(&std::path::Path::new(&dir).join(name), &case);
+    }
+}

@@ -14,6 +14,7 @@
 use designer::description::parse_str;
 use designer::description::Description;
 use designer::model::{Model, ModelPlant};
+use designer::observe::discrete::{DiscreteModel, ResistanceSettings};
 use designer::sim::{simulate_sampled, Event, Limit, Measurement, Mode, Options, State};
 /// The sensorless design: `tests/data/sensorless-valve.toml` (the
 /// perfect-tracking valve with a 2.5 ms settling time and EKF/UKF at 10 µs),
@@ -154,8 +155,10 @@ fn observer(filter: Filter, ts: f64) -> Observer {
             settings.process_z *= r;
             settings.process_phi *= r;
             let model = Model::build(&d);
-            let mut f = designer::observe::ukf::Ukf::from_model(&model, &settings)
+            let resistance = ResistanceSettings::from_observer(o);
+            let dm = DiscreteModel::with_resistance(&model, &settings, resistance)
                 .expect("filter settings");
+            let mut f = designer::observe::ukf::Ukf::new(&dm);
             Box::new(move |u, i| {
                 let e = f.step(u, i);
                 [e.z, e.v, e.phi]
@@ -299,25 +302,88 @@ fn sensorless_row(ks: f64, r: f64, ts: f64, filter: Filter) -> (Cycle, Cycle, Cy
 }
 
 /// Measuring only v and i (σ_v = 15 mV, σ_i = 1 mA), the generated UKF and
-/// EKF with the generated controller of the sensorless design land both
-/// operations on the Jiles–Atherton plant at T_s = 10 µs, softer than
-/// switching: measured 29× (closing) and 4.9× / 5.6× (opening, UKF / EKF).
-/// The issue's target, ≥ 10× for both, is met for closing only; with ±10 %
-/// on k_s and R it is not met (see `sensorless_report`), which is the open
-/// item of the observers issue.
+/// EKF (estimating R) with the generated controller of the sensorless design
+/// land both operations at T_s = 10 µs on the Jiles–Atherton plant and with
+/// ±10 % on k_s and R, softer than switching: closing measured 20–33×
+/// (the issue's ≥ 10× target met), opening 4.3–5.4× (not met: the open
+/// item, see `sensorless_report`).
 #[test]
-fn sensorless_loop_lands_on_the_ja_plant() {
-    for filter in [Filter::GeneratedUkf, Filter::GeneratedEkf] {
-        let (hard, _, soft) = sensorless_row(1.0, 1.0, 10e-6, filter);
-        assert!(
-            10.0 * soft.closing <= hard.closing,
-            "{filter:?}: {soft:?} vs {hard:?}"
-        );
-        assert!(
-            3.0 * soft.opening <= hard.opening,
-            "{filter:?}: {soft:?} vs {hard:?}"
-        );
+fn sensorless_loop_lands_on_the_mismatched_plants() {
+    for (ks, r) in [(1.0, 1.0), (1.1, 0.9), (0.9, 1.1)] {
+        for filter in [Filter::GeneratedUkf, Filter::GeneratedEkf] {
+            let (hard, _, soft) = sensorless_row(ks, r, 10e-6, filter);
+            let what = format!("k×{ks} R×{r} {filter:?}: {soft:?} vs {hard:?}");
+            assert!(15.0 * soft.closing <= hard.closing, "{what}");
+            assert!(3.0 * soft.opening <= hard.opening, "{what}");
+        }
     }
+}
+
+/// The resistance state tracks the plant's R (oracle: the plant's own value,
+/// 10 % off the design's) from v and i alone: 24 V switching on the JA plant
+/// with R ×1.1, the generated f64 UKF and EKF; after 5 ms at the stop the
+/// estimate is within 1 % of 82.5 Ω (it starts at the design's 75 Ω). On the
+/// way the generated filters with the R state agree with the designer's
+/// reference filters (≤ 1e-9 relative), and a NaN sample is skipped.
+#[test]
+fn resistance_state_tracks_the_plant() {
+    use designer::observe::{ekf::Ekf, ukf::Ukf};
+    use sensorless_valve::{ekf, ukf};
+    let d = mismatched_plant(1.0, 1.1);
+    let truth = d.coil.resistance;
+    let mut model = Model::build(&d);
+    let plant = ModelPlant::new(&mut model);
+    let design =
+        designer::description::parse_file(&root().join("tests/data/sensorless-valve.toml"))
+            .unwrap_or_else(|e| panic!("{e}"));
+    let o = design.observer.as_ref().expect("[observer]");
+    let dm = DiscreteModel::from_observer(&Model::build(&design), o)
+        .expect("[observer.kalman]")
+        .expect("filter settings");
+    assert_eq!(dm.resistance_index(), Some(3));
+    let (mut u_ref, mut e_ref) = (Ukf::new(&dm), Ekf::new(&dm));
+    let mut u_filter = ukf::f64::Filter::new();
+    let mut e_filter = ekf::f64::Filter::new();
+    let mut noise = Noise(Rng::new(0x7e515));
+    let mut last = [f64::NAN; 2];
+    let mut k = 0;
+    let mut control = |t: f64, m: &Measurement| -> f64 {
+        let (i, _) = plant.current_and_voltage(t, &m.x, 24.0);
+        let (v, i) = (24.0 + noise.sample(SIGMA_V), i + noise.sample(SIGMA_I));
+        let i = if k == 100 { f64::NAN } else { i };
+        k += 1;
+        let (gu, ge) = (u_filter.step(v, i), e_filter.step(v, i));
+        let (ru, re) = (u_ref.step(v, i), e_ref.step(v, i));
+        for (g, r) in [
+            ([gu.z, gu.v, gu.phi, gu.r], ru),
+            ([ge.z, ge.v, ge.phi, ge.r], re),
+        ] {
+            let want = [r.z, r.v, r.phi, r.r.expect("R estimated")];
+            // scales of z [m], v [m/s], φ [Wb], R [Ω]
+            let scale = [1e-3, 1.0, 25e-6, 75.0];
+            for ((a, b), s) in g.iter().zip(want).zip(scale) {
+                assert!(a.is_finite(), "{g:?}");
+                assert!((a - b).abs() <= 1e-9 * (b.abs() + s), "{g:?} vs {want:?}");
+            }
+        }
+        last = [gu.r, ge.r];
+        24.0
+    };
+    let x0: State = [d.mechanics.z_max, 0.0, 0.0, 0.0];
+    simulate_sampled(
+        &plant,
+        &mut control,
+        ukf::f64::T_S,
+        HALF,
+        x0,
+        Mode::StuckMax,
+        &Options::default(),
+    )
+    .expect("simulation");
+    for r in last {
+        assert!((r - truth).abs() < 0.01 * truth, "R = {r} vs {truth}");
+    }
+    assert_eq!((u_filter.skipped(), e_filter.skipped()), (1, 1));
 }
 
 /// The full report (slow, and not yet meeting the target): every plant

@@ -295,4 +295,15 @@ pub struct KalmanSection {
     pub ukf_beta: f64,
     /// UKF κ (default 0).
     pub ukf_kappa: f64,
+    /// `estimate_resistance = true`: the coil resistance as a random-walk state.
+    pub resistance: Option<ResistanceEstimate>,
+}
+
+/// `estimate_resistance = true` in `[observer.kalman]` with its two keys.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ResistanceEstimate {
+    /// `resistance_rate_std` σ_Ṙ [Ω/s] (> 0): w_R has σ = σ_Ṙ·T_s per sample.
+    pub rate_std: f64,
+    /// `initial_resistance_std` [Ω] (> 0), around `coil.resistance`.
+    pub initial_std: f64,
 }

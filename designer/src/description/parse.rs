@@ -14,7 +14,7 @@ use toml::Spanned;
 use super::{
     Coil, Controller, Core, Description, DescriptionError, Drive, Estimator, FloatType, Gains, Gap,
     IntegralSettings, JilesAtherton, KalmanSection, Law, Mechanics, Observer, Operation,
-    SemeraSettings, Shape, Source, Supply, Trajectory,
+    ResistanceEstimate, SemeraSettings, Shape, Source, Supply, Trajectory,
 };
 
 type Res<T> = Result<T, DescriptionError>;
@@ -66,7 +66,10 @@ const INTEGRAL_KEYS: [&str; 5] = [
     "ci_sigmas",
     "energize_threshold",
 ];
-const KALMAN_KEYS: [&str; 9] = [
+const KALMAN_KEYS: [&str; 12] = [
+    "estimate_resistance",
+    "resistance_rate_std",
+    "initial_resistance_std",
     "process_z",
     "process_phi",
     "process_hc",
@@ -595,6 +598,7 @@ fn parse_kalman(s: &Sect, core_sect: &Sect, core: &Core) -> Res<KalmanSection> {
     let initial_z_std = s.num("initial_z_std", Bound::Positive, "m")?;
     let initial_phi_std = s.num("initial_phi_std", Bound::Positive, "Wb")?;
     let initial_hc_std = hc("initial_hc_std")?;
+    let resistance = parse_resistance_estimate(s, ja)?;
     Ok(KalmanSection {
         process_z,
         process_phi,
@@ -605,7 +609,44 @@ fn parse_kalman(s: &Sect, core_sect: &Sect, core: &Core) -> Res<KalmanSection> {
         ukf_alpha: s.num_or("ukf_alpha", Bound::UnitLeftOpen, "-", 1.0)?,
         ukf_beta: s.num_or("ukf_beta", Bound::NonNegative, "-", 2.0)?,
         ukf_kappa: s.num_or("ukf_kappa", Bound::Any, "-", 0.0)?,
+        resistance,
     })
+}
+
+/// `estimate_resistance` (a boolean, default false) of `[observer.kalman]`
+/// with `resistance_rate_std` [Ω/s] and `initial_resistance_std` [Ω], both
+/// required with it and refused without it. With a Jiles–Atherton core the
+/// state [z, z_prev, φ, H_c, R] would exceed the filters' four states.
+fn parse_resistance_estimate(s: &Sect, ja: bool) -> Res<Option<ResistanceEstimate>> {
+    const KEY: &str = "estimate_resistance";
+    let on = match s.entry(KEY) {
+        None => false,
+        Some((_, v)) => match v.get_ref() {
+            DeValue::Boolean(b) => *b,
+            _ => {
+                let msg = format!("expected a boolean, found {}", s.ctx.found(v));
+                return Err(s.err(KEY, msg, "expected true or false"));
+            }
+        },
+    };
+    let keys = ["resistance_rate_std", "initial_resistance_std"];
+    if !on {
+        if let Some(key) = keys.into_iter().find(|k| s.entry(k).is_some()) {
+            let msg = "only allowed with estimate_resistance = true (the coil resistance is a \
+                       state only then); add estimate_resistance = true or remove it";
+            return Err(s.err(key, msg, "R is not estimated"));
+        }
+        return Ok(None);
+    }
+    if ja {
+        let msg = "not supported with core.model = \"jiles-atherton\": the state \
+                   [z, z_prev, φ, H_c, R] would have 5 entries and the filters hold at most 4";
+        return Err(s.err(KEY, msg, "too many states"));
+    }
+    Ok(Some(ResistanceEstimate {
+        rate_std: s.num(keys[0], Bound::Positive, "Ω/s")?,
+        initial_std: s.num(keys[1], Bound::Positive, "Ω")?,
+    }))
 }
 
 /// K of eq. 48: exactly one of `settling_time` and `poles`.

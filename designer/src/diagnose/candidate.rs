@@ -83,14 +83,13 @@ pub fn candidate(
             if matches!(baseline.core, Core::JilesAtherton(_)) {
                 return Err(not("core.model is already \"jiles-atherton\""));
             }
-            let ja = hysteresis_start(baseline, scales);
+            let area = pole_area(baseline);
+            // The record's peak flux density at 60 % of saturation.
+            let b_sat = (scales.peak_flux / area).max(1e-3) / 0.6;
+            let ja = jiles_atherton(area, linear_r0(baseline), b_sat);
             start.core = Core::JilesAtherton(ja.clone());
-            params.push(param("core.m_sat", 0.05 * ja.m_sat, 20.0 * ja.m_sat));
-            params.push(param("core.b", 0.02 * ja.b, 50.0 * ja.b));
-            params.push(param("core.c", 0.02, 0.98));
-            params.push(param("core.kappa", 0.02 * ja.kappa, 50.0 * ja.kappa));
-            params.push(param("core.length", 0.05 * ja.length, 20.0 * ja.length));
-            starts = 2;
+            params.extend(hysteresis_params(&ja));
+            starts = 1;
         }
         Cause::Fringing => {
             let Gap::Linear { slope, offset } = baseline.gap else {
@@ -171,27 +170,71 @@ fn core_reluctance_param(d: &Description) -> FitParam {
     }
 }
 
-/// A Jiles–Atherton core that starts close to the baseline's linear one.
-///
-/// The material's shape parameters (c, κ, α, and b relative to μ0·M_sat) are
-/// those the JA paper fitted for a valve's steel (Table 2); the pole area is
-/// the gap's (A = 1/(μ0·slope) for a linear gap, else 10 mm²); M_sat puts the
-/// record's peak flux density at 60 % of saturation, and the path length
-/// makes the initial reluctance l_c/(μ0·μ_i·A_c) equal to the baseline's r0.
-fn hysteresis_start(baseline: &Description, scales: Scales) -> JilesAtherton {
-    let area = match baseline.gap {
+/// The hysteresis candidate started from a fitted saturating core instead:
+/// the Jiles–Atherton saturation flux density μ0·M_sat is φ_sat/A_c and the
+/// initial reluctance is the fitted r0. Jiles–Atherton fits are not convex;
+/// the saturation fit is cheap and finds the flux scale reliably.
+pub fn hysteresis_from_saturation(
+    baseline: &Description,
+    saturating: &Description,
+) -> Option<Candidate> {
+    let Core::Saturating { r0, phi_sat } = saturating.core else {
+        return None;
+    };
+    let area = pole_area(baseline);
+    let ja = jiles_atherton(area, r0, phi_sat / area);
+    let mut start = baseline.clone();
+    start.coil.resistance = saturating.coil.resistance;
+    start.core = Core::JilesAtherton(ja.clone());
+    let mut params = vec![resistance(baseline)];
+    params.extend(hysteresis_params(&ja));
+    Some(Candidate {
+        cause: Cause::Hysteresis,
+        start,
+        params,
+        starts: 1,
+    })
+}
+
+/// The fitted Jiles–Atherton parameters around `ja` (α stays: the path
+/// length l_c takes its part of the reduced model's α*, eq. 60).
+fn hysteresis_params(ja: &JilesAtherton) -> [FitParam; 5] {
+    [
+        param("core.m_sat", 0.05 * ja.m_sat, 20.0 * ja.m_sat),
+        param("core.b", 0.02 * ja.b, 50.0 * ja.b),
+        param("core.c", 0.02, 0.98),
+        param("core.kappa", 0.02 * ja.kappa, 50.0 * ja.kappa),
+        param("core.length", 0.05 * ja.length, 20.0 * ja.length),
+    ]
+}
+
+/// The pole area: the gap's (A = 1/(μ0·slope) for a linear gap), else 10 mm².
+fn pole_area(d: &Description) -> f64 {
+    match d.gap {
         Gap::Linear { slope, .. } if slope > 0.0 => 1.0 / (MU0 * slope),
         Gap::McLyman { area, .. } => area,
         _ => 1e-5,
-    };
-    let r0 = match baseline.core {
+    }
+}
+
+/// The core's reluctance at φ = 0 of a linear or saturating core.
+fn linear_r0(d: &Description) -> f64 {
+    match d.core {
         Core::Linear { r0 } | Core::Saturating { r0, .. } => r0,
         Core::JilesAtherton(_) => 1e6,
-    };
+    }
+}
+
+/// A Jiles–Atherton core of pole area `area`, initial reluctance `r0` and
+/// saturation flux density `b_sat` = μ0·M_sat [T].
+///
+/// The material's shape parameters (c, κ, α, and b relative to μ0·M_sat) are
+/// those the JA paper fitted for a valve's steel (Table 2); the path length
+/// makes the initial reluctance l_c/(μ0·μ_i·A_c) equal to `r0`.
+fn jiles_atherton(area: f64, r0: f64, b_sat: f64) -> JilesAtherton {
     // Table 2: μ0·M_sat = 1.822 T, b = 2.45 mT, c = 0.736, κ = 943 A/m, α = 3.66e-3.
-    let b_peak: f64 = (scales.peak_flux / area).max(1e-3);
-    let m_sat = b_peak / 0.6 / MU0;
-    let b = 2.45e-3 * (MU0 * m_sat) / 1.822;
+    let m_sat = b_sat / MU0;
+    let b = 2.45e-3 * b_sat / 1.822;
     let (c, kappa, alpha) = (0.736, 943.0, 3.66e-3);
     // Initial (anhysteretic, mean-field) relative permeability 1 + χ,
     // χ = χ_an / (1 − α·χ_an) with χ_an = μ0·M_sat/(3b).

@@ -2,9 +2,10 @@
 //! built by the symbolic core from the model's own expressions, with the
 //! measurement and the Jacobians the EKF needs.
 //!
-//! State x = [z, z_prev, φ] (+ H_c with the Jiles–Atherton core), where
-//! z_prev is the position one sample earlier; input u (the coil voltage, or
-//! the current with `drive = "current"`); sample period T_s.
+//! State x = [z, z_prev, φ] (+ H_c with the Jiles–Atherton core) (+ R with
+//! [`ResistanceSettings`]), where z_prev is the position one sample earlier;
+//! input u (the coil voltage, or the current with `drive = "current"`);
+//! sample period T_s.
 //!
 //! | quantity | expression |
 //! | --- | --- |
@@ -13,6 +14,7 @@
 //! | (84b) previous position | z_prev⁺ = sat_{z_min}^{z_max}(z) (= z for every state (84a) produces) |
 //! | (84c) flux | φ⁺ = φ + T_s·f_φ(z, φ, H_c, u) |
 //! | (84d) core field | H_c⁺ = H_c + T_s·f_Hc(z, φ, H_c, u) |
+//! | coil resistance (optional) | R⁺ = R (random walk: w_R of σ = σ_Ṙ·T_s, as semera's q_r) |
 //! | (86) mode | 1 if z ≤ z_min + band, 3 if z ≥ z_max − band, else 2 |
 //! | (87) acceleration | a = f_v(z, v, φ) in mode 2, else 0 |
 //! | measurement | y = h(z, φ, H_c, u): the coil current (voltage drive), the coil voltage (current drive) |
@@ -29,7 +31,15 @@
 //! spurious velocity (z_next − z)/T_s of its saturation into the next step,
 //! a bias the mean inherits.
 //!
-//! **Noise.** w_z, w_φ, w_Hc are independent with the standard deviations of
+//! **Resistance state.** With [`ResistanceSettings`] the model's parameter R
+//! becomes a state (the symbol stays, it is no longer bound to the
+//! description's value), so f_φ, h and their Jacobians carry it. Under
+//! voltage drive an error in R biases the flux rate (u − R·i)/N, hence the
+//! flux and, through h, the position estimate; while the armature rests on a
+//! stop z is pinned, the steady current makes R observable (R ≈ u/i), and
+//! the filter tracks it. R's initial value is the description's.
+//!
+//! **Noise.** w_z, w_φ, w_Hc (, w_R) are independent with the standard deviations of
 //! [`KalmanSettings`] (per step). The measured input u (σ_u: the voltage
 //! noise, or the current noise with current drive) enters the transition
 //! through (84c)–(84d); its noise is mapped into the process noise to first
@@ -78,6 +88,45 @@ pub const MODE_BAND_SIGMAS: f64 = 3.0;
 /// The saturating core is evaluated at |φ| ≤ (1 − this)·φ_sat.
 pub const FLUX_DOMAIN_MARGIN: f64 = 1e-3;
 
+/// The largest state the filters hold: [z, z_prev, φ, H_c] or [z, z_prev, φ, R].
+pub const MAX_DIM: usize = 4;
+
+/// What each state of the discretised model is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StateKind {
+    /// z [m]
+    Position,
+    /// z_prev [m], the position one sample earlier
+    PreviousPosition,
+    /// φ [Wb]
+    Flux,
+    /// H_c [A/m] (Jiles–Atherton core)
+    CoreField,
+    /// R [Ω], the coil resistance (with [`ResistanceSettings`])
+    Resistance,
+}
+
+/// Coil-resistance estimation (`estimate_resistance = true` in
+/// `[observer.kalman]`): R as a random-walk state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ResistanceSettings {
+    /// σ_Ṙ [Ω/s] (> 0): the random walk's rate; w_R has σ = σ_Ṙ·T_s per step.
+    pub rate_std: f64,
+    /// Initial σ of R [Ω] (> 0) around the description's value.
+    pub initial_std: f64,
+}
+
+impl ResistanceSettings {
+    /// The settings of `[observer.kalman]`, `None` unless it estimates R.
+    pub fn from_observer(o: &crate::description::Observer) -> Option<ResistanceSettings> {
+        let r = o.kalman.as_ref()?.resistance?;
+        Some(ResistanceSettings {
+            rate_std: r.rate_std,
+            initial_std: r.initial_std,
+        })
+    }
+}
+
 /// The Kalman filters' settings (`[observer.kalman]` with σ_v, σ_i and T_s
 /// of `[observer]`). Standard deviations are per sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -123,6 +172,12 @@ pub enum KalmanError {
     UnusedFieldSetting(&'static str),
     #[error("the symbol `{0}` the discretised model needs is already taken by the model")]
     NameTaken(String),
+    #[error("observer.kalman: estimate_resistance with the Jiles–Atherton core needs 5 states [z, z_prev, φ, H_c, R]; the filters hold at most {MAX_DIM}")]
+    TooManyStates,
+    #[error("observer.kalman: {name} = {value:e}: expected a finite number > 0")]
+    BadResistanceSetting { name: &'static str, value: f64 },
+    #[error("estimate_resistance: the model has no coil resistance parameter `R`")]
+    NoResistance,
 }
 
 impl KalmanSettings {
@@ -233,8 +288,14 @@ pub struct DiscreteModel {
     /// The model's parameters plus T_s, z_min, z_max (and φ_lim with the
     /// saturating core), in that order.
     pub params: Params,
-    /// x = [z, z_prev, φ] (+ H_c).
+    /// x = [z, z_prev, φ] (+ H_c) (+ R).
     pub states: Vec<Id>,
+    /// What each state is.
+    pub kinds: Vec<StateKind>,
+    /// R as a state, if estimated.
+    pub resistance: Option<ResistanceSettings>,
+    /// The description's coil resistance [Ω] (R's initial estimate).
+    pub nominal_resistance: f64,
     /// u
     pub input: Id,
     /// t (only through the resistance drift).
@@ -276,11 +337,39 @@ pub const Z_MAX: &str = "z_max";
 pub const PHI_LIM: &str = "phi_lim";
 
 impl DiscreteModel {
-    /// Discretises `model` with `settings` (validated here).
+    /// Discretises `model` with `settings` (validated here), R a parameter.
     pub fn new(model: &Model, settings: &KalmanSettings) -> Result<DiscreteModel, KalmanError> {
+        DiscreteModel::with_resistance(model, settings, None)
+    }
+
+    /// The settings of the description's `[observer]`, `None` without a
+    /// `[observer.kalman]` section.
+    pub fn from_observer(
+        model: &Model,
+        o: &crate::description::Observer,
+    ) -> Option<Result<DiscreteModel, KalmanError>> {
+        let settings = KalmanSettings::from_observer(o)?;
+        let r = ResistanceSettings::from_observer(o);
+        Some(DiscreteModel::with_resistance(model, &settings, r))
+    }
+
+    /// Discretises `model` with `settings`, and R as a state when
+    /// `resistance` is given (validated here).
+    pub fn with_resistance(
+        model: &Model,
+        settings: &KalmanSettings,
+        resistance: Option<ResistanceSettings>,
+    ) -> Result<DiscreteModel, KalmanError> {
         settings.validate(model.has_field_state())?;
+        let r_symbol = match resistance {
+            Some(r) => Some(resistance_symbol(model, settings, &r)?),
+            None => None,
+        };
         let mut g = model.graph.clone();
         let mut params = model.params.clone();
+        if let Some(r) = r_symbol {
+            params = without(&mut g, &model.params, r);
+        }
         let fresh = |g: &mut Graph, name: &str| {
             if g.find_symbol(name).is_some() {
                 Err(KalmanError::NameTaken(name.to_owned()))
@@ -342,12 +431,24 @@ impl DiscreteModel {
         // (84b) z_prev⁺ = z, as sat(z): the same for every state (84a) gives,
         // and no spurious velocity (85) from sigma points beyond a stop
         let mut states = vec![z, z_prev, phi];
+        let mut kinds = vec![
+            StateKind::Position,
+            StateKind::PreviousPosition,
+            StateKind::Flux,
+        ];
         let mut transition = vec![z_next, z_dom, phi_next];
         if let Some(hc) = hc {
             // (84d) H_c⁺ = H_c + T_s·f_Hc
             let dh = g.mul(ts, subst[3]);
             states.push(hc);
+            kinds.push(StateKind::CoreField);
             transition.push(g.add(hc, dh));
+        }
+        if let Some(r) = r_symbol {
+            // R⁺ = R: a random walk (its noise is in Q)
+            states.push(r);
+            kinds.push(StateKind::Resistance);
+            transition.push(r);
         }
 
         let transition_jacobian = g.jacobian(&transition, &states);
@@ -372,6 +473,9 @@ impl DiscreteModel {
             settings: *settings,
             params,
             states,
+            kinds,
+            resistance,
+            nominal_resistance: model.description.coil.resistance,
             input: u,
             time: model.time,
             uses_time,
@@ -392,13 +496,18 @@ impl DiscreteModel {
         })
     }
 
-    /// Number of states (3, or 4 with H_c).
+    /// Number of states (3, plus H_c, plus R).
     pub fn dim(&self) -> usize {
         self.states.len()
     }
 
     pub fn has_field_state(&self) -> bool {
-        self.states.len() == 4
+        self.kinds.contains(&StateKind::CoreField)
+    }
+
+    /// Index of the state R, if estimated.
+    pub fn resistance_index(&self) -> Option<usize> {
+        self.kinds.iter().position(|&k| k == StateKind::Resistance)
     }
 
     /// Tape inputs: the states, u, then t.
@@ -454,26 +563,37 @@ impl DiscreteModel {
         }
     }
 
-    /// x₀: at rest at z_max (z = z_prev = z_max), φ = 0, H_c = 0.
+    /// x₀: at rest at z_max (z = z_prev = z_max), φ = 0, H_c = 0, R = the
+    /// description's.
     pub fn initial_state(&self) -> [f64; 4] {
-        [self.z_max, self.z_max, 0.0, 0.0]
+        let mut x = [self.z_max, self.z_max, 0.0, 0.0];
+        if let Some(i) = self.resistance_index() {
+            x[i] = self.nominal_resistance;
+        }
+        x
     }
 
     /// P₀: the armature is known to start at rest, so z and z_prev share
     /// the initial uncertainty σ_z0 (fully correlated: v = 0), each with the
     /// per-step variance q_z² added so that P₀ is positive definite:
     /// [[σ_z0² + q_z², σ_z0²], [σ_z0², σ_z0² + q_z²]]; then σ_φ0², σ_Hc0² on
-    /// the diagonal.
+    /// the diagonal (and σ_R0² for R).
     pub fn initial_covariance(&self) -> [[f64; 4]; 4] {
         let s = &self.settings;
         let z2 = s.initial_z_std * s.initial_z_std;
         let q2 = s.process_z * s.process_z;
-        let hc = s.initial_hc_std.unwrap_or(0.0);
         let mut p = [[0.0; 4]; 4];
         p[0] = [z2 + q2, z2, 0.0, 0.0];
         p[1] = [z2, z2 + q2, 0.0, 0.0];
-        p[2][2] = s.initial_phi_std * s.initial_phi_std;
-        p[3][3] = hc * hc;
+        for (i, kind) in self.kinds.iter().enumerate() {
+            let sd = match kind {
+                StateKind::Flux => s.initial_phi_std,
+                StateKind::CoreField => s.initial_hc_std.unwrap_or(0.0),
+                StateKind::Resistance => self.resistance.map_or(0.0, |r| r.initial_std),
+                StateKind::Position | StateKind::PreviousPosition => continue,
+            };
+            p[i][i] = sd * sd;
+        }
         p
     }
 
@@ -484,22 +604,70 @@ impl DiscreteModel {
             .expect("P₀ is positive definite by construction")
     }
 
-    /// diag(q_z², 0, q_φ², q_Hc²): the part of Q that does not come from u.
+    /// diag(q_z², 0, q_φ², q_Hc², (σ_Ṙ·T_s)²): the part of Q that does not
+    /// come from u.
     pub fn process_variance(&self) -> [f64; 4] {
         let s = &self.settings;
-        let hc = s.process_hc.unwrap_or(0.0);
-        [
-            s.process_z * s.process_z,
-            0.0,
-            s.process_phi * s.process_phi,
-            hc * hc,
-        ]
+        let mut q = [0.0; 4];
+        for (i, kind) in self.kinds.iter().enumerate() {
+            let sd = match kind {
+                StateKind::Position => s.process_z,
+                StateKind::PreviousPosition => 0.0,
+                StateKind::Flux => s.process_phi,
+                StateKind::CoreField => s.process_hc.unwrap_or(0.0),
+                StateKind::Resistance => self
+                    .resistance
+                    .map_or(0.0, |r| r.rate_std * s.sample_period),
+            };
+            q[i] = sd * sd;
+        }
+        q
     }
 
     /// (86) with the band: the discrete mode of the estimate z.
     pub fn mode(&self, z: f64) -> Mode {
         mode_of(z, self.z_min, self.z_max, self.mode_band)
     }
+}
+
+/// The model's symbol R checked for use as a state: valid settings, room in
+/// [`MAX_DIM`], and a parameter called R.
+fn resistance_symbol(
+    model: &Model,
+    settings: &KalmanSettings,
+    r: &ResistanceSettings,
+) -> Result<Id, KalmanError> {
+    for (name, value) in [
+        ("resistance_rate_std", r.rate_std),
+        ("initial_resistance_std", r.initial_std),
+    ] {
+        if !(value > 0.0 && value.is_finite()) {
+            return Err(KalmanError::BadResistanceSetting { name, value });
+        }
+    }
+    if model.has_field_state() {
+        return Err(KalmanError::TooManyStates);
+    }
+    // n = 4 with R: the unscented transform needs n + κ > 0
+    if 4.0 + settings.ukf_kappa <= 0.0 {
+        return Err(KalmanError::BadSetting {
+            name: "ukf_kappa",
+            value: settings.ukf_kappa,
+            expected: "n + kappa > 0 (n = number of states)",
+        });
+    }
+    model.params.symbol("R").ok_or(KalmanError::NoResistance)
+}
+
+/// `params` without the symbol `skip` (which becomes a state).
+fn without(g: &mut Graph, params: &Params, skip: Id) -> Params {
+    let mut out = Params::default();
+    for (name, id, value) in params.iter() {
+        if id != skip {
+            out.add(g, name, value);
+        }
+    }
+    out
 }
 
 /// z projected onto [lo, hi] (NaN stays NaN).
@@ -669,6 +837,8 @@ pub struct Estimate {
     pub phi: f64,
     /// H_c [A/m] (Jiles–Atherton core only)
     pub hc: Option<f64>,
+    /// R [Ω] (when estimated)
+    pub r: Option<f64>,
     /// (86), with the band of [`DiscreteModel::mode_band`]
     pub mode: Mode,
 }

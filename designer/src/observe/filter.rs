@@ -26,6 +26,8 @@ pub(crate) struct FilterCore {
     pub x0: [f64; 4],
     pub p0: [[f64; 4]; 4],
     pub has_field: bool,
+    /// Index of R in the state, if estimated.
+    pub r_index: Option<usize>,
     pub uses_time: bool,
     /// Prior mean x_{k|k−1}.
     pub x: [f64; 4],
@@ -50,7 +52,10 @@ pub(crate) struct Posterior {
     pub z: f64,
     pub z_prev: f64,
     pub phi: f64,
+    /// x[3]: H_c with the Jiles–Atherton core.
     pub hc: f64,
+    /// R, if estimated.
+    pub r: Option<f64>,
     pub mode: Mode,
 }
 
@@ -72,6 +77,7 @@ impl FilterCore {
             x0,
             p0,
             has_field: discrete.has_field_state(),
+            r_index: discrete.resistance_index(),
             uses_time: discrete.uses_time,
             x: x0,
             p: p0,
@@ -129,6 +135,7 @@ impl FilterCore {
             z_prev,
             phi,
             hc,
+            r: self.r_index.map(|i| self.x[i]),
             mode: mode_of(z, self.z_min, self.z_max, self.mode_band),
         }
     }
@@ -145,6 +152,7 @@ impl FilterCore {
             },
             phi: post.phi,
             hc: self.has_field.then_some(post.hc),
+            r: post.r,
             mode: post.mode,
         }
     }

@@ -1,0 +1,451 @@
+//! `reldesign diagnose` end to end (`shared/spec/measured-data.md`, `cli.md`):
+//! records with a known hidden effect (`reldesign_tests::hidden`: the SEMERA
+//! valve stripped to its baseline, one extension added in secret, a noisy
+//! simulated experiment) are diagnosed through the real binary.
+//!
+//! Checked: the `--json` contract (one object, the spec's fields,
+//! `gain = 1 − extended/baseline`, the extended model valid for `reldesign
+//! check` and carrying the drawn parameter), `none` on baseline data, where
+//! the extended model and the three plots go (`--out` or next to the data),
+//! the text report, and clean rejections of bad records, bad models and bad
+//! options, after which nothing is written.
+//!
+//! The saturation case runs every candidate (about 8 s in the test profile,
+//! most of it the hysteresis fit); the other runs restrict the candidates
+//! with `--causes` to stay fast.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use designer::description::{parse_file, parse_str, Core, Description};
+use designer::diagnose::Cause;
+use reldesign_tests::hidden::{baseline, hidden_case, write_case, Excitation, HiddenCase};
+use serde_json::Value;
+
+const BIN: &str = env!("CARGO_BIN_EXE_reldesign");
+
+const EXAMPLE: &str = "semera-valve.toml";
+
+/// Every cause of the vocabulary but hysteresis (the slow fit).
+const QUICK_CAUSES: &str = "eddy-currents,saturation,fringing,resistance-drift,bouncing";
+
+/// Relative error allowed on a parameter recovered from noisy data.
+const RECOVERY_TOLERANCE: f64 = 0.1;
+
+// ---------------------------------------------------------------------------
+// helpers
+// ---------------------------------------------------------------------------
+
+/// The SEMERA valve's case for `cause`: three square-wave cycles, 40 µs
+/// sampling, σ_v = 15 mV, σ_i = 1 mA, no `z` column.
+fn semera_case(cause: Cause, seed: u64) -> HiddenCase {
+    let path = reldesign_tests::root().join("examples").join(EXAMPLE);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let desc = parse_str(&text, EXAMPLE).unwrap_or_else(|e| panic!("{e}"));
+    let excitation = Excitation::square_wave(&baseline(&desc));
+    hidden_case(EXAMPLE, cause, &excitation, false, seed)
+}
+
+/// The drawn value of `key` in a case.
+fn drawn(case: &HiddenCase, key: &str) -> f64 {
+    case.drawn
+        .iter()
+        .find(|(k, _)| k == key)
+        .unwrap_or_else(|| panic!("{key} not drawn: {:?}", case.drawn))
+        .1
+}
+
+/// One run of the binary.
+struct Run {
+    args: String,
+    code: Option<i32>,
+    stdout: String,
+    stderr: String,
+}
+
+impl Run {
+    fn context(&self) -> String {
+        format!(
+            "`reldesign {}` exited with {:?}\n--- stdout ---\n{}\n--- stderr ---\n{}",
+            self.args, self.code, self.stdout, self.stderr
+        )
+    }
+
+    /// Exit 0. Returns stdout.
+    fn ok(&self) -> &str {
+        assert_eq!(self.code, Some(0), "expected success\n{}", self.context());
+        &self.stdout
+    }
+
+    /// Non-zero exit (not a signal), no panic, nothing on stdout, and every
+    /// needle on stderr (compared with whitespace and the report's `│`
+    /// margin removed, so that wrapped messages still match).
+    fn rejected(&self, needles: &[&str]) {
+        let ctx = self.context();
+        assert!(
+            matches!(self.code, Some(c) if c != 0),
+            "expected a failure\n{ctx}"
+        );
+        assert!(!self.stderr.contains("panicked"), "panic\n{ctx}");
+        assert!(self.stdout.is_empty(), "stdout must stay empty\n{ctx}");
+        for needle in needles {
+            assert!(
+                squeeze(&self.stderr).contains(&squeeze(needle)),
+                "stderr does not mention {needle:?}\n{ctx}"
+            );
+        }
+    }
+}
+
+fn squeeze(s: &str) -> String {
+    s.chars()
+        .filter(|c| !c.is_whitespace() && *c != '│')
+        .collect()
+}
+
+fn run<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Run {
+    let out = Command::new(BIN)
+        .args(args)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("cannot run the reldesign binary");
+    Run {
+        args: args
+            .iter()
+            .map(|a| a.as_ref().to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+            .join(" "),
+        code: out.status.code(),
+        stdout: String::from_utf8(out.stdout).expect("stdout is UTF-8"),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// A fresh directory under the system temp dir, removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(tag: &str) -> TempDir {
+        static COUNTER: AtomicUsize = AtomicUsize::new(0);
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let dir = std::env::temp_dir().join(format!(
+            "reldesign-diagnose-{tag}-{}-{n}",
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("create temp dir");
+        TempDir(dir)
+    }
+
+    fn path(&self) -> &Path {
+        &self.0
+    }
+
+    /// Names of the files in the directory, sorted (hidden ones included).
+    fn files(&self) -> Vec<String> {
+        files_in(&self.0)
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// stdout as exactly one JSON object (trailing text fails the parse).
+fn one_object(stdout: &str) -> serde_json::Map<String, Value> {
+    match serde_json::from_str::<Value>(stdout) {
+        Ok(Value::Object(m)) => m,
+        other => panic!("expected one JSON object on stdout, got {other:?}:\n{stdout}"),
+    }
+}
+
+fn number(m: &serde_json::Map<String, Value>, key: &str) -> f64 {
+    m.get(key)
+        .and_then(Value::as_f64)
+        .unwrap_or_else(|| panic!("`{key}` is not a number in {m:?}"))
+}
+
+/// The spec's fields, `gain = 1 − extended/baseline`; returns the cause and
+/// the extended model's path.
+fn spec_fields(m: &serde_json::Map<String, Value>) -> (String, PathBuf) {
+    let cause = m["cause"].as_str().expect("`cause` is a string").to_owned();
+    let base = number(m, "baseline_wnrmse");
+    let ext = number(m, "extended_wnrmse");
+    let gain = number(m, "gain");
+    assert!(base > 0.0 && ext > 0.0, "{m:?}");
+    assert!(
+        (gain - (1.0 - ext / base)).abs() < 1e-12,
+        "gain {gain} ≠ 1 − {ext}/{base}"
+    );
+    let path = m["extended_model"]
+        .as_str()
+        .expect("`extended_model` is a string");
+    (cause, PathBuf::from(path))
+}
+
+/// The extended model passes `reldesign check` and parses.
+fn checked_model(path: &Path) -> Description {
+    assert!(path.is_file(), "{} was not written", path.display());
+    run(&["check".as_ref(), path.as_os_str()]).ok();
+    parse_file(path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+const PLOTS: [&str; 3] = ["current.svg", "residual.svg", "loop.svg"];
+
+/// `<stem>.extended.toml` and the three plots, as SVG, in `dir`.
+fn assert_outputs(dir: &Path, stem: &str) {
+    let model = dir.join(format!("{stem}.extended.toml"));
+    assert!(model.is_file(), "{} missing", model.display());
+    for plot in PLOTS {
+        let p = dir.join(format!("{stem}.{plot}"));
+        let text = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+        assert!(text.contains("<svg"), "{} is not SVG", p.display());
+    }
+}
+
+// ---------------------------------------------------------------------------
+// the contract on hidden effects
+// ---------------------------------------------------------------------------
+
+#[test]
+fn json_names_hidden_saturation_and_writes_the_extended_model_in_out_dir() {
+    let case = semera_case(Cause::Saturation, 21);
+    let dir = TempDir::new("saturation");
+    let (model, data) = write_case(&dir.path().join("case"), &case);
+    let out = dir.path().join("out");
+    let r = run(&[
+        "diagnose".as_ref(),
+        model.as_os_str(),
+        data.as_os_str(),
+        "--json".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    let m = one_object(r.ok());
+    let (cause, extended) = spec_fields(&m);
+    assert_eq!(cause, "saturation", "{}", r.context());
+    assert!(number(&m, "gain") >= 0.5, "{}", r.context());
+    assert_eq!(extended, out.join("data.extended.toml"));
+    assert_outputs(&out, "data");
+    // Nothing next to the data when --out is given.
+    assert_eq!(
+        files_in(&dir.path().join("case")),
+        ["baseline.toml", "data.csv"]
+    );
+    // The extension, with the hidden φ_sat recovered.
+    let truth = drawn(&case, "core.phi_sat");
+    match checked_model(&extended).core {
+        Core::Saturating { phi_sat, .. } => assert!(
+            (phi_sat / truth - 1.0).abs() < RECOVERY_TOLERANCE,
+            "φ_sat {phi_sat:e} vs hidden {truth:e}"
+        ),
+        other => panic!("expected a saturating core, got {other:?}"),
+    }
+    let text = std::fs::read_to_string(&extended).unwrap();
+    assert!(text.contains("model = \"saturating\""), "{text}");
+}
+
+#[test]
+fn baseline_data_gives_none() {
+    let case = semera_case(Cause::None, 22);
+    let dir = TempDir::new("none");
+    let (model, data) = write_case(dir.path(), &case);
+    let r = run(&[
+        "diagnose".as_ref(),
+        model.as_os_str(),
+        data.as_os_str(),
+        "--json".as_ref(),
+        "--causes".as_ref(),
+        QUICK_CAUSES.as_ref(),
+    ]);
+    let m = one_object(r.ok());
+    let (cause, extended) = spec_fields(&m);
+    assert_eq!(cause, "none", "{}", r.context());
+    // The baseline already sits on the noise floor: nothing to gain.
+    assert!(number(&m, "gain").abs() < 0.1, "{}", r.context());
+    let ext = checked_model(&extended);
+    let base = parse_file(&model).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(ext.core, base.core);
+    assert_eq!(ext.coil.eddy, 0.0);
+}
+
+#[test]
+fn text_report_and_files_next_to_the_data() {
+    let case = semera_case(Cause::EddyCurrents, 23);
+    let dir = TempDir::new("text");
+    let model = dir.path().join("valve.toml");
+    let data = dir.path().join("bench-run.csv");
+    std::fs::write(&model, &case.baseline_toml).unwrap();
+    std::fs::write(&data, &case.data_csv).unwrap();
+    let r = run(&[
+        "diagnose".as_ref(),
+        model.as_os_str(),
+        data.as_os_str(),
+        "--causes".as_ref(),
+        "eddy-currents,resistance-drift".as_ref(),
+    ]);
+    let text = r.ok();
+    for needle in [
+        "cause: eddy-currents",
+        "gain = 1 − extended/baseline",
+        "held-out last",
+        "candidates",
+        "resistance-drift",
+        "bench-run.extended.toml",
+    ] {
+        assert!(text.contains(needle), "no {needle:?} in\n{}", r.context());
+    }
+    assert!(
+        serde_json::from_str::<Value>(text).is_err(),
+        "text mode printed JSON"
+    );
+    assert_outputs(dir.path(), "bench-run");
+    let truth = drawn(&case, "coil.eddy");
+    let eddy = checked_model(&dir.path().join("bench-run.extended.toml"))
+        .coil
+        .eddy;
+    assert!(
+        (eddy / truth - 1.0).abs() < RECOVERY_TOLERANCE,
+        "k_e {eddy:e} vs hidden {truth:e}"
+    );
+}
+
+// ---------------------------------------------------------------------------
+// rejections: nothing written
+// ---------------------------------------------------------------------------
+
+/// Replaces field `col` (0-based) of 1-based line `line` of a CSV text.
+fn set_field(csv: &str, line: usize, col: usize, value: &str) -> String {
+    let mut lines: Vec<String> = csv.lines().map(str::to_owned).collect();
+    let mut fields: Vec<&str> = lines[line - 1].split(',').collect();
+    fields[col] = value;
+    lines[line - 1] = fields.join(",");
+    lines.join("\n") + "\n"
+}
+
+fn field(csv: &str, line: usize, col: usize) -> f64 {
+    csv.lines()
+        .nth(line - 1)
+        .unwrap()
+        .split(',')
+        .nth(col)
+        .unwrap()
+        .parse()
+        .unwrap()
+}
+
+/// Runs diagnose on (model text, data text) in a fresh directory, with
+/// `--out` to a directory that does not exist yet, and asserts a rejection
+/// with `needles` after which neither directory holds anything new.
+fn rejected_without_output(model_toml: &str, data_csv: &str, extra: &[&str], needles: &[&str]) {
+    let dir = TempDir::new("bad");
+    let model = dir.path().join("valve.toml");
+    let data = dir.path().join("bad-record.csv");
+    std::fs::write(&model, model_toml).unwrap();
+    std::fs::write(&data, data_csv).unwrap();
+    let out = dir.path().join("out");
+    let mut args = vec![
+        "diagnose".as_ref(),
+        model.as_os_str(),
+        data.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ];
+    args.extend(extra.iter().map(std::ffi::OsStr::new));
+    run(&args).rejected(needles);
+    assert_eq!(dir.files(), ["bad-record.csv", "valve.toml"]);
+    // Without --out: nothing next to the data either.
+    args.truncate(3);
+    args.extend(extra.iter().map(std::ffi::OsStr::new));
+    run(&args).rejected(needles);
+    assert_eq!(dir.files(), ["bad-record.csv", "valve.toml"]);
+}
+
+#[test]
+fn bad_records_are_rejected_naming_file_line_and_column() {
+    let case = semera_case(Cause::None, 24);
+    let csv = &case.data_csv;
+    let model = &case.baseline_toml;
+    // Line 1 is a comment, line 2 the header `t,v,i`.
+    assert!(csv.lines().nth(1) == Some("t,v,i"), "{csv:.200}");
+    let dt = field(csv, 4, 0) - field(csv, 3, 0);
+
+    let no_current = csv.replacen("\nt,v,i\n", "\nt,v,current\n", 1);
+    rejected_without_output(
+        model,
+        &no_current,
+        &[],
+        &["bad-record.csv", "missing column `i`"],
+    );
+
+    let text_cell = set_field(csv, 100, 1, "abc");
+    rejected_without_output(
+        model,
+        &text_cell,
+        &[],
+        &["bad-record.csv:100", "`v`", "`abc`"],
+    );
+
+    let nan = set_field(csv, 120, 2, "NaN");
+    rejected_without_output(model, &nan, &[], &["bad-record.csv:120", "`i`", "NaN"]);
+
+    let repeated_time = set_field(csv, 150, 0, &format!("{:e}", field(csv, 149, 0)));
+    rejected_without_output(
+        model,
+        &repeated_time,
+        &[],
+        &["bad-record.csv:150", "`t`", "increase"],
+    );
+
+    // A 5 % jitter on one sample time: steps of 1.05 Δ and 0.95 Δ.
+    let jitter = set_field(
+        csv,
+        200,
+        0,
+        &format!("{:e}", field(csv, 200, 0) + 0.05 * dt),
+    );
+    rejected_without_output(
+        model,
+        &jitter,
+        &[],
+        &["bad-record.csv:200", "`t`", "uniform"],
+    );
+}
+
+#[test]
+fn bad_model_is_rejected_naming_the_key() {
+    let case = semera_case(Cause::None, 25);
+    let model = case
+        .baseline_toml
+        .replacen("\nresistance = 75.0", "\nresistance = -75.0", 1);
+    assert_ne!(model, case.baseline_toml, "the example changed");
+    rejected_without_output(
+        &model,
+        &case.data_csv,
+        &[],
+        &["valve.toml", "coil.resistance"],
+    );
+}
+
+#[test]
+fn bad_options_are_rejected() {
+    let case = semera_case(Cause::None, 26);
+    let (model, data) = (&case.baseline_toml, &case.data_csv);
+    rejected_without_output(model, data, &["--holdout", "0.9"], &["--holdout", "0.9"]);
+    let mut names = vec!["`eddy`"];
+    names.extend(Cause::EXTENSIONS.iter().map(|c| c.name()));
+    names.push("none");
+    rejected_without_output(model, data, &["--causes", "saturation,eddy"], &names);
+}
