@@ -380,13 +380,9 @@ pub fn fit(
     options: &FitOptions,
     progress: &(dyn Fn(FitProgress) + Sync),
 ) -> Result<FitReport, FitError> {
-    let start0 = check_params(description, params)?;
-    let objective = Objective::new(description, data, options)?;
-    let bounds: Vec<(f64, f64)> = params.iter().map(|p| (p.lower, p.upper)).collect();
-    let residual = |theta: &[f64]| {
-        let d = with_values(description, params, theta).ok()?;
-        objective.residuals(&d).ok()
-    };
+    let setup = Setup::new(description, data, params, options)?;
+    let (start0, bounds) = (&setup.x0, &setup.bounds);
+    let residual = |theta: &[f64]| setup.residuals(description, params, theta);
     let lm_options = lm::Options {
         max_iterations: options.max_iterations,
         ftol: options.ftol,
@@ -397,7 +393,7 @@ pub fn fit(
     let mut best: Option<(usize, lm::Report)> = None;
     let (mut iterations, mut simulations) = (0, 0);
     let mut last_error = None;
-    for (k, x0) in start_points(&start0, params, starts, options.seed)
+    for (k, x0) in start_points(start0, params, starts, options.seed)
         .iter()
         .enumerate()
     {
@@ -409,7 +405,7 @@ pub fn fit(
                 objective: 2.0 * it.cost,
             })
         };
-        match lm::minimize(residual, x0, &bounds, &lm_options, &mut monitor) {
+        match lm::minimize(residual, x0, bounds, &lm_options, &mut monitor) {
             Ok(report) => {
                 iterations += report.iterations;
                 simulations += report.evaluations;
@@ -425,7 +421,7 @@ pub fn fit(
         message: last_error.map_or_else(String::new, |e: LmError| e.to_string()),
     })?;
     let fitted = with_values(description, params, &report.theta)?;
-    let errors = objective.errors(&fitted)?;
+    let errors = setup.objective.errors(&fitted)?;
     let names: Vec<String> = params.iter().map(|p| p.path.clone()).collect();
     Ok(FitReport {
         sensitivity: Sensitivity::from_jacobian(
@@ -458,24 +454,18 @@ pub fn sensitivity_at(
     params: &[FitParam],
     options: &FitOptions,
 ) -> Result<Sensitivity, FitError> {
-    let x0 = check_params(description, params)?;
-    let objective = Objective::new(description, data, options)?;
-    let bounds: Vec<(f64, f64)> = params.iter().map(|p| (p.lower, p.upper)).collect();
-    let residual = |theta: &[f64]| {
-        let d = with_values(description, params, theta).ok()?;
-        objective.residuals(&d).ok()
-    };
+    let setup = Setup::new(description, data, params, options)?;
+    let residual = |theta: &[f64]| setup.residuals(description, params, theta);
     let lm_options = lm::Options {
         max_iterations: 0,
         fd_step: options.fd_step,
         ..lm::Options::default()
     };
-    let report = lm::minimize(residual, &x0, &bounds, &lm_options, &mut |_| {}).map_err(|e| {
-        FitError::Solver {
+    let report = lm::minimize(residual, &setup.x0, &setup.bounds, &lm_options, &mut |_| {})
+        .map_err(|e| FitError::Solver {
             file: data.file_name.clone(),
             message: e.to_string(),
-        }
-    })?;
+        })?;
     let names: Vec<String> = params.iter().map(|p| p.path.clone()).collect();
     Ok(Sensitivity::from_jacobian(
         &names,
@@ -483,6 +473,39 @@ pub fn sensitivity_at(
         &report.theta,
         &report.residuals,
     ))
+}
+
+/// The checked start values, the objective (80) and the box of one fit.
+struct Setup<'a> {
+    x0: Vec<f64>,
+    objective: Objective<'a>,
+    bounds: Vec<(f64, f64)>,
+}
+
+impl<'a> Setup<'a> {
+    fn new(
+        description: &Description,
+        data: &'a Measured,
+        params: &[FitParam],
+        options: &FitOptions,
+    ) -> Result<Self, FitError> {
+        Ok(Setup {
+            x0: check_params(description, params)?,
+            objective: Objective::new(description, data, options)?,
+            bounds: params.iter().map(|p| (p.lower, p.upper)).collect(),
+        })
+    }
+
+    /// The residuals of (80) at θ (none: invalid values or a failed replay).
+    fn residuals(
+        &self,
+        description: &Description,
+        params: &[FitParam],
+        theta: &[f64],
+    ) -> Option<Vec<f64>> {
+        let d = with_values(description, params, theta).ok()?;
+        self.objective.residuals(&d).ok()
+    }
 }
 
 /// Checks paths, duplicates and bounds; returns the start values (the
