@@ -11,7 +11,7 @@ use designer::description::{parse_file, Description};
 use designer::identify::gap_fit::{fit_gap, reluctance_and_slope, GapModel, GapTable};
 use designer::identify::{
     current_wnrmse, fit, params, reduced_parameters, simulate_outputs, FitOptions, FitParam,
-    Measured,
+    Measured, Sensitivities,
 };
 
 fn example(name: &str) -> Description {
@@ -122,10 +122,26 @@ fn saturating_valve_parameters_are_recovered_from_noisy_data() {
     let clock = Instant::now();
     let report = fit(&start, &data, &fitted, &FitOptions::default(), &|_| {}).unwrap();
     let seconds = clock.elapsed().as_secs_f64();
+    assert_eq!(report.sensitivities, Sensitivities::Analytic);
     eprintln!(
-        "saturating fit: {:?}, {seconds:.2} s, {} iterations, {} replays, wNRMSE {before:.4} → {:.5} (floor {floor:.5})\n{}",
+        "saturating fit (analytic): {:?}, {seconds:.2} s, {} iterations, {} replays, wNRMSE {before:.4} → {:.5} (floor {floor:.5})\n{}",
         report.status, report.iterations, report.simulations, report.wnrmse_current, report.sensitivity
     );
+    let clock = Instant::now();
+    let options = FitOptions {
+        sensitivities: Sensitivities::FiniteDifference,
+        ..FitOptions::default()
+    };
+    let fd = fit(&start, &data, &fitted, &options, &|_| {}).unwrap();
+    eprintln!(
+        "saturating fit (finite differences): {:?}, {:.2} s, {} iterations, {} replays, wNRMSE {:.5}",
+        fd.status, clock.elapsed().as_secs_f64(), fd.iterations, fd.simulations, fd.wnrmse_current
+    );
+    assert_eq!(fd.sensitivities, Sensitivities::FiniteDifference);
+    // Both Jacobians lead to the same minimum.
+    for ((path, a), (_, f)) in report.values.iter().zip(&fd.values) {
+        assert!((a / f - 1.0).abs() < 1e-3, "{path}: {a:e} vs {f:e}");
+    }
     // Tolerances: R 0.5 %, φ_sat 3 %, R_core0 and the gap slope 3 %.
     for ((path, value), tol) in report.values.iter().zip([5e-3, 3e-2, 3e-2, 3e-2]) {
         let want = params::get(&truth, path).unwrap();

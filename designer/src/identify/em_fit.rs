@@ -16,22 +16,30 @@
 //! whenever the data has `z`.
 //! Residuals are √w·(sim − exp)/‖exp‖_w so that ‖r‖² is the objective.
 //!
-//! Sensitivities are forward differences of whole replays (no sensitivity
-//! equations): the replays run at a tight tolerance ([`FitOptions::rtol`]) so
-//! that a relative step of [`FitOptions::fd_step`] sees a smooth function.
+//! Sensitivities are analytic where the symbolic core gives them
+//! ([`sensitivity`](super::sensitivity): forward sensitivity equations along
+//! the replay, [`Sensitivities::Analytic`]); otherwise (a parameter of the
+//! resets, the Jiles–Atherton core, or when asked) forward differences of
+//! whole replays: the replays run at a tight tolerance ([`FitOptions::rtol`])
+//! so that a relative step of [`FitOptions::fd_step`] sees a smooth function.
 //! Several starts ([`FitOptions::starts`]) are drawn deterministically from
 //! the bounds (log-uniform for positive parameters spanning a decade or more);
 //! the best fit is kept.
 
+use std::cell::{Cell, RefCell};
+
+use nalgebra::DMatrix;
+
 use crate::description::{Core, Description, Drive};
 use crate::model::{Model, ModelPlant};
 use crate::replay::{replay_plant, Replay};
-use crate::sim::{Options, PiecewiseLinear};
+use crate::sim::{Options, PiecewiseLinear, Trajectory};
 
 use super::identifiability::Sensitivity;
 use super::lm::{self, LmError, Status};
 use super::measured::Measured;
 use super::params::{self, ParamError};
+use super::sensitivity;
 use super::weighted::{flux_from_data, flux_rate_weights, has_measured_flux, wnrmse};
 
 /// One parameter to fit, by TOML key path, with its bounds.
@@ -65,6 +73,19 @@ pub struct FitOptions {
     /// sample of the record: a trial parameter set that makes the model so
     /// stiff that it needs more fails fast, and the solver shrinks its step.
     pub max_steps_per_sample: usize,
+    /// How the Jacobian is computed (analytic falls back to finite
+    /// differences when a fitted parameter has no analytic sensitivity).
+    pub sensitivities: Sensitivities,
+}
+
+/// How the fit's Jacobian is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sensitivities {
+    /// Forward sensitivity equations along the replay (see
+    /// [`sensitivity`](super::sensitivity)).
+    Analytic,
+    /// Forward differences of whole replays.
+    FiniteDifference,
 }
 
 impl Default for FitOptions {
@@ -79,6 +100,7 @@ impl Default for FitOptions {
             fd_step: 1e-6,
             ftol: 1e-8,
             max_steps_per_sample: 200,
+            sensitivities: Sensitivities::Analytic,
         }
     }
 }
@@ -110,8 +132,12 @@ pub struct FitReport {
     pub cost: f64,
     /// Solver iterations, all starts.
     pub iterations: usize,
-    /// Replays, all starts, finite differences included.
+    /// Replays, all starts, finite differences and sensitivity replays
+    /// included.
     pub simulations: usize,
+    /// The Jacobian actually used (analytic only when every fitted
+    /// parameter has an analytic sensitivity).
+    pub sensitivities: Sensitivities,
     /// Why the best start stopped.
     pub status: Status,
     /// Which start gave the best fit (0 = the description's values).
@@ -198,10 +224,14 @@ fn simulate_with(
     data: &Measured,
     budget: &Budget,
 ) -> Result<SimOutputs, FitError> {
-    let replay = replay(d, data, budget)?;
+    Ok(outputs(d, &replay(d, data, budget)?))
+}
+
+/// The signals of one replay of `d`.
+fn outputs(d: &Description, replay: &Replay) -> SimOutputs {
     let tr = &replay.trajectory;
     let field = matches!(d.core, Core::JilesAtherton(_));
-    Ok(SimOutputs {
+    SimOutputs {
         t: tr.t.clone(),
         current: replay.current.clone(),
         voltage: replay.voltage.clone(),
@@ -209,7 +239,7 @@ fn simulate_with(
         phi: tr.x.iter().map(|x| x[2]).collect(),
         h_c: field.then(|| tr.x.iter().map(|x| x[3]).collect()),
         mode: tr.mode.iter().map(|m| m.number()).collect(),
-    })
+    }
 }
 
 /// The measured voltage replayed through `d` from rest.
@@ -323,7 +353,11 @@ impl<'a> Objective<'a> {
 
     /// Residuals √w·(sim − exp)/norm: ‖r‖² is the objective (80).
     fn residuals(&self, d: &Description) -> Result<Vec<f64>, FitError> {
-        let out = simulate_with(d, self.data, &self.budget)?;
+        Ok(self.residuals_of(d, &simulate_with(d, self.data, &self.budget)?))
+    }
+
+    /// [`residuals`](Self::residuals) of the signals `out` of `d`.
+    fn residuals_of(&self, d: &Description, out: &SimOutputs) -> Vec<f64> {
         let sw: Vec<f64> = self.weights.iter().map(|w| w.sqrt()).collect();
         let mut r: Vec<f64> = (0..self.data.len())
             .map(|k| sw[k] * (out.current[k] - self.data.i[k]) / self.current_norm)
@@ -334,7 +368,76 @@ impl<'a> Objective<'a> {
         if let (Some(norm), Some(z)) = (self.position_norm, &self.data.z) {
             r.extend(z.iter().zip(&out.z).map(|(e, s)| (s - e) / norm));
         }
-        Ok(r)
+        r
+    }
+
+    /// ∂r/∂θ of [`residuals`](Self::residuals) from the forward
+    /// sensitivities along `trajectory`, the replay of `d` (none: an
+    /// unsupported parameter).
+    fn jacobian(
+        &self,
+        d: &Description,
+        paths: &[&str],
+        trajectory: &Trajectory,
+    ) -> Option<DMatrix<f64>> {
+        let s = sensitivity::forward(&mut Model::build(d), paths, trajectory).ok()?;
+        let (n, p) = (self.data.len(), paths.len());
+        let sw: Vec<f64> = self.weights.iter().map(|w| w.sqrt()).collect();
+        let mut blocks = vec![DMatrix::from_fn(n, p, |k, j| {
+            sw[k] * s.current[(k, j)] / self.current_norm
+        })];
+        if let Some((phi, norm)) = self.flux_reference(d) {
+            let x = &trajectory.x;
+            let mut block = DMatrix::zeros(n, p);
+            for (j, path) in paths.iter().enumerate() {
+                let dphi = self.flux_reference_derivative(d, path, &phi);
+                // ∂‖φ_ref‖_w = Σ w·φ_ref·∂φ_ref / ‖φ_ref‖_w
+                let dnorm = (0..n)
+                    .map(|k| self.weights[k] * phi[k] * dphi[k])
+                    .sum::<f64>()
+                    / norm;
+                for k in 0..n {
+                    let r = sw[k] * (x[k][2] - phi[k]) / norm;
+                    block[(k, j)] = sw[k] * (s.phi[(k, j)] - dphi[k]) / norm - r * dnorm / norm;
+                }
+            }
+            blocks.push(block);
+        }
+        if let (Some(norm), Some(_)) = (self.position_norm, &self.data.z) {
+            blocks.push(s.z / norm);
+        }
+        let rows = blocks.iter().map(|b| b.nrows()).sum();
+        let mut jac = DMatrix::zeros(rows, p);
+        let mut at = 0;
+        for b in blocks {
+            jac.rows_mut(at, b.nrows()).copy_from(&b);
+            at += b.nrows();
+        }
+        Some(jac)
+    }
+
+    /// ∂φ_ref/∂θ for the parameter `path`: the integrated reference
+    /// φ = ∫(v − R·i)/N depends on R and N, a flux linkage λ/N on N.
+    fn flux_reference_derivative(&self, d: &Description, path: &str, phi: &[f64]) -> Vec<f64> {
+        let integrated = matches!(self.flux, Some(FluxReference::Integrated));
+        let n_turns = d.coil.turns;
+        match path {
+            "coil.turns" if integrated => phi.iter().map(|x| -x / n_turns).collect(),
+            "coil.resistance" if integrated => {
+                // −∫i dt / N (trapezoidal, as the reference itself)
+                let (t, i) = (&self.data.t, &self.data.i);
+                let mut acc = 0.0;
+                (0..phi.len())
+                    .map(|k| {
+                        if k > 0 {
+                            acc += 0.5 * (t[k] - t[k - 1]) * (i[k - 1] + i[k]);
+                        }
+                        -acc / n_turns
+                    })
+                    .collect()
+            }
+            _ => vec![0.0; phi.len()],
+        }
     }
 
     fn errors(&self, d: &Description) -> Result<Errors, FitError> {
@@ -383,6 +486,32 @@ pub fn fit(
     let setup = Setup::new(description, data, params, options)?;
     let (start0, bounds) = (&setup.x0, &setup.bounds);
     let residual = |theta: &[f64]| setup.residuals(description, params, theta);
+    let paths: Vec<&str> = params.iter().map(|p| p.path.as_str()).collect();
+    let analytic = options.sensitivities == Sensitivities::Analytic
+        && sensitivity::check(description, &paths).is_ok();
+    // The analytic Jacobian reuses the replay of the residuals at the same
+    // θ (the solver asks for J at the point it just evaluated and accepted).
+    let last: RefCell<Option<(Vec<f64>, Trajectory)>> = RefCell::new(None);
+    let jacobian_replays = Cell::new(0);
+    let keeping = |theta: &[f64]| {
+        let d = with_values(description, params, theta).ok()?;
+        let replay = replay(&d, data, &setup.objective.budget).ok()?;
+        let r = setup.objective.residuals_of(&d, &outputs(&d, &replay));
+        *last.borrow_mut() = Some((theta.to_vec(), replay.trajectory));
+        Some(r)
+    };
+    let jacobian = |theta: &[f64]| {
+        let d = with_values(description, params, theta).ok()?;
+        let kept = last.borrow_mut().take().filter(|(t, _)| t == theta);
+        let trajectory = match kept {
+            Some((_, trajectory)) => trajectory,
+            None => {
+                jacobian_replays.set(jacobian_replays.get() + 1);
+                replay(&d, data, &setup.objective.budget).ok()?.trajectory
+            }
+        };
+        setup.objective.jacobian(&d, &paths, &trajectory)
+    };
     let lm_options = lm::Options {
         max_iterations: options.max_iterations,
         ftol: options.ftol,
@@ -405,7 +534,13 @@ pub fn fit(
                 objective: 2.0 * it.cost,
             })
         };
-        match lm::minimize(residual, x0, bounds, &lm_options, &mut monitor) {
+        let result = match analytic {
+            true => {
+                lm::minimize_with_jacobian(keeping, jacobian, x0, bounds, &lm_options, &mut monitor)
+            }
+            false => lm::minimize(residual, x0, bounds, &lm_options, &mut monitor),
+        };
+        match result {
             Ok(report) => {
                 iterations += report.iterations;
                 simulations += report.evaluations;
@@ -441,7 +576,11 @@ pub fn fit(
         nrmse_position: errors.position,
         cost: 2.0 * report.cost,
         iterations,
-        simulations: simulations + 1,
+        simulations: simulations + 1 + jacobian_replays.get(),
+        sensitivities: match analytic {
+            true => Sensitivities::Analytic,
+            false => Sensitivities::FiniteDifference,
+        },
         status: report.status,
         best_start,
     })

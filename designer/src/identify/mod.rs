@@ -7,6 +7,8 @@
 //! - [`params`]: description parameters addressed by TOML key path.
 //! - [`lm`]: a bounded Levenberg–Marquardt least-squares solver.
 //! - [`em_fit`]: the fit of (80) by replaying the measured voltage.
+//! - [`sensitivity`]: forward parameter sensitivities of a replay (the
+//!   fit's analytic Jacobian).
 //! - [`identifiability`]: what the data can and cannot separate (SVD of the
 //!   scaled Jacobian), and the reduced model's parameters (55), (57), (60).
 //! - [`gap_fit`]: the gap model fitted to a reluctance table (75)–(77).
@@ -17,11 +19,12 @@ pub mod identifiability;
 pub mod lm;
 pub mod measured;
 pub mod params;
+pub mod sensitivity;
 pub mod weighted;
 
 pub use em_fit::{
     current_wnrmse, fit, simulate_outputs, FitError, FitOptions, FitParam, FitProgress, FitReport,
-    SimOutputs,
+    Sensitivities, SimOutputs,
 };
 pub use identifiability::{reduced_parameters, ReducedParameters, Sensitivity};
 pub use measured::Measured;
