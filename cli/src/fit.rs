@@ -15,7 +15,7 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use designer::description::{edit::write_physics, Description};
-use designer::identify::em_fit::{FitProgress, FitReport};
+use designer::identify::em_fit::{FitProgress, FitReport, Sensitivities};
 use designer::identify::gap_fit::{fit_gap, GapFit, GapModel, GapTable};
 use designer::identify::params::{self, Domain};
 use designer::identify::{current_wnrmse, fit, FitOptions, FitParam, Measured};
@@ -211,8 +211,14 @@ fn fit_text(
         s += &format!("RMS position error / stroke: {:.4} % after\n", 100.0 * z);
     }
     s += &format!(
-        "objective (80): {:.4e}; {} iterations, {} replays, best start {}, stopped: {:?}\n",
-        r.cost, r.iterations, r.simulations, r.best_start, r.status
+        "objective (80): {:.4e}; {} iterations, {} replays, best start {}, stopped: {:?}; \
+         Jacobian: {}\n",
+        r.cost,
+        r.iterations,
+        r.simulations,
+        r.best_start,
+        r.status,
+        jacobian_name(r.sensitivities)
     );
     s += &r.sensitivity.to_string();
     if let Some(p) = written {
@@ -260,6 +266,7 @@ fn fit_json(d: &Description, r: &FitReport, before: f64, written: Option<&str>) 
         "cost": finite(r.cost),
         "iterations": r.iterations,
         "simulations": r.simulations,
+        "jacobian": jacobian_name(r.sensitivities),
         "status": format!("{:?}", r.status),
         "singular_values": sens.singular_values.iter().map(|s| finite(*s)).collect::<Vec<_>>(),
         "condition": finite(sens.condition),
@@ -325,4 +332,12 @@ fn gap_json(r: &GapFit, written: Option<&str>) -> Value {
         "iterations": r.iterations,
         "out": written,
     })
+}
+
+/// How the fit's Jacobian was obtained.
+fn jacobian_name(s: Sensitivities) -> &'static str {
+    match s {
+        Sensitivities::Analytic => "analytic forward sensitivities",
+        Sensitivities::FiniteDifference => "finite differences of whole replays",
+    }
 }

@@ -88,6 +88,8 @@ fn fit_recovers_resistance_and_saturation_flux_and_writes_the_model() {
     // here as one-sample ramps: 0.5 % on R, 1 % on φ_sat.
     assert!((r / 75.0 - 1.0).abs() < 5e-3, "{v}");
     assert!((phi_sat / 2e-5 - 1.0).abs() < 1e-2, "{v}");
+    // R and φ_sat enter the model's field: the Jacobian is analytic.
+    assert_eq!(v["jacobian"], "analytic forward sensitivities", "{v}");
     let before = v["wnrmse_current_before"].as_f64().unwrap();
     let after = v["wnrmse_current"].as_f64().unwrap();
     // The error left is the edges' jump-versus-ramp mismatch, where |φ̇| (the
