@@ -466,6 +466,33 @@ fn doc_attrs(text: &str) -> TokenStream {
     out
 }
 
+/// The `Filter` struct both filters keep (prior mean and covariance, the
+/// last finite input, skip and repair counters) and its `Default`.
+fn filter_struct(which: &str, ty: &Ident, dim: &Literal, time_field: &TokenStream) -> TokenStream {
+    let doc = format!(" {which} Kalman filter (see the module docs). Allocation- and panic-free.");
+    quote! {
+        #[doc = #doc]
+        #[derive(Clone, Debug, PartialEq)]
+        pub struct Filter {
+            /// Prior mean x_{k|k−1}.
+            x: [#ty; #dim],
+            /// Prior covariance.
+            p: [[#ty; #dim]; #dim],
+            /// The last finite input.
+            u_last: #ty,
+            #time_field
+            skipped: u32,
+            repairs: u32,
+        }
+
+        impl Default for Filter {
+            fn default() -> Self {
+                Self::new()
+            }
+        }
+    }
+}
+
 /// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.
 fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<String, ObserverError> {
     let dm = input.discrete;
@@ -903,26 +930,9 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
             let h = vector_tokens(&layout.h_row, &mo, float)?;
             let dy_du = format_ident!("d{}_du", layout.y);
             let (n0, n1) = (&next_fields[0], &next_fields[1]);
+            let filter_struct = filter_struct("The extended", &ty, &dim, &time_field);
             quote! {
-                /// The extended Kalman filter (see the module docs). Allocation- and panic-free.
-                #[derive(Clone, Debug, PartialEq)]
-                pub struct Filter {
-                    /// Prior mean x_{k|k−1}.
-                    x: [#ty; #dim],
-                    /// Prior covariance.
-                    p: [[#ty; #dim]; #dim],
-                    /// The last finite input.
-                    u_last: #ty,
-                    #time_field
-                    skipped: u32,
-                    repairs: u32,
-                }
-
-                impl Default for Filter {
-                    fn default() -> Self {
-                        Self::new()
-                    }
-                }
+                #filter_struct
 
                 impl Filter {
                     /// A filter at rest at z_max with φ = 0 (and H_c = 0): x₀, P₀.
@@ -1010,26 +1020,9 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
                     quote!(#v)
                 })
                 .collect();
+            let filter_struct = filter_struct("The unscented", &ty, &dim, &time_field);
             quote! {
-                /// The unscented Kalman filter (see the module docs). Allocation- and panic-free.
-                #[derive(Clone, Debug, PartialEq)]
-                pub struct Filter {
-                    /// Prior mean x_{k|k−1}.
-                    x: [#ty; #dim],
-                    /// Prior covariance.
-                    p: [[#ty; #dim]; #dim],
-                    /// The last finite input.
-                    u_last: #ty,
-                    #time_field
-                    skipped: u32,
-                    repairs: u32,
-                }
-
-                impl Default for Filter {
-                    fn default() -> Self {
-                        Self::new()
-                    }
-                }
+                #filter_struct
 
                 /// Weight of sigma point `k` in means.
                 fn weight_mean(k: usize) -> #ty {
