@@ -13,6 +13,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use designer::description::edit::{annotate, write_physics};
+use designer::description::Description;
 use designer::diagnose::localise::{localise, Localisation, Signals};
 use designer::diagnose::{diagnose, Cause, Diagnosis, Options};
 use designer::identify::{flux_from_data, Measured, SimOutputs};
@@ -125,8 +126,6 @@ fn extended_toml(description: &Description, d: &Diagnosis) -> Result<String, Rep
     );
     Ok(annotate(&text, &header))
 }
-
-use designer::description::Description;
 
 fn signals<'a>(
     d: &'a Diagnosis,

@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use designer::description::edit::write_physics;
 use designer::description::{parse_str, Core, Description, Gap, JilesAtherton};
 use designer::diagnose::Cause;
+use designer::identify::wnrmse;
 use designer::model::{Model, Statics, MU0};
 use designer::replay::{replay, Replay};
 use designer::sim::{EventKind, Limit, Options, PiecewiseLinear};
@@ -643,13 +644,4 @@ pub fn visibility(case: &HiddenCase) -> Visibility {
         baseline_wnrmse: error(&base),
         noise_wnrmse: error(&case.truth),
     }
-}
-
-/// (81) wNRMSE = √(Σ w·(sim − meas)² / Σ w·meas²).
-pub fn wnrmse(sim: &[f64], meas: &[f64], w: &[f64]) -> f64 {
-    let num: f64 = (0..meas.len())
-        .map(|k| w[k] * (sim[k] - meas[k]).powi(2))
-        .sum();
-    let den: f64 = (0..meas.len()).map(|k| w[k] * meas[k] * meas[k]).sum();
-    (num / den).sqrt()
 }
