@@ -273,6 +273,8 @@ struct Layout {
     y: String,
     transition: Function,
     measurement: Function,
+    /// f_v of (87) alone, for the estimate at the posterior.
+    acceleration: Function,
     /// UKF: g = ∂F/∂u (none if every entry is constant).
     input_gain: Option<Function>,
     /// ∂F/∂x (EKF), from `transition`.
@@ -409,11 +411,23 @@ impl Layout {
             .to_owned(),
             outputs: m_outputs,
         };
+        let acceleration = Function {
+            name: "acceleration",
+            doc: "The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the\n\
+                  estimate's a, at the posterior."
+                .to_owned(),
+            outputs: vec![(
+                "accel".to_owned(),
+                dm.acceleration,
+                "(87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)".to_owned(),
+            )],
+        };
         Layout {
             n,
             y,
             transition,
             measurement,
+            acceleration,
             input_gain,
             jacobian,
             gain,
@@ -466,7 +480,7 @@ fn doc_attrs(text: &str) -> TokenStream {
     out
 }
 
-/// The `Filter` struct both filters keep (prior mean and covariance, the
+/// The `Filter` struct both filters keep (posterior mean and covariance, the
 /// last finite input, skip and repair counters) and its `Default`.
 fn filter_struct(which: &str, ty: &Ident, dim: &Literal, time_field: &TokenStream) -> TokenStream {
     let doc = format!(" {which} Kalman filter (see the module docs). Allocation- and panic-free.");
@@ -474,9 +488,9 @@ fn filter_struct(which: &str, ty: &Ident, dim: &Literal, time_field: &TokenStrea
         #[doc = #doc]
         #[derive(Clone, Debug, PartialEq)]
         pub struct Filter {
-            /// Prior mean x_{k|k−1}.
+            /// Posterior mean x_{k|k} of the last sample (x₀ before the first).
             x: [#ty; #dim],
-            /// Prior covariance.
+            /// Its covariance.
             p: [[#ty; #dim]; #dim],
             /// The last finite input.
             u_last: #ty,
@@ -705,7 +719,11 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
     }
 
     // ---- model functions
-    let mut functions = vec![&layout.transition, &layout.measurement];
+    let mut functions = vec![
+        &layout.transition,
+        &layout.measurement,
+        &layout.acceleration,
+    ];
     if let Some(f) = &layout.input_gain {
         functions.push(f);
     }
@@ -721,14 +739,15 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
     let time_arg = if dm.uses_time { quote!(, t) } else { quote!() };
     let time_field = if dm.uses_time {
         quote!(
-            /// Time since the start [s] (the model depends on it through the resistance drift).
+            /// Time of the last posterior [s] from the first sample (−T_s before it; the model
+            /// depends on it through the resistance drift).
             time: #ty,
         )
     } else {
         quote!()
     };
     let time_init = if dm.uses_time {
-        quote!(time: 0.0,)
+        quote!(time: -T_S,)
     } else {
         quote!()
     };
@@ -773,11 +792,13 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
         "the measured coil current [A]"
     };
     let step_doc = doc_attrs(&format!(
-        "One sample k: `u` is {u_doc} (the input u_k, held over the coming\n\
-         sample), `{}` is {y_doc}, both at t_k. Updates the prior with the\n\
-         measurement, returns the posterior estimate and predicts the next prior. A\n\
-         non-finite `u` is replaced by the last finite one and its update skipped; a\n\
-         non-finite measurement skips the update.",
+        "One sample k: `u` is {u_doc} held over the last sample (u_{{k−1}}, what\n\
+         was applied since the previous call), `{}` is {y_doc} at t_k. Predicts\n\
+         the prior from the last posterior with u, updates it with the measurement and\n\
+         returns the posterior estimate, so that the controller acts on an estimate\n\
+         without lag and the prediction uses the input actually applied. A non-finite\n\
+         `u` is replaced by the last finite one and its update skipped; a non-finite\n\
+         measurement skips the update.",
         layout.y
     ));
     let rest_pattern: Vec<TokenStream> = (2..n)
@@ -859,13 +880,13 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
         .collect();
     let next_rest: Vec<TokenStream> = next_fields[2..].to_vec();
     let accessors = quote! {
-        /// The prior mean x_{k+1|k} (after the last `step`).
+        /// The posterior mean x_{k|k} (after the last `step`).
         #[must_use]
         pub const fn state(&self) -> [#ty; #dim] {
             self.x
         }
 
-        /// The prior covariance.
+        /// The posterior covariance.
         #[must_use]
         pub const fn covariance(&self) -> [[#ty; #dim]; #dim] {
             self.p
@@ -877,13 +898,14 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
             self.skipped
         }
     };
-    // The estimate (85)–(87) with the predicted acceleration `accel`.
-    let estimate_of = |accel: TokenStream| {
+    // The estimate (85)–(87) at the posterior.
+    let estimate = {
         quote! {
+            let a = acceleration(#(#names),*, u #time_arg).accel;
             Estimate {
                 z,
                 v: (z - z_prev) / T_S,
-                a: if mode == 2 { #accel } else { 0.0 },
+                a: if mode == 2 { a } else { 0.0 },
                 phi,
                 #hc_init
                 #r_init
@@ -891,8 +913,6 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
             }
         }
     };
-    let estimate_value = estimate_of(quote!(o.accel));
-    let estimate_ukf = estimate_of(quote!(accel));
     // The predicted prior if finite, else a restart from (x₀, P₀), counted.
     let accept = |next: TokenStream| {
         quote! {
@@ -951,6 +971,24 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
                     #step_doc
                     pub fn step(&mut self, u: #ty, #y: #ty) -> Estimate {
                         #head
+                        let [#(#names),*] = self.x;
+                        let o = transition(#(#names),*, u #time_arg);
+                        let resting = resting_stop(mode_of(z), o.accel, o.z_next);
+                        let (next, f) = match resting {
+                            Some(stop) => (
+                                [stop, #n1, #(#next_rest),*],
+                                [[0.0; #dim], #j1, #(#jac_rest),*],
+                            ),
+                            None => (
+                                [#n0, #n1, #(#next_rest),*],
+                                [#j0, #j1, #(#jac_rest),*],
+                            ),
+                        };
+                        let mut p = linalg::sandwich(&f, &self.p);
+                        p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
+                        linalg::rank1_update(&mut p, INPUT_VARIANCE, &#gain);
+                        #accept_next
+                        #time_let
                         let mut updated = false;
                         if u_ok && #y.is_finite() {
                             let [#(#names),*] = self.x;
@@ -974,24 +1012,7 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
                         let (z, z_prev) = (project(z), project(z_prev));
                         self.x = [z, z_prev, #(#rest_pattern),*];
                         let mode = mode_of(z);
-                        let o = transition(#(#names),*, u #time_arg);
-                        let resting = resting_stop(mode, o.accel, o.z_next);
-                        let (next, f) = match resting {
-                            Some(stop) => (
-                                [stop, #n1, #(#next_rest),*],
-                                [[0.0; #dim], #j1, #(#jac_rest),*],
-                            ),
-                            None => (
-                                [#n0, #n1, #(#next_rest),*],
-                                [#j0, #j1, #(#jac_rest),*],
-                            ),
-                        };
-                        let estimate = #estimate_value;
-                        let mut p = linalg::sandwich(&f, &self.p);
-                        p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
-                        linalg::rank1_update(&mut p, INPUT_VARIANCE, &#gain);
-                        #accept_next
-                        estimate
+                        #estimate
                     }
 
                     #accessors
@@ -1075,6 +1096,34 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
                     #step_doc
                     pub fn step(&mut self, u: #ty, #y: #ty) -> Estimate {
                         #head
+                        let l = self.factor();
+                        let pts: [[#ty; #dim]; #m_lit] = linalg::sigma_points(&self.x, &l, GAMMA);
+                        let mut next = pts;
+                        let mut accel = 0.0;
+                        let mut z_next = 0.0;
+                        for (k, (nk, pt)) in next.iter_mut().zip(&pts).enumerate() {
+                            let [#(#names),*] = *pt;
+                            let o = transition(#(#names),*, u #time_arg);
+                            *nk = [#(#next_fields),*];
+                            if k == 0 {
+                                accel = o.accel;
+                                z_next = o.z_next;
+                            }
+                        }
+                        let [z_post, ..] = self.x;
+                        if let Some(stop) = resting_stop(mode_of(z_post), accel, z_next) {
+                            for nk in next.iter_mut() {
+                                let [_, #(#rest_next_pattern),*] = *nk;
+                                *nk = [stop, #(#rest_next_pattern),*];
+                            }
+                        }
+                        let mean = linalg::weighted_mean(&next, WEIGHT_MEAN0, WEIGHT);
+                        let mut p = linalg::weighted_covariance(&next, &mean, WEIGHT_COV0, WEIGHT);
+                        p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
+                        #gain_call
+                        linalg::rank1_update(&mut p, INPUT_VARIANCE, &#gain);
+                        #accept_mean
+                        #time_let
                         let mut updated = false;
                         if u_ok && #y.is_finite() {
                             let l = self.factor();
@@ -1116,34 +1165,7 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
                         let (z, z_prev) = (project(z), project(z_prev));
                         self.x = [z, z_prev, #(#rest_pattern),*];
                         let mode = mode_of(z);
-                        let l = self.factor();
-                        let pts: [[#ty; #dim]; #m_lit] = linalg::sigma_points(&self.x, &l, GAMMA);
-                        let mut next = pts;
-                        let mut accel = 0.0;
-                        let mut z_next = 0.0;
-                        for (k, (nk, pt)) in next.iter_mut().zip(&pts).enumerate() {
-                            let [#(#names),*] = *pt;
-                            let o = transition(#(#names),*, u #time_arg);
-                            *nk = [#(#next_fields),*];
-                            if k == 0 {
-                                accel = o.accel;
-                                z_next = o.z_next;
-                            }
-                        }
-                        if let Some(stop) = resting_stop(mode, accel, z_next) {
-                            for nk in next.iter_mut() {
-                                let [_, #(#rest_next_pattern),*] = *nk;
-                                *nk = [stop, #(#rest_next_pattern),*];
-                            }
-                        }
-                        let estimate = #estimate_ukf;
-                        let mean = linalg::weighted_mean(&next, WEIGHT_MEAN0, WEIGHT);
-                        let mut p = linalg::weighted_covariance(&next, &mean, WEIGHT_COV0, WEIGHT);
-                        p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
-                        #gain_call
-                        linalg::rank1_update(&mut p, INPUT_VARIANCE, &#gain);
-                        #accept_mean
-                        estimate
+                        #estimate
                     }
 
                     #accessors
@@ -1228,6 +1250,10 @@ fn step_comments(kind: Kind) -> Vec<(&'static str, &'static str)> {
             "on a stop, or reaching it (f_v into it): the prediction keeps z = the stop",
         ),
         (
+            "let a = acceleration(",
+            "the estimate (85)–(87) at the posterior",
+        ),
+        (
             "if let Some(stop) = resting_stop(",
             "on a stop, or reaching it (f_v into it): every point keeps z = the stop",
         ),
@@ -1235,12 +1261,14 @@ fn step_comments(kind: Kind) -> Vec<(&'static str, &'static str)> {
     match kind {
         Kind::Ekf => c.push((
             "let o = transition(",
-            "prediction (84) with u held over the sample: x = F(x, u), P = F_x·P·F_xᵀ + Q",
+            "prediction (84) from the last posterior with u held over the last sample:\n\
+             x = F(x, u), P = F_x·P·F_xᵀ + Q",
         )),
         Kind::Ukf => {
             c.push((
                 "let mut next = pts;",
-                "prediction: the posterior's sigma points through (84), u held over the sample",
+                "prediction: the last posterior's sigma points through (84), u held over the\n\
+                 last sample",
             ));
             c.push((
                 "linalg::rank1_update(&mut p, INPUT_VARIANCE,",

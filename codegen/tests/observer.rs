@@ -117,7 +117,10 @@ impl Rng {
 /// `holes`, a few samples are NaN (u, i or both).
 fn record(d: &Description, t_end: f64, holes: bool) -> Vec<(f64, f64)> {
     let mut model = Model::build(d);
-    let k = |t: f64| (t / TS).round() * TS;
+    // switching just after the sample: u_k of the record is the voltage held
+    // over the sample ending at t_k (the filters' convention) and the current
+    // at t_k is the one before the switch
+    let k = |t: f64| (t / TS).round() * TS * (1.0 + 1e-9);
     let input = PiecewiseLinear::steps(&[
         (0.0, 24.0),
         (k(6e-3), 0.0),

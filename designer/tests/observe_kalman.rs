@@ -234,7 +234,10 @@ struct Record {
 /// at z_max. Breakpoints on the sample grid (the filters' zero-order hold).
 fn valve_record(d: &Description, ts: f64, t_end: f64, seed: u64) -> Record {
     let mut model = Model::build(d);
-    let k = |t: f64| (t / ts).round() * ts;
+    // switching just after the sample: u_k of the record is the voltage held
+    // over the sample ending at t_k (the filters' convention) and the current
+    // at t_k is the one before the switch
+    let k = |t: f64| (t / ts).round() * ts * (1.0 + 1e-9);
     // with current drive the input is the coil current: 0.35 A closes the
     // perfect-tracking valve
     let current_drive = d.supply.drive == Drive::Current;

@@ -2314,6 +2314,39 @@ pub mod ekf {
             }
         }
 
+        /// Outputs of [`acceleration`].
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct AccelerationOutput {
+            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+            pub accel: f32,
+        }
+
+        /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
+        /// estimate's a, at the posterior.
+        #[inline]
+        #[must_use]
+        pub fn acceleration(z: f32, z_prev: f32, phi: f32, _u: f32) -> AccelerationOutput {
+            use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f32 = 223.6068;
+            let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
+            let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
+            let inv_a_gap = 1.0_f32 / A_GAP;
+            let t0 = 1.0_f32 / (min + 1e-9_f32);
+            let ln = Real::ln(2.0_f32 * L_W * t0);
+            let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f32;
+            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+            let accel = 1.0_f32 / M
+                * (-(F0 + K_S * min + C / T_S * (z - z_prev))
+                    - 0.5_f32 * (min_2 * min_2)
+                        * (795774.7_f32 * inv_a_gap / t1
+                            - 795774.7_f32 * inv_a_gap * min
+                                * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
+                                / (t1 * t1)));
+            AccelerationOutput { accel }
+        }
+
         /// The estimate at one sample: what the controllers consume.
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Estimate {
@@ -2360,9 +2393,9 @@ pub mod ekf {
         /// The extended Kalman filter (see the module docs). Allocation- and panic-free.
         #[derive(Clone, Debug, PartialEq)]
         pub struct Filter {
-            /// Prior mean x_{k|k−1}.
+            /// Posterior mean x_{k|k} of the last sample (x₀ before the first).
             x: [f32; 3],
-            /// Prior covariance.
+            /// Its covariance.
             p: [[f32; 3]; 3],
             /// The last finite input.
             u_last: f32,
@@ -2389,11 +2422,13 @@ pub mod ekf {
                 }
             }
 
-            /// One sample k: `u` is the measured coil voltage [V] (the input u_k, held over the coming
-            /// sample), `i` is the measured coil current [A], both at t_k. Updates the prior with the
-            /// measurement, returns the posterior estimate and predicts the next prior. A
-            /// non-finite `u` is replaced by the last finite one and its update skipped; a
-            /// non-finite measurement skips the update.
+            /// One sample k: `u` is the measured coil voltage [V] held over the last sample (u_{k−1}, what
+            /// was applied since the previous call), `i` is the measured coil current [A] at t_k. Predicts
+            /// the prior from the last posterior with u, updates it with the measurement and
+            /// returns the posterior estimate, so that the controller acts on an estimate
+            /// without lag and the prediction uses the input actually applied. A non-finite
+            /// `u` is replaced by the last finite one and its update skipped; a non-finite
+            /// measurement skips the update.
             pub fn step(&mut self, u: f32, i: f32) -> Estimate {
                 let u_ok = u.is_finite();
                 if u_ok {
@@ -2401,6 +2436,42 @@ pub mod ekf {
                 }
                 // a non-finite input is replaced by the last finite one (and its update skipped)
                 let u = self.u_last;
+                let [z, z_prev, phi] = self.x;
+                // prediction (84) from the last posterior with u held over the last sample:
+                // x = F(x, u), P = F_x·P·F_xᵀ + Q
+                let o = transition(z, z_prev, phi, u);
+                // on a stop, or reaching it (f_v into it): the prediction keeps z = the stop
+                let resting = resting_stop(mode_of(z), o.accel, o.z_next);
+                let (next, f) = match resting {
+                    Some(stop) => {
+                        (
+                            [stop, o.zp_next, o.phi_next],
+                            [[0.0; 3], [o.dzp_dz, 0.0, 0.0], [o.dphi_dz, 0.0, o.dphi_dphi]],
+                        )
+                    }
+                    None => {
+                        (
+                            [o.z_next, o.zp_next, o.phi_next],
+                            [
+                                [o.dz_dz, o.dz_dzp, o.dz_dphi],
+                                [o.dzp_dz, 0.0, 0.0],
+                                [o.dphi_dz, 0.0, o.dphi_dphi],
+                            ],
+                        )
+                    }
+                };
+                let mut p = linalg::sandwich(&f, &self.p);
+                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
+                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, o.dphi_du]);
+                if linalg::all_finite(&next) && linalg::all_finite_matrix(&p) {
+                    self.x = next;
+                    self.p = p;
+                } else {
+                    // a non-finite prediction: restart from x₀, P₀ (counted)
+                    self.x = INITIAL_STATE;
+                    self.p = INITIAL_COVARIANCE;
+                    self.repairs = self.repairs.saturating_add(1);
+                }
                 // Measurement update, Joseph form (symmetric and positive semi-definite for any
                 // rounding of the gain). Skipped when u, the measurement, the innovation
                 // variance or the innovation is not finite: a NaN or ∞ never enters the state
@@ -2429,57 +2500,24 @@ pub mod ekf {
                 let (z, z_prev) = (project(z), project(z_prev));
                 self.x = [z, z_prev, phi];
                 let mode = mode_of(z);
-                // prediction (84) with u held over the sample: x = F(x, u), P = F_x·P·F_xᵀ + Q
-                let o = transition(z, z_prev, phi, u);
-                // on a stop, or reaching it (f_v into it): the prediction keeps z = the stop
-                let resting = resting_stop(mode, o.accel, o.z_next);
-                let (next, f) = match resting {
-                    Some(stop) => {
-                        (
-                            [stop, o.zp_next, o.phi_next],
-                            [[0.0; 3], [o.dzp_dz, 0.0, 0.0], [o.dphi_dz, 0.0, o.dphi_dphi]],
-                        )
-                    }
-                    None => {
-                        (
-                            [o.z_next, o.zp_next, o.phi_next],
-                            [
-                                [o.dz_dz, o.dz_dzp, o.dz_dphi],
-                                [o.dzp_dz, 0.0, 0.0],
-                                [o.dphi_dz, 0.0, o.dphi_dphi],
-                            ],
-                        )
-                    }
-                };
-                let estimate = Estimate {
+                // the estimate (85)–(87) at the posterior
+                let a = acceleration(z, z_prev, phi, u).accel;
+                Estimate {
                     z,
                     v: (z - z_prev) / T_S,
-                    a: if mode == 2 { o.accel } else { 0.0 },
+                    a: if mode == 2 { a } else { 0.0 },
                     phi,
                     mode,
-                };
-                let mut p = linalg::sandwich(&f, &self.p);
-                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
-                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, o.dphi_du]);
-                if linalg::all_finite(&next) && linalg::all_finite_matrix(&p) {
-                    self.x = next;
-                    self.p = p;
-                } else {
-                    // a non-finite prediction: restart from x₀, P₀ (counted)
-                    self.x = INITIAL_STATE;
-                    self.p = INITIAL_COVARIANCE;
-                    self.repairs = self.repairs.saturating_add(1);
                 }
-                estimate
             }
 
-            /// The prior mean x_{k+1|k} (after the last `step`).
+            /// The posterior mean x_{k|k} (after the last `step`).
             #[must_use]
             pub const fn state(&self) -> [f32; 3] {
                 self.x
             }
 
-            /// The prior covariance.
+            /// The posterior covariance.
             #[must_use]
             pub const fn covariance(&self) -> [[f32; 3]; 3] {
                 self.p
@@ -2813,6 +2851,39 @@ pub mod ekf {
             }
         }
 
+        /// Outputs of [`acceleration`].
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct AccelerationOutput {
+            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+            pub accel: f64,
+        }
+
+        /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
+        /// estimate's a, at the posterior.
+        #[inline]
+        #[must_use]
+        pub fn acceleration(z: f64, z_prev: f64, phi: f64, _u: f64) -> AccelerationOutput {
+            use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
+            let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
+            let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
+            let inv_a_gap = 1.0_f64 / A_GAP;
+            let t0 = 1.0_f64 / (min + 1e-9_f64);
+            let ln = Real::ln(2.0_f64 * L_W * t0);
+            let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f64;
+            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+            let accel = 1.0_f64 / M
+                * (-(F0 + K_S * min + C / T_S * (z - z_prev))
+                    - 0.5_f64 * (min_2 * min_2)
+                        * (795774.7154594767_f64 * inv_a_gap / t1
+                            - 795774.7154594767_f64 * inv_a_gap * min
+                                * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
+                                / (t1 * t1)));
+            AccelerationOutput { accel }
+        }
+
         /// The estimate at one sample: what the controllers consume.
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Estimate {
@@ -2859,9 +2930,9 @@ pub mod ekf {
         /// The extended Kalman filter (see the module docs). Allocation- and panic-free.
         #[derive(Clone, Debug, PartialEq)]
         pub struct Filter {
-            /// Prior mean x_{k|k−1}.
+            /// Posterior mean x_{k|k} of the last sample (x₀ before the first).
             x: [f64; 3],
-            /// Prior covariance.
+            /// Its covariance.
             p: [[f64; 3]; 3],
             /// The last finite input.
             u_last: f64,
@@ -2888,11 +2959,13 @@ pub mod ekf {
                 }
             }
 
-            /// One sample k: `u` is the measured coil voltage [V] (the input u_k, held over the coming
-            /// sample), `i` is the measured coil current [A], both at t_k. Updates the prior with the
-            /// measurement, returns the posterior estimate and predicts the next prior. A
-            /// non-finite `u` is replaced by the last finite one and its update skipped; a
-            /// non-finite measurement skips the update.
+            /// One sample k: `u` is the measured coil voltage [V] held over the last sample (u_{k−1}, what
+            /// was applied since the previous call), `i` is the measured coil current [A] at t_k. Predicts
+            /// the prior from the last posterior with u, updates it with the measurement and
+            /// returns the posterior estimate, so that the controller acts on an estimate
+            /// without lag and the prediction uses the input actually applied. A non-finite
+            /// `u` is replaced by the last finite one and its update skipped; a non-finite
+            /// measurement skips the update.
             pub fn step(&mut self, u: f64, i: f64) -> Estimate {
                 let u_ok = u.is_finite();
                 if u_ok {
@@ -2900,6 +2973,42 @@ pub mod ekf {
                 }
                 // a non-finite input is replaced by the last finite one (and its update skipped)
                 let u = self.u_last;
+                let [z, z_prev, phi] = self.x;
+                // prediction (84) from the last posterior with u held over the last sample:
+                // x = F(x, u), P = F_x·P·F_xᵀ + Q
+                let o = transition(z, z_prev, phi, u);
+                // on a stop, or reaching it (f_v into it): the prediction keeps z = the stop
+                let resting = resting_stop(mode_of(z), o.accel, o.z_next);
+                let (next, f) = match resting {
+                    Some(stop) => {
+                        (
+                            [stop, o.zp_next, o.phi_next],
+                            [[0.0; 3], [o.dzp_dz, 0.0, 0.0], [o.dphi_dz, 0.0, o.dphi_dphi]],
+                        )
+                    }
+                    None => {
+                        (
+                            [o.z_next, o.zp_next, o.phi_next],
+                            [
+                                [o.dz_dz, o.dz_dzp, o.dz_dphi],
+                                [o.dzp_dz, 0.0, 0.0],
+                                [o.dphi_dz, 0.0, o.dphi_dphi],
+                            ],
+                        )
+                    }
+                };
+                let mut p = linalg::sandwich(&f, &self.p);
+                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
+                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, o.dphi_du]);
+                if linalg::all_finite(&next) && linalg::all_finite_matrix(&p) {
+                    self.x = next;
+                    self.p = p;
+                } else {
+                    // a non-finite prediction: restart from x₀, P₀ (counted)
+                    self.x = INITIAL_STATE;
+                    self.p = INITIAL_COVARIANCE;
+                    self.repairs = self.repairs.saturating_add(1);
+                }
                 // Measurement update, Joseph form (symmetric and positive semi-definite for any
                 // rounding of the gain). Skipped when u, the measurement, the innovation
                 // variance or the innovation is not finite: a NaN or ∞ never enters the state
@@ -2928,57 +3037,24 @@ pub mod ekf {
                 let (z, z_prev) = (project(z), project(z_prev));
                 self.x = [z, z_prev, phi];
                 let mode = mode_of(z);
-                // prediction (84) with u held over the sample: x = F(x, u), P = F_x·P·F_xᵀ + Q
-                let o = transition(z, z_prev, phi, u);
-                // on a stop, or reaching it (f_v into it): the prediction keeps z = the stop
-                let resting = resting_stop(mode, o.accel, o.z_next);
-                let (next, f) = match resting {
-                    Some(stop) => {
-                        (
-                            [stop, o.zp_next, o.phi_next],
-                            [[0.0; 3], [o.dzp_dz, 0.0, 0.0], [o.dphi_dz, 0.0, o.dphi_dphi]],
-                        )
-                    }
-                    None => {
-                        (
-                            [o.z_next, o.zp_next, o.phi_next],
-                            [
-                                [o.dz_dz, o.dz_dzp, o.dz_dphi],
-                                [o.dzp_dz, 0.0, 0.0],
-                                [o.dphi_dz, 0.0, o.dphi_dphi],
-                            ],
-                        )
-                    }
-                };
-                let estimate = Estimate {
+                // the estimate (85)–(87) at the posterior
+                let a = acceleration(z, z_prev, phi, u).accel;
+                Estimate {
                     z,
                     v: (z - z_prev) / T_S,
-                    a: if mode == 2 { o.accel } else { 0.0 },
+                    a: if mode == 2 { a } else { 0.0 },
                     phi,
                     mode,
-                };
-                let mut p = linalg::sandwich(&f, &self.p);
-                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
-                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, o.dphi_du]);
-                if linalg::all_finite(&next) && linalg::all_finite_matrix(&p) {
-                    self.x = next;
-                    self.p = p;
-                } else {
-                    // a non-finite prediction: restart from x₀, P₀ (counted)
-                    self.x = INITIAL_STATE;
-                    self.p = INITIAL_COVARIANCE;
-                    self.repairs = self.repairs.saturating_add(1);
                 }
-                estimate
             }
 
-            /// The prior mean x_{k+1|k} (after the last `step`).
+            /// The posterior mean x_{k|k} (after the last `step`).
             #[must_use]
             pub const fn state(&self) -> [f64; 3] {
                 self.x
             }
 
-            /// The prior covariance.
+            /// The posterior covariance.
             #[must_use]
             pub const fn covariance(&self) -> [[f64; 3]; 3] {
                 self.p
@@ -3236,6 +3312,39 @@ pub mod ukf {
             MeasurementOutput { i, di_du }
         }
 
+        /// Outputs of [`acceleration`].
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct AccelerationOutput {
+            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+            pub accel: f32,
+        }
+
+        /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
+        /// estimate's a, at the posterior.
+        #[inline]
+        #[must_use]
+        pub fn acceleration(z: f32, z_prev: f32, phi: f32, _u: f32) -> AccelerationOutput {
+            use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f32 = 223.6068;
+            let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
+            let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
+            let inv_a_gap = 1.0_f32 / A_GAP;
+            let t0 = 1.0_f32 / (min + 1e-9_f32);
+            let ln = Real::ln(2.0_f32 * L_W * t0);
+            let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f32;
+            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+            let accel = 1.0_f32 / M
+                * (-(F0 + K_S * min + C / T_S * (z - z_prev))
+                    - 0.5_f32 * (min_2 * min_2)
+                        * (795774.7_f32 * inv_a_gap / t1
+                            - 795774.7_f32 * inv_a_gap * min
+                                * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
+                                / (t1 * t1)));
+            AccelerationOutput { accel }
+        }
+
         /// Outputs of [`input_gain`].
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct InputGainOutput {
@@ -3299,9 +3408,9 @@ pub mod ukf {
         /// The unscented Kalman filter (see the module docs). Allocation- and panic-free.
         #[derive(Clone, Debug, PartialEq)]
         pub struct Filter {
-            /// Prior mean x_{k|k−1}.
+            /// Posterior mean x_{k|k} of the last sample (x₀ before the first).
             x: [f32; 3],
-            /// Prior covariance.
+            /// Its covariance.
             p: [[f32; 3]; 3],
             /// The last finite input.
             u_last: f32,
@@ -3362,11 +3471,13 @@ pub mod ukf {
                 INITIAL_FACTOR
             }
 
-            /// One sample k: `u` is the measured coil voltage [V] (the input u_k, held over the coming
-            /// sample), `i` is the measured coil current [A], both at t_k. Updates the prior with the
-            /// measurement, returns the posterior estimate and predicts the next prior. A
-            /// non-finite `u` is replaced by the last finite one and its update skipped; a
-            /// non-finite measurement skips the update.
+            /// One sample k: `u` is the measured coil voltage [V] held over the last sample (u_{k−1}, what
+            /// was applied since the previous call), `i` is the measured coil current [A] at t_k. Predicts
+            /// the prior from the last posterior with u, updates it with the measurement and
+            /// returns the posterior estimate, so that the controller acts on an estimate
+            /// without lag and the prediction uses the input actually applied. A non-finite
+            /// `u` is replaced by the last finite one and its update skipped; a non-finite
+            /// measurement skips the update.
             pub fn step(&mut self, u: f32, i: f32) -> Estimate {
                 let u_ok = u.is_finite();
                 if u_ok {
@@ -3374,6 +3485,46 @@ pub mod ukf {
                 }
                 // a non-finite input is replaced by the last finite one (and its update skipped)
                 let u = self.u_last;
+                let l = self.factor();
+                let pts: [[f32; 3]; 7] = linalg::sigma_points(&self.x, &l, GAMMA);
+                // prediction: the last posterior's sigma points through (84), u held over the
+                // last sample
+                let mut next = pts;
+                let mut accel = 0.0;
+                let mut z_next = 0.0;
+                for (k, (nk, pt)) in next.iter_mut().zip(&pts).enumerate() {
+                    let [z, z_prev, phi] = *pt;
+                    let o = transition(z, z_prev, phi, u);
+                    *nk = [o.z_next, o.zp_next, o.phi_next];
+                    if k == 0 {
+                        accel = o.accel;
+                        z_next = o.z_next;
+                    }
+                }
+                let [z_post, ..] = self.x;
+                // on a stop, or reaching it (f_v into it): every point keeps z = the stop
+                if let Some(stop) = resting_stop(mode_of(z_post), accel, z_next) {
+                    for nk in next.iter_mut() {
+                        let [_, zp, phi] = *nk;
+                        *nk = [stop, zp, phi];
+                    }
+                }
+                let mean = linalg::weighted_mean(&next, WEIGHT_MEAN0, WEIGHT);
+                let mut p = linalg::weighted_covariance(&next, &mean, WEIGHT_COV0, WEIGHT);
+                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
+                let [z, z_prev, phi] = self.x;
+                let gain_out = input_gain(z, z_prev, phi, u);
+                // the input's noise: Q += σ_u²·g·gᵀ, g = ∂F/∂u at the posterior mean
+                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, gain_out.dphi_du]);
+                if linalg::all_finite(&mean) && linalg::all_finite_matrix(&p) {
+                    self.x = mean;
+                    self.p = p;
+                } else {
+                    // a non-finite prediction: restart from x₀, P₀ (counted)
+                    self.x = INITIAL_STATE;
+                    self.p = INITIAL_COVARIANCE;
+                    self.repairs = self.repairs.saturating_add(1);
+                }
                 // Measurement update through the sigma points. Skipped when u, the measurement,
                 // the innovation variance or the innovation is not finite: a NaN or ∞ never
                 // enters the state (where it would stay forever).
@@ -3426,61 +3577,24 @@ pub mod ukf {
                 let (z, z_prev) = (project(z), project(z_prev));
                 self.x = [z, z_prev, phi];
                 let mode = mode_of(z);
-                let l = self.factor();
-                let pts: [[f32; 3]; 7] = linalg::sigma_points(&self.x, &l, GAMMA);
-                // prediction: the posterior's sigma points through (84), u held over the sample
-                let mut next = pts;
-                let mut accel = 0.0;
-                let mut z_next = 0.0;
-                for (k, (nk, pt)) in next.iter_mut().zip(&pts).enumerate() {
-                    let [z, z_prev, phi] = *pt;
-                    let o = transition(z, z_prev, phi, u);
-                    *nk = [o.z_next, o.zp_next, o.phi_next];
-                    if k == 0 {
-                        accel = o.accel;
-                        z_next = o.z_next;
-                    }
-                }
-                // on a stop, or reaching it (f_v into it): every point keeps z = the stop
-                if let Some(stop) = resting_stop(mode, accel, z_next) {
-                    for nk in next.iter_mut() {
-                        let [_, zp, phi] = *nk;
-                        *nk = [stop, zp, phi];
-                    }
-                }
-                let estimate = Estimate {
+                // the estimate (85)–(87) at the posterior
+                let a = acceleration(z, z_prev, phi, u).accel;
+                Estimate {
                     z,
                     v: (z - z_prev) / T_S,
-                    a: if mode == 2 { accel } else { 0.0 },
+                    a: if mode == 2 { a } else { 0.0 },
                     phi,
                     mode,
-                };
-                let mean = linalg::weighted_mean(&next, WEIGHT_MEAN0, WEIGHT);
-                let mut p = linalg::weighted_covariance(&next, &mean, WEIGHT_COV0, WEIGHT);
-                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
-                let [z, z_prev, phi] = self.x;
-                let gain_out = input_gain(z, z_prev, phi, u);
-                // the input's noise: Q += σ_u²·g·gᵀ, g = ∂F/∂u at the posterior mean
-                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, gain_out.dphi_du]);
-                if linalg::all_finite(&mean) && linalg::all_finite_matrix(&p) {
-                    self.x = mean;
-                    self.p = p;
-                } else {
-                    // a non-finite prediction: restart from x₀, P₀ (counted)
-                    self.x = INITIAL_STATE;
-                    self.p = INITIAL_COVARIANCE;
-                    self.repairs = self.repairs.saturating_add(1);
                 }
-                estimate
             }
 
-            /// The prior mean x_{k+1|k} (after the last `step`).
+            /// The posterior mean x_{k|k} (after the last `step`).
             #[must_use]
             pub const fn state(&self) -> [f32; 3] {
                 self.x
             }
 
-            /// The prior covariance.
+            /// The posterior covariance.
             #[must_use]
             pub const fn covariance(&self) -> [[f32; 3]; 3] {
                 self.p
@@ -3736,6 +3850,39 @@ pub mod ukf {
             MeasurementOutput { i, di_du }
         }
 
+        /// Outputs of [`acceleration`].
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct AccelerationOutput {
+            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+            pub accel: f64,
+        }
+
+        /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
+        /// estimate's a, at the posterior.
+        #[inline]
+        #[must_use]
+        pub fn acceleration(z: f64, z_prev: f64, phi: f64, _u: f64) -> AccelerationOutput {
+            use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
+            let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
+            let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
+            let inv_a_gap = 1.0_f64 / A_GAP;
+            let t0 = 1.0_f64 / (min + 1e-9_f64);
+            let ln = Real::ln(2.0_f64 * L_W * t0);
+            let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f64;
+            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+            let accel = 1.0_f64 / M
+                * (-(F0 + K_S * min + C / T_S * (z - z_prev))
+                    - 0.5_f64 * (min_2 * min_2)
+                        * (795774.7154594767_f64 * inv_a_gap / t1
+                            - 795774.7154594767_f64 * inv_a_gap * min
+                                * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
+                                / (t1 * t1)));
+            AccelerationOutput { accel }
+        }
+
         /// Outputs of [`input_gain`].
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct InputGainOutput {
@@ -3799,9 +3946,9 @@ pub mod ukf {
         /// The unscented Kalman filter (see the module docs). Allocation- and panic-free.
         #[derive(Clone, Debug, PartialEq)]
         pub struct Filter {
-            /// Prior mean x_{k|k−1}.
+            /// Posterior mean x_{k|k} of the last sample (x₀ before the first).
             x: [f64; 3],
-            /// Prior covariance.
+            /// Its covariance.
             p: [[f64; 3]; 3],
             /// The last finite input.
             u_last: f64,
@@ -3862,11 +4009,13 @@ pub mod ukf {
                 INITIAL_FACTOR
             }
 
-            /// One sample k: `u` is the measured coil voltage [V] (the input u_k, held over the coming
-            /// sample), `i` is the measured coil current [A], both at t_k. Updates the prior with the
-            /// measurement, returns the posterior estimate and predicts the next prior. A
-            /// non-finite `u` is replaced by the last finite one and its update skipped; a
-            /// non-finite measurement skips the update.
+            /// One sample k: `u` is the measured coil voltage [V] held over the last sample (u_{k−1}, what
+            /// was applied since the previous call), `i` is the measured coil current [A] at t_k. Predicts
+            /// the prior from the last posterior with u, updates it with the measurement and
+            /// returns the posterior estimate, so that the controller acts on an estimate
+            /// without lag and the prediction uses the input actually applied. A non-finite
+            /// `u` is replaced by the last finite one and its update skipped; a non-finite
+            /// measurement skips the update.
             pub fn step(&mut self, u: f64, i: f64) -> Estimate {
                 let u_ok = u.is_finite();
                 if u_ok {
@@ -3874,6 +4023,46 @@ pub mod ukf {
                 }
                 // a non-finite input is replaced by the last finite one (and its update skipped)
                 let u = self.u_last;
+                let l = self.factor();
+                let pts: [[f64; 3]; 7] = linalg::sigma_points(&self.x, &l, GAMMA);
+                // prediction: the last posterior's sigma points through (84), u held over the
+                // last sample
+                let mut next = pts;
+                let mut accel = 0.0;
+                let mut z_next = 0.0;
+                for (k, (nk, pt)) in next.iter_mut().zip(&pts).enumerate() {
+                    let [z, z_prev, phi] = *pt;
+                    let o = transition(z, z_prev, phi, u);
+                    *nk = [o.z_next, o.zp_next, o.phi_next];
+                    if k == 0 {
+                        accel = o.accel;
+                        z_next = o.z_next;
+                    }
+                }
+                let [z_post, ..] = self.x;
+                // on a stop, or reaching it (f_v into it): every point keeps z = the stop
+                if let Some(stop) = resting_stop(mode_of(z_post), accel, z_next) {
+                    for nk in next.iter_mut() {
+                        let [_, zp, phi] = *nk;
+                        *nk = [stop, zp, phi];
+                    }
+                }
+                let mean = linalg::weighted_mean(&next, WEIGHT_MEAN0, WEIGHT);
+                let mut p = linalg::weighted_covariance(&next, &mean, WEIGHT_COV0, WEIGHT);
+                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
+                let [z, z_prev, phi] = self.x;
+                let gain_out = input_gain(z, z_prev, phi, u);
+                // the input's noise: Q += σ_u²·g·gᵀ, g = ∂F/∂u at the posterior mean
+                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, gain_out.dphi_du]);
+                if linalg::all_finite(&mean) && linalg::all_finite_matrix(&p) {
+                    self.x = mean;
+                    self.p = p;
+                } else {
+                    // a non-finite prediction: restart from x₀, P₀ (counted)
+                    self.x = INITIAL_STATE;
+                    self.p = INITIAL_COVARIANCE;
+                    self.repairs = self.repairs.saturating_add(1);
+                }
                 // Measurement update through the sigma points. Skipped when u, the measurement,
                 // the innovation variance or the innovation is not finite: a NaN or ∞ never
                 // enters the state (where it would stay forever).
@@ -3926,61 +4115,24 @@ pub mod ukf {
                 let (z, z_prev) = (project(z), project(z_prev));
                 self.x = [z, z_prev, phi];
                 let mode = mode_of(z);
-                let l = self.factor();
-                let pts: [[f64; 3]; 7] = linalg::sigma_points(&self.x, &l, GAMMA);
-                // prediction: the posterior's sigma points through (84), u held over the sample
-                let mut next = pts;
-                let mut accel = 0.0;
-                let mut z_next = 0.0;
-                for (k, (nk, pt)) in next.iter_mut().zip(&pts).enumerate() {
-                    let [z, z_prev, phi] = *pt;
-                    let o = transition(z, z_prev, phi, u);
-                    *nk = [o.z_next, o.zp_next, o.phi_next];
-                    if k == 0 {
-                        accel = o.accel;
-                        z_next = o.z_next;
-                    }
-                }
-                // on a stop, or reaching it (f_v into it): every point keeps z = the stop
-                if let Some(stop) = resting_stop(mode, accel, z_next) {
-                    for nk in next.iter_mut() {
-                        let [_, zp, phi] = *nk;
-                        *nk = [stop, zp, phi];
-                    }
-                }
-                let estimate = Estimate {
+                // the estimate (85)–(87) at the posterior
+                let a = acceleration(z, z_prev, phi, u).accel;
+                Estimate {
                     z,
                     v: (z - z_prev) / T_S,
-                    a: if mode == 2 { accel } else { 0.0 },
+                    a: if mode == 2 { a } else { 0.0 },
                     phi,
                     mode,
-                };
-                let mean = linalg::weighted_mean(&next, WEIGHT_MEAN0, WEIGHT);
-                let mut p = linalg::weighted_covariance(&next, &mean, WEIGHT_COV0, WEIGHT);
-                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
-                let [z, z_prev, phi] = self.x;
-                let gain_out = input_gain(z, z_prev, phi, u);
-                // the input's noise: Q += σ_u²·g·gᵀ, g = ∂F/∂u at the posterior mean
-                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, gain_out.dphi_du]);
-                if linalg::all_finite(&mean) && linalg::all_finite_matrix(&p) {
-                    self.x = mean;
-                    self.p = p;
-                } else {
-                    // a non-finite prediction: restart from x₀, P₀ (counted)
-                    self.x = INITIAL_STATE;
-                    self.p = INITIAL_COVARIANCE;
-                    self.repairs = self.repairs.saturating_add(1);
                 }
-                estimate
             }
 
-            /// The prior mean x_{k+1|k} (after the last `step`).
+            /// The posterior mean x_{k|k} (after the last `step`).
             #[must_use]
             pub const fn state(&self) -> [f64; 3] {
                 self.x
             }
 
-            /// The prior covariance.
+            /// The posterior covariance.
             #[must_use]
             pub const fn covariance(&self) -> [[f64; 3]; 3] {
                 self.p

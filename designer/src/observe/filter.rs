@@ -1,5 +1,5 @@
 //! What the EKF and the UKF share: the discretised model's constants, the
-//! prior (x, P) with its initial value, the held input, and the steps
+//! posterior (x, P) with its initial value, the held input, and the steps
 //! around the two filters' own algebra — input handling, projection onto
 //! [z_min, z_max] with the estimate (85)–(87), Q added to the predicted
 //! covariance, and the restart from (x₀, P₀) after a non-finite prediction.
@@ -29,9 +29,10 @@ pub(crate) struct FilterCore {
     /// Index of R in the state, if estimated.
     pub r_index: Option<usize>,
     pub uses_time: bool,
-    /// Prior mean x_{k|k−1}.
+    /// Mean: the posterior x_{k|k} between steps, the prior x_{k|k−1}
+    /// between a step's prediction and its update.
     pub x: [f64; 4],
-    /// Prior covariance.
+    /// Its covariance.
     pub p: [[f64; 4]; 4],
     pub u_last: f64,
     pub time: f64,
@@ -39,12 +40,11 @@ pub(crate) struct FilterCore {
     pub repairs: usize,
 }
 
-/// The input of one step: whether the measured u was finite, the u used
-/// (the last finite one) and the time argument of the tapes.
+/// The input of one step: whether the measured u was finite and the u used
+/// (the last finite one).
 pub(crate) struct StepInput {
     pub u_ok: bool,
     pub u: f64,
-    pub t: f64,
 }
 
 /// The posterior after projection: its components and mode (86).
@@ -82,7 +82,8 @@ impl FilterCore {
             x: x0,
             p: p0,
             u_last: 0.0,
-            time: 0.0,
+            // the first step predicts from x₀ at −T_s to the first sample at 0
+            time: -discrete.settings.sample_period,
             skipped: 0,
             repairs: 0,
         }
@@ -98,8 +99,28 @@ impl FilterCore {
         StepInput {
             u_ok,
             u: self.u_last,
-            t: if self.uses_time { self.time } else { 0.0 },
         }
+    }
+
+    /// The time argument of the tapes for the prediction from the last
+    /// posterior (its sample's time).
+    pub fn prediction_time(&self) -> f64 {
+        if self.uses_time {
+            self.time
+        } else {
+            0.0
+        }
+    }
+
+    /// The time argument of the tapes for this sample's update (after
+    /// [`FilterCore::accept`] advanced the clock).
+    pub fn measurement_time(&self) -> f64 {
+        self.prediction_time()
+    }
+
+    /// The mode (86) of the current mean.
+    pub fn mode(&self) -> Mode {
+        mode_of(self.x[0], self.z_min, self.z_max, self.mode_band)
     }
 
     /// R = σ_y² + σ_u²·(∂h/∂u)²: the measurement variance with the input's.

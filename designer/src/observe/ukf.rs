@@ -4,22 +4,23 @@
 //!
 //! Sigma points: χ₀ = x̄, χ_{1+j} = x̄ + γ·Lⱼ, χ_{1+n+j} = x̄ − γ·Lⱼ, where
 //! Lⱼ is column j of the lower Cholesky factor of P and γ, W₀ᵐ, W₀ᶜ, Wᵢ come
-//! from α, β, κ (`KalmanSettings::unscented`). One [`Ukf::step`] at sample k,
-//! with the measured input u_k and output y_k:
+//! from α, β, κ (`KalmanSettings::unscented`). One [`Ukf::step`] at sample
+//! k, with the input u held over the last sample and the output y_k
+//! measured now (see `discrete.rs`, "Timing"):
 //!
-//! 1. update of the prior with y_k: sigma points of (x̄, P), yᵢ = h(χᵢ, u_k),
+//! 1. prediction with u (the last finite input if u is not): sigma points
+//!    of the last posterior through F (84), x̄ = Σ Wᵢᵐ·F(χᵢ),
+//!    P = Σ Wᵢᶜ·(F(χᵢ) − x̄)(F(χᵢ) − x̄)ᵀ + Q, Q as in the EKF (g = ∂F/∂u at
+//!    the posterior mean). At a stop (the posterior mean in mode 1 or 3 or
+//!    (84a) of the mean saturating there, and f_v at the mean into the stop)
+//!    every propagated point gets z = the stop (see `discrete.rs`);
+//! 2. update of the prior with y_k: sigma points of (x̄, P), yᵢ = h(χᵢ, u),
 //!    ŷ = Σ Wᵢᵐ·yᵢ, S = Σ Wᵢᶜ·(yᵢ − ŷ)² + R (R = σ_y² + σ_u²·(∂h/∂u)² at x̄),
 //!    P_xy = Σ Wᵢᶜ·(χᵢ − x̄)·(yᵢ − ŷ), K = P_xy/S, x̄ ← x̄ + K·(y_k − ŷ),
-//!    P ← P − S·K·Kᵀ (exactly symmetric). Skipped (and counted) when u_k,
+//!    P ← P − S·K·Kᵀ (exactly symmetric). Skipped (and counted) when u,
 //!    y_k, S or the innovation is not finite;
-//! 2. projection of z, z_prev onto [z_min, z_max]; the estimate: v (85),
-//!    mode (86), a (87) = f_v at x̄ (the centre sigma point of the prediction);
-//! 3. prediction with u_k held (the last finite input if u_k is not):
-//!    sigma points of the posterior through F (84), x̄ = Σ Wᵢᵐ·F(χᵢ),
-//!    P = Σ Wᵢᶜ·(F(χᵢ) − x̄)(F(χᵢ) − x̄)ᵀ + Q, Q as in the EKF (g = ∂F/∂u at
-//!    the posterior mean). At a stop (mode 1 or 3 or (84a) of the mean
-//!    saturating there, and f_v at the mean into the stop) every propagated
-//!    point gets z = the stop (see `discrete.rs`).
+//! 3. projection of z, z_prev onto [z_min, z_max]; the estimate: v (85),
+//!    mode (86), a (87) = f_v at the posterior mean.
 //!
 //! **Factorisation.** Both steps factor P. When the Cholesky factorisation
 //! fails (P not numerically positive definite), P is repaired: first by
@@ -121,54 +122,26 @@ impl Ukf {
         }
     }
 
-    /// One sample: update with (u, y), report the posterior, predict.
+    /// One sample: predict with u (held over the last sample), update with
+    /// y (measured now), report the posterior.
     pub fn step(&mut self, u: f64, y: f64) -> Estimate {
+        let input = self.core.input(u);
+        let u = input.u;
+        self.predict(u);
+        let t = self.core.measurement_time();
+        let updated = input.u_ok && y.is_finite() && self.update(u, y, t);
+        let post = self.core.project(updated);
+        let c = &mut self.core;
+        let accel = c.tapes.acceleration(&c.x, u, t);
+        c.estimate(&post, accel)
+    }
+
+    /// Prediction: the posterior's sigma points through F (84) with u held
+    /// over the sample; at a stop every point keeps z = the stop.
+    fn predict(&mut self, u: f64) {
         let n = self.core.n;
         let m = 2 * n + 1;
-        let input = self.core.input(u);
-        let (u, t) = (input.u, input.t);
-
-        // measurement update
-        let mut updated = false;
-        if input.u_ok && y.is_finite() {
-            let l = self.factor();
-            let pts = self.sigma_points(&l);
-            let mut ys = [0.0; MAX_POINTS];
-            let mut dy_du = 0.0;
-            for k in 0..m {
-                let e = self.core.tapes.measure(&pts[k], u, t);
-                ys[k] = e.y;
-                if k == 0 {
-                    dy_du = e.dy_du;
-                }
-            }
-            let mut y_mean = 0.0;
-            for k in 0..m {
-                y_mean += self.weight_mean(k) * ys[k];
-            }
-            let mut s = 0.0;
-            for k in 0..m {
-                let d = ys[k] - y_mean;
-                s += self.weight_cov(k) * (d * d);
-            }
-            let s = s + self.core.output_variance(dy_du);
-            let mut pxy = [0.0; 4];
-            for k in 0..m {
-                let dy = self.weight_cov(k) * (ys[k] - y_mean);
-                for i in 0..n {
-                    pxy[i] += (pts[k][i] - self.core.x[i]) * dy;
-                }
-            }
-            if let Some(k) = self.core.correct(y - y_mean, s, &pxy) {
-                dense::rank1_update(n, &mut self.core.p, -s, &k);
-                updated = true;
-            }
-        }
-
-        // projection, the estimate
-        let post = self.core.project(updated);
-
-        // prediction
+        let t = self.core.prediction_time();
         let l = self.factor();
         let pts = self.sigma_points(&l);
         let mut next = [[0.0; 4]; MAX_POINTS];
@@ -182,12 +155,11 @@ impl Ukf {
         }
         // the centre point is the posterior mean
         let c = &self.core;
-        if let Some(stop) = resting_stop(post.mode, accel, next[0][0], c.z_min, c.z_max) {
+        if let Some(stop) = resting_stop(c.mode(), accel, next[0][0], c.z_min, c.z_max) {
             for pt in next.iter_mut().take(m) {
                 pt[0] = stop;
             }
         }
-        let estimate = c.estimate(&post, accel);
         let mut mean = [0.0; 4];
         for k in 0..m {
             dense::axpy(n, &mut mean, self.weight_mean(k), &next[k]);
@@ -202,15 +174,55 @@ impl Ukf {
         let gain = c.tapes.input_gain(&c.x, u, t);
         c.add_process_noise(&mut p, &gain);
         c.accept(mean, p);
-        estimate
     }
 
-    /// The prior mean x_{k+1|k} (first `dim` entries).
+    /// Measurement update of the prior with y; whether it was applied.
+    fn update(&mut self, u: f64, y: f64, t: f64) -> bool {
+        let n = self.core.n;
+        let m = 2 * n + 1;
+        let l = self.factor();
+        let pts = self.sigma_points(&l);
+        let mut ys = [0.0; MAX_POINTS];
+        let mut dy_du = 0.0;
+        for k in 0..m {
+            let e = self.core.tapes.measure(&pts[k], u, t);
+            ys[k] = e.y;
+            if k == 0 {
+                dy_du = e.dy_du;
+            }
+        }
+        let mut y_mean = 0.0;
+        for k in 0..m {
+            y_mean += self.weight_mean(k) * ys[k];
+        }
+        let mut s = 0.0;
+        for k in 0..m {
+            let d = ys[k] - y_mean;
+            s += self.weight_cov(k) * (d * d);
+        }
+        let s = s + self.core.output_variance(dy_du);
+        let mut pxy = [0.0; 4];
+        for k in 0..m {
+            let dy = self.weight_cov(k) * (ys[k] - y_mean);
+            for i in 0..n {
+                pxy[i] += (pts[k][i] - self.core.x[i]) * dy;
+            }
+        }
+        match self.core.correct(y - y_mean, s, &pxy) {
+            Some(k) => {
+                dense::rank1_update(n, &mut self.core.p, -s, &k);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The posterior mean x_{k|k} (first `dim` entries).
     pub fn state(&self) -> [f64; 4] {
         self.core.x
     }
 
-    /// The prior covariance (leading `dim`×`dim` block).
+    /// The posterior covariance (leading `dim`×`dim` block).
     pub fn covariance(&self) -> [[f64; 4]; 4] {
         self.core.p
     }
