@@ -333,6 +333,7 @@ impl Design {
             u_max: d.supply.u_max,
             takeoff: trajectory.takeoff,
             landing: trajectory.landing,
+            creep_speed: controller.creep_speed,
             operations: c
                 .operations
                 .iter()

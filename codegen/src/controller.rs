@@ -23,8 +23,9 @@
 //!   monotonically (lookup with `.get()`);
 //! - after t_f: ξ_r = [z_f + (z_f − z₀)·(PRESS + CREEP·(t − t_f)), (z_f − z₀)·CREEP, 0],
 //!   a reference just beyond the end stop (10⁻⁶ of the stroke) that keeps
-//!   creeping beyond it (at 2.5·10⁻³ stroke per motion time, 0.5 mm/s for a 1 mm
-//!   stroke in 5 ms; up to `CREEP_MAX` = 5 % of the stroke), so the loop
+//!   creeping beyond it (at `[controller] creep_speed`, by default 2.5·10⁻³
+//!   stroke per motion time, 0.5 mm/s for a 1 mm stroke in 5 ms; up to
+//!   `CREEP_MAX` = 5 % of the stroke), so the loop
 //!   closes whatever gap the tracking error left gently (at about λ·gap, tens
 //!   of µm/s) and, when the plant differs from the model so that a
 //!   pure hold would hover short of the stop, still lands (at about the
@@ -72,6 +73,19 @@ const PRESS_FRACTION: f64 = 1e-6;
 const CREEP_FRACTION: f64 = 2.5e-3;
 /// … up to this fraction of the stroke beyond it.
 const CREEP_MAX_FRACTION: f64 = 0.05;
+
+/// CREEP [1/s]: the creep after t_f in strokes per second, from
+/// `creep_speed` [m/s] if given, else [`CREEP_FRACTION`] per motion time.
+fn creep(input: &ControllerInput) -> f64 {
+    let stroke = input
+        .operations
+        .first()
+        .map_or(0.0, |o| (o.zf - o.z0).abs());
+    match input.creep_speed {
+        Some(speed) if stroke > 0.0 => speed / stroke,
+        _ => CREEP_FRACTION / (input.landing - input.takeoff),
+    }
+}
 
 /// Reference samples per segment when searching the smallest flux.
 const FLUX_SAMPLES: usize = 64;
@@ -178,6 +192,8 @@ pub struct ControllerInput<'a> {
     /// t₀, t_f [s] from the operation's start.
     pub takeoff: f64,
     pub landing: f64,
+    /// `[controller] creep_speed` [m/s]; `None`: the default creep.
+    pub creep_speed: Option<f64>,
     pub operations: Vec<OperationTable<'a>>,
     /// Emitted float types, in this order.
     pub floats: Vec<Float>,
@@ -599,7 +615,7 @@ fn float_module(
         ("PHI_GUARD", design.phi_guard, "Guard at φ → 0 [Wb]: where φ ≤ PHI_GUARD the law is not evaluated and u = u_max\n(drives the flux into D₀⁺). 10⁻³ of the smallest flux the reference needs, rounded down."),
         ("LANDED_BAND", design.landed_band, "Distance [m] to the end stop within which the armature counts as in contact\n(expert rules after t_f): 10⁻⁹ of the stroke, rounded down."),
         ("PRESS", PRESS_FRACTION, "After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes\nthe last gap gently and the contact is certain."),
-        ("CREEP", CREEP_FRACTION / (input.landing - input.takeoff), "After t_f the reference creeps on beyond the stop at CREEP·stroke per second [1/s]:\nwhere the plant differs from the model and a pure hold would hover short of the\nstop, the armature still lands, at about that speed."),
+        ("CREEP", creep(input), "After t_f the reference creeps on beyond the stop at CREEP·stroke per second [1/s]:\nwhere the plant differs from the model and a pure hold would hover short of the\nstop, the armature still lands, at about that speed."),
         ("CREEP_MAX", CREEP_MAX_FRACTION, "The creep stops CREEP_MAX·stroke beyond the end stop."),
     ];
     let mut items = TokenStream::new();

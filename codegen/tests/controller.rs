@@ -101,6 +101,7 @@ fn emit_ops(v: &Valve, floats: &[Float], both: bool) -> String {
         u_max: d.supply.u_max,
         takeoff: T0,
         landing: TF,
+        creep_speed: None,
         operations: vec![OperationTable {
             operation: Operation::Closing,
             z0: d.mechanics.z_max,

@@ -422,8 +422,9 @@ fn both_sections_parse_into_the_expected_values() {
             gains: Gains::SettlingTime(1e-3),
             sample_period: 1e-5,
             floats: vec![FloatType::F32, FloatType::F64],
+            creep_speed: None,
         }),
-        "float defaults to both"
+        "float defaults to both, creep_speed to the generator's"
     );
 }
 

@@ -338,6 +338,9 @@ fn report_header() {
 /// seeds and the four corners see `sensorless_report`.
 #[test]
 fn sensorless_loop_lands_on_the_mismatched_plants() {
+    // the design's `creep_speed = 5e-3` [m/s] reaches the emitted CREEP
+    // [strokes/s] (1 mm stroke)
+    assert!((c64::CREEP - 5.0).abs() < 1e-12, "{}", c64::CREEP);
     report_header();
     for (ks, r) in [(1.0, 1.0), (1.1, 0.9), (0.9, 1.1)] {
         for filter in [Filter::GeneratedUkf, Filter::GeneratedEkf] {

@@ -195,6 +195,11 @@ pub struct Controller {
     pub sample_period: f64,
     /// Emitted variants, sorted, no duplicates (default: both).
     pub floats: Vec<FloatType>,
+    /// Speed [m/s] (> 0) at which the reference creeps on beyond the end stop
+    /// after t_f, so that an armature held short of it (a plant that differs
+    /// from the model, a biased estimate) still lands, at about this speed.
+    /// `None`: 2.5·10⁻³ of the stroke per motion time (`codegen`).
+    pub creep_speed: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -36,7 +36,14 @@ const DRIVES: [&str; 2] = ["voltage", "current"];
 const TRAJECTORY_KEYS: [&str; 5] = ["operations", "takeoff", "landing", "shape", "u_bound"];
 const OPERATIONS: [&str; 2] = ["closing", "opening"];
 const SHAPES: [&str; 2] = ["energy-optimal", "polynomial"];
-const CONTROLLER_KEYS: [&str; 5] = ["law", "settling_time", "poles", "sample_period", "float"];
+const CONTROLLER_KEYS: [&str; 6] = [
+    "law",
+    "settling_time",
+    "poles",
+    "sample_period",
+    "float",
+    "creep_speed",
+];
 const LAWS: [&str; 1] = ["feedback-linearization"];
 const FLOATS: [&str; 2] = ["f32", "f64"];
 const OBSERVER_KEYS: [&str; 8] = [
@@ -428,11 +435,13 @@ fn parse_controller(s: &Sect) -> Res<Controller> {
     let gains = parse_gains(s)?;
     let sample_period = s.num("sample_period", Bound::Positive, "s")?;
     let floats = parse_floats(s)?;
+    let creep_speed = s.opt_num("creep_speed", Bound::Positive, "m/s")?;
     Ok(Controller {
         law,
         gains,
         sample_period,
         floats,
+        creep_speed,
     })
 }
 
