@@ -93,11 +93,12 @@ impl Ukf {
         self.l0
     }
 
-    /// The 2n + 1 sigma points of (x, L).
-    fn sigma_points(&self, l: &dense::M4) -> [[f64; 4]; MAX_POINTS] {
+    /// The 2n + 1 sigma points of (x, P), factoring P (see [`Ukf::factor`]).
+    fn sigma_points(&mut self) -> [[f64; 4]; MAX_POINTS] {
+        let l = self.factor();
         let n = self.core.n;
         let mut pts = [self.core.x; MAX_POINTS];
-        let lt = dense::transpose(n, l);
+        let lt = dense::transpose(n, &l);
         let g = self.weights.gamma;
         for j in 0..n {
             dense::axpy(n, &mut pts[1 + j], g, &lt[j]);
@@ -142,8 +143,7 @@ impl Ukf {
         let n = self.core.n;
         let m = 2 * n + 1;
         let t = self.core.prediction_time();
-        let l = self.factor();
-        let pts = self.sigma_points(&l);
+        let pts = self.sigma_points();
         let mut next = [[0.0; 4]; MAX_POINTS];
         let mut accel = 0.0;
         for k in 0..m {
@@ -180,8 +180,7 @@ impl Ukf {
     fn update(&mut self, u: f64, y: f64, t: f64) -> bool {
         let n = self.core.n;
         let m = 2 * n + 1;
-        let l = self.factor();
-        let pts = self.sigma_points(&l);
+        let pts = self.sigma_points();
         let mut ys = [0.0; MAX_POINTS];
         let mut dy_du = 0.0;
         for k in 0..m {
