@@ -901,11 +901,15 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
     // The estimate (85)–(87) at the posterior.
     let estimate = {
         quote! {
-            let a = acceleration(#(#names),*, u #time_arg).accel;
+            let a = if mode == 2 {
+                acceleration(#(#names),*, u #time_arg).accel
+            } else {
+                0.0
+            };
             Estimate {
                 z,
                 v: (z - z_prev) / T_S,
-                a: if mode == 2 { a } else { 0.0 },
+                a,
                 phi,
                 #hc_init
                 #r_init
@@ -1250,8 +1254,8 @@ fn step_comments(kind: Kind) -> Vec<(&'static str, &'static str)> {
             "on a stop, or reaching it (f_v into it): the prediction keeps z = the stop",
         ),
         (
-            "let a = acceleration(",
-            "the estimate (85)–(87) at the posterior",
+            "let a = if mode == 2",
+            "the estimate (85)–(87) at the posterior; f_v of (87) only in mode 2",
         ),
         (
             "if let Some(stop) = resting_stop(",

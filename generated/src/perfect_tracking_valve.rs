@@ -2500,12 +2500,12 @@ pub mod ekf {
                 let (z, z_prev) = (project(z), project(z_prev));
                 self.x = [z, z_prev, phi];
                 let mode = mode_of(z);
-                // the estimate (85)–(87) at the posterior
-                let a = acceleration(z, z_prev, phi, u).accel;
+                // the estimate (85)–(87) at the posterior; f_v of (87) only in mode 2
+                let a = if mode == 2 { acceleration(z, z_prev, phi, u).accel } else { 0.0 };
                 Estimate {
                     z,
                     v: (z - z_prev) / T_S,
-                    a: if mode == 2 { a } else { 0.0 },
+                    a,
                     phi,
                     mode,
                 }
@@ -3037,12 +3037,12 @@ pub mod ekf {
                 let (z, z_prev) = (project(z), project(z_prev));
                 self.x = [z, z_prev, phi];
                 let mode = mode_of(z);
-                // the estimate (85)–(87) at the posterior
-                let a = acceleration(z, z_prev, phi, u).accel;
+                // the estimate (85)–(87) at the posterior; f_v of (87) only in mode 2
+                let a = if mode == 2 { acceleration(z, z_prev, phi, u).accel } else { 0.0 };
                 Estimate {
                     z,
                     v: (z - z_prev) / T_S,
-                    a: if mode == 2 { a } else { 0.0 },
+                    a,
                     phi,
                     mode,
                 }
@@ -3577,12 +3577,12 @@ pub mod ukf {
                 let (z, z_prev) = (project(z), project(z_prev));
                 self.x = [z, z_prev, phi];
                 let mode = mode_of(z);
-                // the estimate (85)–(87) at the posterior
-                let a = acceleration(z, z_prev, phi, u).accel;
+                // the estimate (85)–(87) at the posterior; f_v of (87) only in mode 2
+                let a = if mode == 2 { acceleration(z, z_prev, phi, u).accel } else { 0.0 };
                 Estimate {
                     z,
                     v: (z - z_prev) / T_S,
-                    a: if mode == 2 { a } else { 0.0 },
+                    a,
                     phi,
                     mode,
                 }
@@ -4115,12 +4115,12 @@ pub mod ukf {
                 let (z, z_prev) = (project(z), project(z_prev));
                 self.x = [z, z_prev, phi];
                 let mode = mode_of(z);
-                // the estimate (85)–(87) at the posterior
-                let a = acceleration(z, z_prev, phi, u).accel;
+                // the estimate (85)–(87) at the posterior; f_v of (87) only in mode 2
+                let a = if mode == 2 { acceleration(z, z_prev, phi, u).accel } else { 0.0 };
                 Estimate {
                     z,
                     v: (z - z_prev) / T_S,
-                    a: if mode == 2 { a } else { 0.0 },
+                    a,
                     phi,
                     mode,
                 }

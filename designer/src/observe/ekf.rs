@@ -58,7 +58,7 @@ impl Ekf {
         let u = input.u;
 
         // prediction from the last posterior with u held over the sample
-        let t = c.prediction_time();
+        let t = c.tape_time();
         let mut pred = c.tapes.predict(&c.x, u, t);
         let (mut f, gain) = c.tapes.jacobian(&c.x, u, t);
         if let Some(stop) =
@@ -72,7 +72,7 @@ impl Ekf {
         c.accept(pred.next, p);
 
         // measurement update (skipped when anything is not finite)
-        let t = c.measurement_time();
+        let t = c.tape_time();
         let mut updated = false;
         if input.u_ok && y.is_finite() {
             let m = c.tapes.measure(&c.x, u, t);
@@ -87,8 +87,7 @@ impl Ekf {
 
         // projection onto [z_min, z_max], the estimate
         let post = c.project(updated);
-        let accel = c.tapes.acceleration(&c.x, u, t);
-        c.estimate(&post, accel)
+        c.estimate(&post, u)
     }
 
     /// The posterior mean x_{k|k} (first `dim` entries).

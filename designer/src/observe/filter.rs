@@ -102,20 +102,14 @@ impl FilterCore {
         }
     }
 
-    /// The time argument of the tapes for the prediction from the last
-    /// posterior (its sample's time).
-    pub fn prediction_time(&self) -> f64 {
+    /// The time argument of the tapes: the time of the current mean (the
+    /// last posterior's before [`FilterCore::accept`], this sample's after).
+    pub fn tape_time(&self) -> f64 {
         if self.uses_time {
             self.time
         } else {
             0.0
         }
-    }
-
-    /// The time argument of the tapes for this sample's update (after
-    /// [`FilterCore::accept`] advanced the clock).
-    pub fn measurement_time(&self) -> f64 {
-        self.prediction_time()
     }
 
     /// The mode (86) of the current mean.
@@ -161,16 +155,19 @@ impl FilterCore {
         }
     }
 
-    /// The estimate: v (85), a (87) from the predicted acceleration.
-    pub fn estimate(&self, post: &Posterior, acceleration: f64) -> Estimate {
+    /// The estimate: v (85), a (87) = f_v at the posterior in mode 2 (only
+    /// evaluated there), else 0.
+    pub fn estimate(&mut self, post: &Posterior, u: f64) -> Estimate {
+        let a = if post.mode == Mode::Free {
+            let t = self.tape_time();
+            self.tapes.acceleration(&self.x, u, t)
+        } else {
+            0.0
+        };
         Estimate {
             z: post.z,
             v: (post.z - post.z_prev) / self.ts,
-            a: if post.mode == Mode::Free {
-                acceleration
-            } else {
-                0.0
-            },
+            a,
             phi: post.phi,
             hc: self.has_field.then_some(post.hc),
             r: post.r,

@@ -129,12 +129,10 @@ impl Ukf {
         let input = self.core.input(u);
         let u = input.u;
         self.predict(u);
-        let t = self.core.measurement_time();
+        let t = self.core.tape_time();
         let updated = input.u_ok && y.is_finite() && self.update(u, y, t);
         let post = self.core.project(updated);
-        let c = &mut self.core;
-        let accel = c.tapes.acceleration(&c.x, u, t);
-        c.estimate(&post, accel)
+        self.core.estimate(&post, u)
     }
 
     /// Prediction: the posterior's sigma points through F (84) with u held
@@ -142,7 +140,7 @@ impl Ukf {
     fn predict(&mut self, u: f64) {
         let n = self.core.n;
         let m = 2 * n + 1;
-        let t = self.core.prediction_time();
+        let t = self.core.tape_time();
         let pts = self.sigma_points();
         let mut next = [[0.0; 4]; MAX_POINTS];
         let mut accel = 0.0;
