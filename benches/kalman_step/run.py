@@ -38,6 +38,10 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import callgrind  # noqa: E402  (benches/callgrind.py)
+from callgrind import sh  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 TARGET = os.path.join(ROOT, "target", "kalman_step")
@@ -52,10 +56,6 @@ ROWS = [
     ("base64", "loop without call (f64)"),
     ("base32", "loop without call (f32)"),
 ]
-
-
-def sh(cmd, **kw):
-    return subprocess.run(cmd, check=True, text=True, capture_output=True, **kw)
 
 
 def build():
@@ -84,39 +84,10 @@ def check():
     return ok
 
 
-def self_costs(path):
-    """{file:function: self Ir} of a callgrind output file."""
-    out = sh(["callgrind_annotate", "--threshold=100", "--inclusive=no", "--auto=no", path]).stdout
-    lines = out.splitlines()
-    start = next(i for i, l in enumerate(lines) if l.strip().endswith("file:function")) + 2
-    costs = {}
-    for line in lines[start:]:
-        if line.startswith("---"):
-            break
-        m = re.match(r"^\s*([\d,]+)\s+(?:\([^)]*\)\s+)?(\S.*?)\s*(?:\[.*\])?$", line)
-        if m:
-            file, _, fn = m.group(2).partition(":")
-            fn = re.sub(r"^kalman_step_bench::", "", fn)
-            key = f"{os.path.basename(file)}:{fn}"
-            costs[key] = costs.get(key, 0) + int(m.group(1).replace(",", ""))
-    return costs
-
-
 def instructions(kind, n, work):
     """(Ir per step, {function: self Ir per step}) from the 2N − N difference."""
-    ir, files = [], []
-    for calls in (n, 2 * n):
-        out = os.path.join(work, f"cg.{kind}.{calls}")
-        r = subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
-                            BIN, kind, str(calls), "1"], text=True, capture_output=True)
-        m = re.search(r"Collected\s*:\s*(\d+)", r.stderr)
-        if r.returncode or not m:
-            sys.exit(f"callgrind failed for {kind}:\n{r.stderr}")
-        ir.append(int(m.group(1)))
-        files.append(out)
-    a, b = self_costs(files[0]), self_costs(files[1])
-    per_fn = {f: (b.get(f, 0) - a.get(f, 0)) / n for f in set(a) | set(b)}
-    return (ir[1] - ir[0]) / n, {f: c for f, c in per_fn.items() if c >= 0.5}
+    per_call, files = callgrind.difference(lambda calls: [BIN, kind, str(calls), "1"], n, work, kind)
+    return per_call, callgrind.self_costs_per_call(files, n, r"^kalman_step_bench::")
 
 
 def nanoseconds(n, runs, reps):

@@ -31,6 +31,10 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+import callgrind  # noqa: E402  (benches/callgrind.py)
+from callgrind import sh  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 TARGET = os.path.join(ROOT, "target", "semera_step")
@@ -47,10 +51,6 @@ ROWS = [
 ]
 
 
-def sh(cmd, **kw):
-    return subprocess.run(cmd, check=True, text=True, capture_output=True, **kw)
-
-
 def build():
     print("== build (the first build compiles the designer for build.rs: a few minutes)")
     r = subprocess.run(["cargo", "build", "--release", "--quiet", "--manifest-path",
@@ -60,31 +60,13 @@ def build():
     print(f"  {sh(['rustc', '--version']).stdout.strip()}")
 
 
-def inclusive(path, function):
-    """Inclusive Ir of `function` (a suffix of its path) in a callgrind output; 0 when
-    the function does not appear (inlined into the loop)."""
-    out = sh(["callgrind_annotate", "--threshold=100", "--inclusive=yes", "--auto=no", path]).stdout
-    total = 0
-    for line in out.splitlines():
-        m = re.match(r"^\s*([\d,]+)\s+(?:\([^)]*\)\s+)?(\S.*?)\s*(?:\[.*\])?$", line)
-        if m and m.group(2).partition(":")[2].endswith(function):
-            total = max(total, int(m.group(1).replace(",", "")))
-    return total
-
-
 def instructions(kind, function, n, work):
     """(Ir per call of the whole loop iteration, Ir per call of the step function)."""
-    ir, fn = [], []
-    for calls in (n, 2 * n):
-        out = os.path.join(work, f"cg.{kind}.{calls}")
-        r = subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
-                            BIN, kind, str(calls), "1"], text=True, capture_output=True)
-        m = re.search(r"Collected\s*:\s*(\d+)", r.stderr)
-        if r.returncode or not m:
-            sys.exit(f"callgrind failed for {kind}:\n{r.stderr}")
-        ir.append(int(m.group(1)))
-        fn.append(inclusive(out, function) if function else 0)
-    return (ir[1] - ir[0]) / n, (fn[1] - fn[0]) / n
+    per_call, files = callgrind.difference(lambda calls: [BIN, kind, str(calls), "1"], n, work, kind)
+    if not function:
+        return per_call, 0
+    a, b = (callgrind.inclusive(f, function) for f in files)
+    return per_call, (b - a) / n
 
 
 def nanoseconds(n, runs, reps):
