@@ -12,7 +12,8 @@ use std::path::{Path, PathBuf};
 use designer::description::{parse_file, Description, Estimator, FloatType, Operation, Shape};
 use designer::design::{
     check_feasibility, energy_optimal, fit_segments, DesignError, Feasibility, Linearization,
-    OptimalSpec, OptimalTrajectory, Polynomial, Reference, SegmentTolerance, Segments,
+    OptimalError, OptimalSpec, OptimalTrajectory, Polynomial, Reference, SegmentTolerance,
+    Segments,
 };
 use designer::model::Model;
 use designer::observe::discrete::{DiscreteModel, KalmanSettings, ResistanceSettings};
@@ -49,7 +50,7 @@ pub enum BuildError {
         operation: &'static str,
         report: String,
     },
-    #[error("{file}: the {operation} energy-optimal trajectory: {message}\nhint: if the motion cannot be done with |u| ≤ trajectory.u_bound the problem has no solution: try a larger u_bound (up to the supply limit) or a longer motion (landing − takeoff); `shape = \"polynomial\"` shows which feasibility condition the motion violates")]
+    #[error("{file}: the {operation} energy-optimal trajectory: {message}")]
     Optimal {
         file: String,
         operation: &'static str,
@@ -165,19 +166,22 @@ fn design_controller(
             match trajectory.shape {
                 Shape::Polynomial => (Box::new(polynomial), None),
                 Shape::EnergyOptimal => {
-                    let spec = OptimalSpec::new(
-                        z0,
-                        zf,
-                        trajectory.takeoff,
-                        trajectory.landing,
-                        bounds.0,
-                        bounds.1,
-                    );
+                    let spec = OptimalSpec {
+                        u_max_limit: description.supply.u_max,
+                        ..OptimalSpec::new(
+                            z0,
+                            zf,
+                            trajectory.takeoff,
+                            trajectory.landing,
+                            bounds.0,
+                            bounds.1,
+                        )
+                    };
                     let solution = energy_optimal(model, &linearization, &spec).map_err(|e| {
                         BuildError::Optimal {
                             file: file.clone(),
                             operation: name,
-                            message: e.to_string(),
+                            message: optimal_message(&e, description),
                         }
                     })?;
                     (Box::new(solution.clone()), Some(solution))
@@ -192,10 +196,7 @@ fn design_controller(
                 report: feasibility.report(),
             });
         }
-        let breaks: Vec<f64> = optimal
-            .iter()
-            .flat_map(|o| o.switches.iter().map(|s| s.t))
-            .collect();
+        let breaks: Vec<f64> = optimal.iter().flat_map(|o| o.breaks()).collect();
         let fit = fit_segments(reference.as_ref(), &breaks, &SegmentTolerance::default()).map_err(
             |e| BuildError::Table {
                 file: file.clone(),
@@ -241,6 +242,74 @@ fn design_kalman(
             estimator: "ekf/ukf",
             message: e.to_string(),
         })
+}
+
+/// What an energy-optimal failure means for the description's keys.
+fn optimal_message(e: &OptimalError, description: &Description) -> String {
+    let unit = match description.supply.drive {
+        designer::description::Drive::Voltage => "V",
+        designer::description::Drive::Current => "A",
+    };
+    let supply = description.supply.u_max;
+    match e {
+        OptimalError::BoundTooLow {
+            needed,
+            given,
+            duration,
+            ..
+        } => format!(
+            "no motion of {:.4} ms keeps the input within trajectory.u_bound = {given:.4} {unit}: \
+             it needs trajectory.u_bound ≥ {:.4} {unit} (the supply allows {supply:.4} {unit}), \
+             or a longer motion (trajectory.landing − trajectory.takeoff)",
+            duration * 1e3,
+            needed * (1.0 + 1e-3),
+        ),
+        OptimalError::TooShort {
+            needed,
+            given,
+            u_min,
+            u_max,
+            ..
+        } => format!(
+            "no motion of {:.4} ms exists with the input in [{u_min:.4}, {u_max:.4}] {unit}{}: \
+             it needs trajectory.landing − trajectory.takeoff ≥ {:.4} ms",
+            given * 1e3,
+            if *u_max < supply {
+                " (a larger trajectory.u_bound, up to the supply, does not help)"
+            } else {
+                ""
+            },
+            needed * (1.0 + 1e-3) * 1e3,
+        ),
+        other => other.to_string(),
+    }
+}
+
+/// Where the energy-optimal motion is shorter than [t₀, t_f]: when it moves,
+/// where it rests, and why.
+fn rest_text(opt: &OptimalTrajectory) -> Option<String> {
+    let (t0, tf) = (opt.spec.t0, opt.spec.tf);
+    let (ta, tb) = opt.arc;
+    if ta <= t0 && tb >= tf {
+        return None;
+    }
+    let (place, u) = if tb < tf {
+        (
+            format!("lands at {:.4} ms and rests", tb * 1e3),
+            opt.rest_inputs[1],
+        )
+    } else {
+        (
+            format!("rests until {:.4} ms, then moves", ta * 1e3),
+            opt.rest_inputs[0],
+        )
+    };
+    Some(format!(
+        "the motion {place} (holding input {u:.4}): it lasts {:.4} ms, and any longer interval \
+         is spent at rest, which costs less than moving slower ({:.6e} of J)",
+        (tb - ta) * 1e3,
+        opt.rest_cost,
+    ))
 }
 
 impl Design {
@@ -383,6 +452,12 @@ impl Design {
                         opt.max_residual,
                         opt.switches.len()
                     );
+                    if let Some(rest) = rest_text(opt) {
+                        let _ = writeln!(s, "  {rest}");
+                    }
+                    if let Some(what) = &opt.smoothed_gap {
+                        let _ = writeln!(s, "  note: {what}");
+                    }
                 }
                 let _ = write!(s, "{}", o.feasibility.report());
                 let _ = writeln!(s, "  reference table: {} segments", o.table.segments.len());

@@ -15,7 +15,9 @@
 //! - **Newton.** The (m−1)·n collocation residuals and the n boundary
 //!   residuals are solved by scipy's damped Newton: at most 8 iterations and 4
 //!   Jacobian evaluations per mesh, Armijo backtracking (σ = 0.2, τ = 0.5,
-//!   4 halvings) on the squared norm of the Newton step J⁻¹·res, and a
+//!   4 halvings) on the squared norm of the Newton step J⁻¹·res (a step
+//!   that leaves the domain of f, non-finite values, is halved up to 24
+//!   times: iterates stay where f is defined), and a
 //!   Jacobian re-use (chord step) after a full step was accepted. The Jacobian
 //!   blocks ∂Φᵢ/∂yᵢ, ∂Φᵢ/∂yᵢ₊₁ are built from the caller's ∂f/∂y at the nodes
 //!   and midpoints, exactly as scipy does.
@@ -223,7 +225,7 @@ pub enum BvpError {
         iteration: usize,
         max_residual: f64,
     },
-    #[error("Newton diverged on a mesh of {nodes} nodes: f or bc is non-finite at t = {t:e} even after the smallest damped step (improve the initial guess)")]
+    #[error("Newton diverged on a mesh of {nodes} nodes: f or bc is non-finite at t = {t:e} even after the smallest damped step: the Newton iterates leave the domain of f")]
     NewtonDiverged { nodes: usize, t: f64 },
     #[error("the mesh would need {needed} nodes > max_nodes = {max_nodes}; on the current {nodes} nodes the max relative residual is {max_residual:.3e} (tol {tol:e}) and the BC residual {bc_residual:.3e}")]
     MaxNodesExceeded {
@@ -899,6 +901,7 @@ fn newton<P: BvpProblem + ?Sized>(
     const SIGMA: f64 = 0.2;
     const TAU: f64 = 0.5;
     const N_TRIAL: usize = 4;
+    const N_DOMAIN: usize = 24;
     let n = ev.n;
     let m = x.len();
     let len = m * n;
@@ -935,10 +938,11 @@ fn newton<P: BvpProblem + ?Sized>(
         let fac = &mut work.fac;
         out.iterations += 1;
         let mut alpha = 1.0;
-        let mut ok = false;
+        let mut ok;
         let mut cost_new = f64::INFINITY;
         let mut bad_t = x[0];
-        for trial in 0..=N_TRIAL {
+        let mut trial = 0;
+        loop {
             for q in 0..len {
                 y_new[q] = y[q] - alpha * step[q];
             }
@@ -961,9 +965,15 @@ fn newton<P: BvpProblem + ?Sized>(
             if ok && cost_new < (1.0 - 2.0 * alpha * SIGMA) * cost {
                 break;
             }
-            if trial < N_TRIAL {
-                alpha *= TAU;
+            // Armijo backtracking ends after N_TRIAL halvings; a step that
+            // leaves the domain of f (non-finite values) is halved further,
+            // down to 2^-N_DOMAIN, so iterates stay where f is defined.
+            let limit = if ok { N_TRIAL } else { N_DOMAIN };
+            if trial >= limit {
+                break;
             }
+            trial += 1;
+            alpha *= TAU;
         }
         if !ok {
             return Err(BvpError::NewtonDiverged { nodes: m, t: bad_t });

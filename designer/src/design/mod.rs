@@ -7,6 +7,8 @@
 //! - `feasibility.rs`: conditions (54), (56), (57) along a reference;
 //! - `bvp.rs`: a collocation two-point BVP solver (generic);
 //! - `optimal.rs`: the energy-optimal reference (Pontryagin, eqs. 58–66);
+//! - `optimal_guess.rs`: rest states and the polynomial initial guess of an arc;
+//! - `optimal_search.rs`: rest, move, rest: the optimum within the stroke (57);
 //! - `segments.rs`: a reference as a compact table of polynomial segments.
 
 mod bvp;
@@ -15,6 +17,8 @@ mod fit_segments;
 mod lie;
 mod linearization;
 mod optimal;
+mod optimal_guess;
+mod optimal_search;
 mod reference;
 mod segments;
 

@@ -16,16 +16,20 @@
 //! selects). The two-point BVP is solved by [`solve_bvp`] with per-component
 //! scaling (metres, m/s, webers and the costates differ by ~10 orders).
 //!
-//! **Initial guess** (flat parametrisation): the 5th-degree polynomial
-//! reference z_r, x_r = T⁻¹(z_r, ż_r, z̈_r), u_r = α(x_r) + β(x_r)·z_r⁽³⁾; the
-//! costate is the minimum-norm p with pᵀg = −2u_r (i.e. H stationary in u),
-//! completed with [`CostateGuess::Chain`]: the costate equations solved
-//! backwards along the integrator chain (the φ row gives p₂, the v row p₁,
-//! with ṗ by finite differences on the mesh), or zero ([`CostateGuess::Zero`]).
+//! **Limits of the stroke** (57): a slow motion's free extremal arrives early
+//! and hovers at the stop; the optimum is then a shorter free arc with rest at
+//! the cheaper end (`optimal_search.rs`). **Initial guess**: the polynomial
+//! reference through T⁻¹ (`optimal_guess.rs`).
+//!
+//! **Tabulated gaps** interpolated C¹ (Hermite through `r_prime`, PCHIP) have
+//! a discontinuous R_gap″, which enters the costate equations: the arc is
+//! solved on the C² quintic Hermite through the same (z, r, r′) instead
+//! (`model/table.rs`), and the trajectory says so ([`OptimalTrajectory::smoothed_gap`]).
 //!
 //! **Cost.** J is integrated on the collocation interpolant: u*(S(t)) with 5-
 //! point Gauss–Legendre on every mesh interval, split at the switching times
-//! (so the kinks of the clamp do not degrade the quadrature).
+//! (so the kinks of the clamp do not degrade the quadrature), plus the rest
+//! input's cost where the motion rests.
 //!
 //! **Reference for the controller.** z_r = z, ż_r = v, z̈_r = T₃(x) and the
 //! jerk exactly from state and input: L_f³z(x) + L_g L_f²z(x)·u* (eq. 30).
@@ -39,8 +43,10 @@ use std::collections::HashMap;
 use crate::model::Model;
 use crate::sym::{Id, Tape};
 
-use super::bvp::{solve_bvp, BvpError, BvpOptions, BvpProblem, BvpSolution};
+use super::bvp::{BvpError, BvpSolution};
 use super::linearization::Linearization;
+use super::optimal_guess::GuessTapes;
+use super::optimal_search::{ArcSolver, Plan, Rest};
 use super::reference::{Flat, Polynomial, Reference};
 
 /// How the costates p₁, p₂ of the initial guess are built.
@@ -70,6 +76,9 @@ pub struct OptimalSpec {
     pub nodes: usize,
     pub max_nodes: usize,
     pub costate_guess: CostateGuess,
+    /// The largest u_max worth trying when the problem has no solution (the
+    /// supply): the needed bound is searched up to it. Default: ∞.
+    pub u_max_limit: f64,
 }
 
 impl OptimalSpec {
@@ -86,6 +95,7 @@ impl OptimalSpec {
             nodes: 151,
             max_nodes: 20000,
             costate_guess: CostateGuess::Chain,
+            u_max_limit: f64::INFINITY,
         }
     }
 }
@@ -110,6 +120,46 @@ pub enum OptimalError {
         #[source]
         source: BvpError,
     },
+    #[error("the free arc of {duration:e} s leaves the stroke (z in [{:e}, {:e}] m)", z_range[0], z_range[1])]
+    OutsideStroke { z_range: [f64; 2], duration: f64 },
+    #[error("no free arc of at most {total:e} s was found that stays within the stroke")]
+    NoShortArc { total: f64 },
+    #[error("the motion needs u_max ≥ {needed:.4} (the bound is {given:.4}): with u_max = {given:.4} no motion of {duration:e} s exists ({source})")]
+    BoundTooLow {
+        needed: f64,
+        given: f64,
+        duration: f64,
+        #[source]
+        source: Box<OptimalError>,
+    },
+    #[error("the motion needs t_f − t₀ ≥ {needed:.4e} s (it is {given:.4e} s): no shorter motion exists within u ∈ [{u_min:.4}, {u_max:.4}] ({source})")]
+    TooShort {
+        needed: f64,
+        given: f64,
+        u_min: f64,
+        u_max: f64,
+        #[source]
+        source: Box<OptimalError>,
+    },
+    #[error("the solver found no solution, and neither a larger bound (up to ×4, within the supply) nor a longer motion (up to ×4) has one: please report this description ({source})")]
+    Unsolved {
+        #[source]
+        source: Box<OptimalError>,
+    },
+}
+
+impl OptimalError {
+    /// Whether the error says the problem may have no solution (rather than
+    /// that the problem or the model is malformed).
+    fn may_be_infeasible(&self) -> bool {
+        matches!(
+            self,
+            OptimalError::Bvp { .. }
+                | OptimalError::Guess { .. }
+                | OptimalError::OutsideStroke { .. }
+                | OptimalError::NoShortArc { .. }
+        )
+    }
 }
 
 /// The symbolic Hamiltonian system compiled to tapes over
@@ -132,7 +182,7 @@ const AUX_U: usize = 0;
 const AUX_RAW: usize = 1;
 const AUX_A: usize = 2;
 const AUX_JERK: usize = 3;
-const AUX_H: usize = 4;
+pub(crate) const AUX_H: usize = 4;
 
 impl HamiltonianSystem {
     /// Derives the system symbolically from `model.f` and the linearization.
@@ -235,45 +285,17 @@ impl HamiltonianSystem {
     }
 }
 
-struct Problem<'a> {
-    sys: &'a HamiltonianSystem,
-    x0: [f64; 3],
-    xf: [f64; 3],
-}
-
-impl BvpProblem for Problem<'_> {
-    fn dim(&self) -> usize {
-        6
+impl HamiltonianSystem {
+    /// [ẋ; ṗ] at (t, [x; p]).
+    pub(crate) fn rhs_at(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+        let mut s = self.scratch.borrow_mut();
+        self.rhs.eval(&Self::inputs(t, y), &mut s.0, dy);
     }
 
-    fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
-        let mut s = self.sys.scratch.borrow_mut();
-        self.sys
-            .rhs
-            .eval(&HamiltonianSystem::inputs(t, y), &mut s.0, dy);
-    }
-
-    fn jacobian(&self, t: f64, y: &[f64], j: &mut [f64]) {
-        let mut s = self.sys.scratch.borrow_mut();
-        self.sys
-            .jacobian
-            .eval(&HamiltonianSystem::inputs(t, y), &mut s.1, j);
-    }
-
-    fn bc(&self, ya: &[f64], yb: &[f64], r: &mut [f64]) {
-        for k in 0..3 {
-            r[k] = ya[k] - self.x0[k];
-            r[3 + k] = yb[k] - self.xf[k];
-        }
-    }
-
-    fn bc_jacobian(&self, _ya: &[f64], _yb: &[f64], ja: &mut [f64], jb: &mut [f64]) {
-        ja.iter_mut().for_each(|v| *v = 0.0);
-        jb.iter_mut().for_each(|v| *v = 0.0);
-        for k in 0..3 {
-            ja[k * 6 + k] = 1.0;
-            jb[(3 + k) * 6 + k] = 1.0;
-        }
+    /// ∂[ẋ; ṗ]/∂[x; p] at (t, [x; p]), row-major.
+    pub(crate) fn jacobian_at(&self, t: f64, y: &[f64], j: &mut [f64]) {
+        let mut s = self.scratch.borrow_mut();
+        self.jacobian.eval(&Self::inputs(t, y), &mut s.1, j);
     }
 }
 
@@ -319,6 +341,18 @@ pub struct OptimalTrajectory {
     /// The collocation solution (its cubic interpolant S(t)).
     pub solution: BvpSolution,
     pub spec: OptimalSpec,
+    /// The free arc [t_a, t_b] ⊆ [t₀, t_f]: the armature rests at z₀ before
+    /// t_a and at z_f after t_b (the limits of the stroke, `optimal_search.rs`).
+    pub arc: (f64, f64),
+    /// The inputs that hold the rest at z₀ and at z_f.
+    pub rest_inputs: [f64; 2],
+    /// ∫u² dt over the rest before and after the arc (included in `cost`).
+    pub rest_cost: f64,
+    /// H − u_rest² at the arc's moving end: ≤ 0 (more time would not lower J)
+    /// when the arc spans [t₀, t_f], ≈ 0 when it is shorter.
+    pub duration_slope: f64,
+    /// Set when the arc was solved on a C² twin of a C¹ tabulated gap: what was done.
+    pub smoothed_gap: Option<String>,
     aux: Tape,
 }
 
@@ -336,10 +370,30 @@ impl OptimalTrajectory {
         out
     }
 
-    /// u*(t) on the interpolant (0 outside [t₀, t_f] is *not* implied: the
-    /// value at the nearest end is returned, which holds the rest state).
+    /// u*(t) on the interpolant inside the arc; outside it, the input that
+    /// holds the rest state.
     pub fn input_at(&self, t: f64) -> f64 {
-        self.aux_at(t.clamp(self.spec.t0, self.spec.tf))[AUX_U]
+        if t < self.arc.0 {
+            self.rest_inputs[0]
+        } else if t > self.arc.1 {
+            self.rest_inputs[1]
+        } else {
+            self.aux_at(t)[AUX_U]
+        }
+    }
+
+    /// Instants where the reference is not smooth inside (t₀, t_f): the
+    /// switches of u* and the arc's ends where the motion rests.
+    pub fn breaks(&self) -> Vec<f64> {
+        let (t0, tf) = (self.spec.t0, self.spec.tf);
+        let mut b: Vec<f64> = self.switches.iter().map(|s| s.t).collect();
+        b.extend(
+            [self.arc.0, self.arc.1]
+                .into_iter()
+                .filter(|&t| t > t0 && t < tf),
+        );
+        b.sort_by(f64::total_cmp);
+        b
     }
 
     /// H on the interpolant.
@@ -363,6 +417,10 @@ impl OptimalTrajectory {
                 "t": s.t, "bound": s.bound, "entering": s.entering,
             })).collect::<Vec<_>>(),
             "nodes": self.nodes(),
+            "arc": [self.arc.0, self.arc.1],
+            "rest_cost": self.rest_cost,
+            "duration_slope": self.duration_slope,
+            "smoothed_gap": self.smoothed_gap,
             "max_residual": self.max_residual,
             "bc_residual": self.bc_residual,
             "newton_iterations": self.newton_iterations,
@@ -373,11 +431,11 @@ impl OptimalTrajectory {
 }
 
 impl Reference for OptimalTrajectory {
-    /// Rest at z₀ before t₀ and at z_f after t_f, the optimal motion between.
+    /// Rest at z₀ before the arc and at z_f after it, the optimal motion between.
     fn at(&self, t: f64) -> Flat {
-        let (t0, tf) = (self.spec.t0, self.spec.tf);
-        if t <= t0 || t >= tf {
-            let z = if t <= t0 { self.spec.z0 } else { self.spec.zf };
+        let (ta, tb) = self.arc;
+        if t <= ta || t >= tb {
+            let z = if t <= ta { self.spec.z0 } else { self.spec.zf };
             return Flat {
                 z,
                 v: 0.0,
@@ -414,197 +472,10 @@ fn gauss5(a: f64, b: f64, f: &mut dyn FnMut(f64) -> f64) -> f64 {
     GL5.iter().map(|&(x, w)| w * f(c + h * x)).sum::<f64>() * h
 }
 
-/// Derivative of samples on a (uniform or not) mesh: central differences
-/// inside, second-order one-sided at the ends.
-fn gradient(t: &[f64], y: &[f64]) -> Vec<f64> {
-    let m = t.len();
-    let mut d = vec![0.0; m];
-    for i in 1..m - 1 {
-        let (h0, h1) = (t[i] - t[i - 1], t[i + 1] - t[i]);
-        d[i] = (h0 * h0 * y[i + 1] - h1 * h1 * y[i - 1] + (h1 * h1 - h0 * h0) * y[i])
-            / (h0 * h1 * (h0 + h1));
-    }
-    let h = t[1] - t[0];
-    d[0] = (-3.0 * y[0] + 4.0 * y[1] - y[2]) / (2.0 * h);
-    let h = t[m - 1] - t[m - 2];
-    d[m - 1] = (3.0 * y[m - 1] - 4.0 * y[m - 2] + y[m - 3]) / (2.0 * h);
-    d
-}
-
-/// The initial guess: mesh, [x; p] per node, and ∫u_r² dt.
-struct Guess {
-    t: Vec<f64>,
-    y: Vec<Vec<f64>>,
-    /// Costates of the chain construction (for scaling even when not used).
-    chain: Vec<[f64; 3]>,
-    cost: f64,
-    max_abs_u: f64,
-}
-
-fn initial_guess(
-    model: &mut Model,
-    lin: &Linearization,
-    spec: &OptimalSpec,
-) -> Result<Guess, OptimalError> {
-    // (α, β, ∂f/∂x (9), g (3)) over (z, v, φ, u, t), and T⁻¹ over ξ.
-    let a = model.jacobian();
-    let mut outs = vec![lin.alpha, lin.beta];
-    outs.extend(a.into_iter().flatten());
-    outs.extend(lin.system.input_field.iter().copied());
-    let tape = model.compile(&outs);
-    let mut inv = lin.inverse.to_vec();
-    inv.push(lin.flux_squared);
-    let inv = model.bind_params(&inv);
-    let inv_tape = Tape::compile(&model.graph, &lin.xi, &inv)
-        .map_err(|e| OptimalError::InvalidSpec(format!("T⁻¹ is not closed: {e}")))?;
-    let reference = Polynomial {
-        z0: spec.z0,
-        zf: spec.zf,
-        t0: spec.t0,
-        tf: spec.tf,
-    };
-    let duration = spec.tf - spec.t0;
-    let eps = 1e-9 * duration;
-    // x_r, u_r and the model Jacobian at time t
-    let at = |t: f64| -> Result<([f64; 3], f64, Vec<f64>), OptimalError> {
-        let r = reference.at(t);
-        // the polynomial's jerk at the ends is its one-sided limit
-        let jerk = reference.at(t.clamp(spec.t0 + eps, spec.tf - eps)).jerk;
-        let mut xr = [0.0; 4];
-        inv_tape.eval(&[r.z, r.v, r.a], &mut inv_tape.scratch(), &mut xr);
-        if !(xr[3] > 0.0) || !xr[2].is_finite() {
-            return Err(OptimalError::Guess {
-                t, what: "φ² ≤ 0"
-            });
-        }
-        let mut o = vec![0.0; tape.n_outputs()];
-        tape.eval(&[xr[0], xr[1], xr[2], 0.0, t], &mut tape.scratch(), &mut o);
-        let u = o[0] + o[1] * jerk;
-        if !u.is_finite() {
-            return Err(OptimalError::Guess { t, what: "u_r" });
-        }
-        // ∂f/∂x at u_r: f is affine in u, so recompute with u
-        tape.eval(&[xr[0], xr[1], xr[2], u, t], &mut tape.scratch(), &mut o);
-        Ok(([xr[0], xr[1], xr[2]], u, o[2..].to_vec()))
-    };
-    let m = spec.nodes.max(5);
-    let t: Vec<f64> = (0..m)
-        .map(|i| spec.t0 + duration * i as f64 / (m - 1) as f64)
-        .collect();
-    let mut xs = Vec::with_capacity(m);
-    let mut us = Vec::with_capacity(m);
-    let mut jacs = Vec::with_capacity(m);
-    for &ti in &t {
-        let (x, u, o) = at(ti)?;
-        xs.push(x);
-        us.push(u);
-        jacs.push(o);
-    }
-    // ∫u_r² dt by composite Simpson on a fine grid (u_r is smooth)
-    let fine = 2000;
-    let mut cost = 0.0;
-    let mut max_abs_u = 0.0f64;
-    for k in 0..=fine {
-        let tk = spec.t0 + duration * k as f64 / fine as f64;
-        let w = if k == 0 || k == fine {
-            1.0
-        } else if k % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        };
-        let u = at(tk)?.1;
-        max_abs_u = max_abs_u.max(u.abs());
-        cost += w * u * u;
-    }
-    cost *= duration / fine as f64 / 3.0;
-    // p_g = −2u_r·g/|g|² (H stationary in u), then the chain
-    let p_from_u: Vec<[f64; 3]> = jacs
-        .iter()
-        .zip(&us)
-        .map(|(o, &u)| {
-            let g = [o[9], o[10], o[11]];
-            let g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-            [
-                -2.0 * u * g[0] / g2,
-                -2.0 * u * g[1] / g2,
-                -2.0 * u * g[2] / g2,
-            ]
-        })
-        .collect();
-    let p3: Vec<f64> = p_from_u.iter().map(|p| p[2]).collect();
-    let dp3 = gradient(&t, &p3);
-    // ṗ₃ = −(A₀₂p₁ + A₁₂p₂ + A₂₂p₃) with A₀₂ = ∂ż/∂φ = 0
-    let p2: Vec<f64> = (0..m)
-        .map(|i| {
-            let a = &jacs[i];
-            -(dp3[i] + a[2 * 3 + 2] * p3[i]) / a[3 + 2]
-        })
-        .collect();
-    let dp2 = gradient(&t, &p2);
-    // ṗ₂ = −(A₀₁p₁ + A₁₁p₂ + A₂₁p₃)
-    let p1: Vec<f64> = (0..m)
-        .map(|i| {
-            let a = &jacs[i];
-            -(dp2[i] + a[3 + 1] * p2[i] + a[2 * 3 + 1] * p3[i]) / a[1]
-        })
-        .collect();
-    let chain_ok = jacs
-        .iter()
-        .all(|a| a[2] == 0.0 && a[5] != 0.0 && a[1] != 0.0)
-        && p1.iter().chain(&p2).all(|v| v.is_finite());
-    let chain: Vec<[f64; 3]> = (0..m)
-        .map(|i| {
-            if chain_ok {
-                [p1[i], p2[i], p3[i]]
-            } else {
-                p_from_u[i]
-            }
-        })
-        .collect();
-    let y = (0..m)
-        .map(|i| {
-            let p = match spec.costate_guess {
-                CostateGuess::Chain => chain[i],
-                CostateGuess::Zero => p_from_u[i],
-            };
-            vec![xs[i][0], xs[i][1], xs[i][2], p[0], p[1], p[2]]
-        })
-        .collect();
-    Ok(Guess {
-        t,
-        y,
-        chain,
-        cost,
-        max_abs_u,
-    })
-}
-
-/// Rest state T⁻¹([z, 0, 0]).
-fn rest_state(
-    model: &mut Model,
-    lin: &Linearization,
-    z: f64,
-    which: &'static str,
-) -> Result<[f64; 3], OptimalError> {
-    let mut inv = lin.inverse.to_vec();
-    inv.push(lin.flux_squared);
-    let inv = model.bind_params(&inv);
-    let tape = Tape::compile(&model.graph, &lin.xi, &inv)
-        .map_err(|e| OptimalError::InvalidSpec(format!("T⁻¹ is not closed: {e}")))?;
-    let mut x = [0.0; 4];
-    tape.eval(&[z, 0.0, 0.0], &mut tape.scratch(), &mut x);
-    if !(x[3] > 0.0) || !x[3].is_finite() {
-        return Err(OptimalError::InfeasibleBoundary {
-            which,
-            z,
-            flux_squared: x[3],
-        });
-    }
-    Ok([x[0], x[1], x[2]])
-}
-
-/// Solves the energy-optimal problem (eqs. 58–66) for `model`.
+/// Solves the energy-optimal problem (eqs. 58–66) for `model`, within the
+/// stroke (57): a free arc, with rest at one end where that costs less.
+/// Where no solution exists, the error says which bound or duration it needs
+/// ([`OptimalError::BoundTooLow`], [`OptimalError::TooShort`]).
 pub fn energy_optimal(
     model: &mut Model,
     lin: &Linearization,
@@ -616,39 +487,185 @@ pub fn energy_optimal(
             spec.t0, spec.tf, spec.z0, spec.zf, spec.tol
         )));
     }
+    match design(model, lin, spec) {
+        Err(e) if e.may_be_infeasible() => Err(explain(model, lin, spec, e)),
+        other => other,
+    }
+}
+
+/// Relaxations tried to tell an infeasible problem from a solver failure.
+const RELAX: [f64; 3] = [1.5, 2.5, 4.0];
+/// Relative accuracy of the bisection on the needed bound or duration.
+const NEED_TOL: f64 = 2e-3;
+
+/// Why `spec` has no solution: the bound it needs (a larger u_max solves it),
+/// else the duration it needs, each found by bisection with the solver.
+fn explain(
+    model: &mut Model,
+    lin: &Linearization,
+    spec: &OptimalSpec,
+    err: OptimalError,
+) -> OptimalError {
+    let source = Box::new(err);
+    let duration = spec.tf - spec.t0;
+    let mut solves = |s: &OptimalSpec| design(model, lin, s).is_ok();
+    let with_bound = |b: f64| OptimalSpec {
+        u_max: b,
+        ..spec.clone()
+    };
+    if spec.u_max > 0.0 {
+        let candidates = RELAX.map(|k| (k * spec.u_max).min(spec.u_max_limit));
+        let larger = candidates.into_iter().filter(|&b| b > spec.u_max);
+        if let Some(hi) = larger.into_iter().find(|&b| solves(&with_bound(b))) {
+            let needed = bisect(spec.u_max, hi, |b| solves(&with_bound(b)));
+            return OptimalError::BoundTooLow {
+                needed,
+                given: spec.u_max,
+                duration,
+                source,
+            };
+        }
+    }
+    let with_duration = |d: f64| OptimalSpec {
+        tf: spec.t0 + d,
+        ..spec.clone()
+    };
+    if let Some(hi) = RELAX
+        .iter()
+        .map(|k| k * duration)
+        .find(|&d| solves(&with_duration(d)))
+    {
+        let needed = bisect(duration, hi, |d| solves(&with_duration(d)));
+        return OptimalError::TooShort {
+            needed,
+            given: duration,
+            u_min: spec.u_min,
+            u_max: spec.u_max,
+            source,
+        };
+    }
+    OptimalError::Unsolved { source }
+}
+
+/// The smallest x in (lo, hi] with ok(x), given !ok(lo) and ok(hi), to NEED_TOL.
+fn bisect(mut lo: f64, mut hi: f64, mut ok: impl FnMut(f64) -> bool) -> f64 {
+    while hi - lo > NEED_TOL * hi {
+        let mid = 0.5 * (lo + hi);
+        if ok(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
+}
+
+/// The design: on the C² twin of a C¹ tabulated gap, else on the model.
+fn design(
+    model: &mut Model,
+    lin: &Linearization,
+    spec: &OptimalSpec,
+) -> Result<OptimalTrajectory, OptimalError> {
+    let Some((mut twin, what)) = Model::c2_twin(&model.description) else {
+        return solve(model, lin, spec);
+    };
+    let twin_lin = Linearization::derive(&mut twin)
+        .map_err(|e| OptimalError::InvalidSpec(format!("the C² gap twin: {e}")))?;
+    // The twin's input differs slightly from the table's own model's: tighten
+    // the twin's bounds until the table's model keeps the input within them.
+    let mut inner = spec.clone();
+    for _ in 0..TWIN_BOUND_PASSES {
+        let mut traj = solve(&mut twin, &twin_lin, &inner)?;
+        let f = super::feasibility::check(model, lin, &traj, (spec.u_min, spec.u_max), 2000);
+        let margin = 1e-7 * spec.u_max.abs().max(spec.u_min.abs());
+        let (over_hi, over_lo) = (f.max_input - spec.u_max, spec.u_min - f.min_input);
+        if !(over_hi > 0.0) && !(over_lo > 0.0) {
+            traj.smoothed_gap = Some(what);
+            return Ok(traj);
+        }
+        if over_hi > 0.0 {
+            inner.u_max = inner.u_max.min(spec.u_max - over_hi) - margin;
+        }
+        if over_lo > 0.0 {
+            inner.u_min = inner.u_min.max(spec.u_min + over_lo) + margin;
+        }
+    }
+    let mut traj = solve(&mut twin, &twin_lin, &inner)?;
+    traj.smoothed_gap = Some(what);
+    Ok(traj)
+}
+
+/// Re-solves of the C² twin with tightened bounds.
+const TWIN_BOUND_PASSES: usize = 4;
+
+fn solve(
+    model: &mut Model,
+    lin: &Linearization,
+    spec: &OptimalSpec,
+) -> Result<OptimalTrajectory, OptimalError> {
     let sys = HamiltonianSystem::derive(model, lin, spec.u_min, spec.u_max)?;
-    let x0 = rest_state(model, lin, spec.z0, "initial")?;
-    let xf = rest_state(model, lin, spec.zf, "final")?;
-    let guess = initial_guess(model, lin, spec)?;
-    // scales
+    let tapes = GuessTapes::new(model, lin)?;
+    let x0 = tapes.rest_state(spec.z0, "initial")?;
+    let xf = tapes.rest_state(spec.zf, "final")?;
+    let full = Polynomial {
+        z0: spec.z0,
+        zf: spec.zf,
+        t0: spec.t0,
+        tf: spec.tf,
+    };
+    let guess = tapes.polynomial(&full, spec.nodes, spec.costate_guess)?;
+    let solver = ArcSolver {
+        sys: &sys,
+        tapes: &tapes,
+        spec,
+        x0,
+        xf,
+        scale: scales(spec, &guess),
+    };
+    let rest_inputs = [tapes.rest_input(x0, spec.t0), tapes.rest_input(xf, spec.tf)];
+    let [c0, cf] = rest_inputs.map(|u| u * u);
+    let rest = Rest {
+        at_end: cf <= c0,
+        rate: c0.min(cf),
+    };
+    let plan = solver.plan(rest)?;
+    let mut traj = trajectory(&sys, spec, plan, [x0, xf], rest_inputs);
+    traj.guess_cost = guess.cost;
+    traj.guess_max_abs_input = guess.max_abs_u;
+    locate_switches(&mut traj);
+    integrate_cost(&mut traj, &tapes);
+    Ok(traj)
+}
+
+/// Per-component scales of [x; p]: stroke, mean speed ×2, the guess's peak
+/// flux and chain costates.
+fn scales(spec: &OptimalSpec, guess: &super::optimal_guess::Guess) -> Vec<f64> {
     let stroke = (spec.zf - spec.z0).abs();
     let duration = spec.tf - spec.t0;
-    let max_of = |k: usize| guess.y.iter().map(|y| y[k].abs()).fold(0.0, f64::max);
-    let phi_scale = max_of(2);
+    let phi_scale = guess.y.iter().map(|y| y[2].abs()).fold(0.0, f64::max);
     let mut scale = vec![stroke, 2.0 * stroke / duration, phi_scale];
     for k in 0..3 {
         let s = guess.chain.iter().map(|p| p[k].abs()).fold(0.0, f64::max);
         scale.push(if s > 0.0 && s.is_finite() { s } else { 1.0 });
     }
-    let bc_scale = [scale[0], scale[1], scale[2], scale[0], scale[1], scale[2]].to_vec();
-    let opts = BvpOptions {
-        tol: spec.tol,
-        max_nodes: spec.max_nodes,
-        scale: Some(scale),
-        bc_scale: Some(bc_scale),
-        ..BvpOptions::default()
-    };
-    let problem = Problem { sys: &sys, x0, xf };
-    let sol = solve_bvp(&problem, &guess.t, &guess.y, &opts)
-        .map_err(|source| OptimalError::Bvp { source })?;
+    scale
+}
 
+fn trajectory(
+    sys: &HamiltonianSystem,
+    spec: &OptimalSpec,
+    plan: Plan,
+    [x0, xf]: [[f64; 3]; 2],
+    rest_inputs: [f64; 2],
+) -> OptimalTrajectory {
+    let sol = plan.arc.sol;
     let aux: Vec<[f64; 5]> = sol
         .t
         .iter()
         .zip(&sol.y)
         .map(|(&t, y)| sys.aux_at(t, y))
         .collect();
-    let mut traj = OptimalTrajectory {
+    OptimalTrajectory {
         t: sol.t.clone(),
         states: sol.y.iter().map(|y| [y[0], y[1], y[2]]).collect(),
         costates: sol.y.iter().map(|y| [y[3], y[4], y[5]]).collect(),
@@ -666,8 +683,8 @@ pub fn energy_optimal(
             })
             .collect(),
         cost: 0.0,
-        guess_cost: guess.cost,
-        guess_max_abs_input: guess.max_abs_u,
+        guess_cost: 0.0,
+        guess_max_abs_input: 0.0,
         max_abs_input: 0.0,
         switches: Vec::new(),
         x0,
@@ -678,11 +695,13 @@ pub fn energy_optimal(
         mesh_refinements: sol.mesh_refinements,
         solution: sol,
         spec: spec.clone(),
+        arc: (plan.arc.a, plan.arc.b),
+        rest_inputs,
+        rest_cost: 0.0,
+        duration_slope: plan.slope,
+        smoothed_gap: None,
         aux: sys.aux.clone(),
-    };
-    locate_switches(&mut traj);
-    integrate_cost(&mut traj);
-    Ok(traj)
+    }
 }
 
 /// Switching times: sign changes of (raw − u_max) and (raw − u_min) on the
@@ -729,7 +748,7 @@ fn locate_switches(traj: &mut OptimalTrajectory) {
 
 /// J = ∫u*² dt and max|u*| on the interpolant (Gauss–Legendre per interval,
 /// split at the switches; max over the GL points, the nodes and the switches).
-fn integrate_cost(traj: &mut OptimalTrajectory) {
+fn integrate_cost(traj: &mut OptimalTrajectory, tapes: &GuessTapes) {
     let mut cost = 0.0;
     let mut umax = traj.input.iter().fold(0.0f64, |m, u| m.max(u.abs()));
     let sw: Vec<f64> = traj.switches.iter().map(|s| s.t).collect();
@@ -746,6 +765,24 @@ fn integrate_cost(traj: &mut OptimalTrajectory) {
             });
         }
     }
-    traj.cost = cost;
+    let (t0, tf) = (traj.spec.t0, traj.spec.tf);
+    let rests = [(t0, traj.arc.0, traj.x0), (traj.arc.1, tf, traj.xf)];
+    let mut rest_cost = 0.0;
+    for (a, b, x) in rests.into_iter().filter(|r| r.1 > r.0) {
+        // the holding input varies in time only with a resistance drift
+        for k in 0..8 {
+            let (ka, kb) = (
+                a + (b - a) * k as f64 / 8.0,
+                a + (b - a) * (k + 1) as f64 / 8.0,
+            );
+            rest_cost += gauss5(ka, kb, &mut |tt| {
+                let u = tapes.rest_input(x, tt);
+                umax = umax.max(u.abs());
+                u * u
+            });
+        }
+    }
+    traj.rest_cost = rest_cost;
+    traj.cost = cost + rest_cost;
     traj.max_abs_input = umax;
 }

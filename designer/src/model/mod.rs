@@ -63,6 +63,31 @@ pub struct Model {
 
 impl Model {
     pub fn build(description: &Description) -> Model {
+        Model::build_with_gap(description, None)
+    }
+
+    /// The model with a C¹ tabulated gap replaced by its C² quintic twin
+    /// (`table.rs`), for the energy-optimal design, and a sentence saying what
+    /// changed; `None` when the gap is already C².
+    pub fn c2_twin(description: &Description) -> Option<(Model, String)> {
+        let Gap::Table { z, r, r_prime } = &description.gap else {
+            return None;
+        };
+        let spline = Spline::fit(z, r, r_prime.as_deref());
+        let twin = spline.c2_twin()?;
+        let worst = max_slope_change(&spline, &twin);
+        let what = format!(
+            "the gap table's {} has a discontinuous R_gap″, which enters the costate equations: \
+             the trajectory is solved on the {} (R_gap′ within {:.2} % of the table's between the knots{})",
+            spline.kind.describe(),
+            twin.kind.describe(),
+            100.0 * worst,
+            if twin.increasing() { "" } else { "; its slope is not positive everywhere" },
+        );
+        Some((Model::build_with_gap(description, Some(twin)), what))
+    }
+
+    fn build_with_gap(description: &Description, gap_spline: Option<Spline>) -> Model {
         let mut g = Graph::new();
         let mut params = Params::default();
         let z = g.symbol("z");
@@ -72,7 +97,10 @@ impl Model {
         let u = g.symbol("u");
         let t = g.symbol("t");
 
-        let r_gap = gap::reluctance(&mut g, &mut params, &description.gap, z);
+        let r_gap = match gap_spline {
+            Some(spline) => spline.expression(&mut g, z),
+            None => gap::reluctance(&mut g, &mut params, &description.gap, z),
+        };
         let r_gap_dz = g.diff(r_gap, z);
         let mmf_core = self::core::mmf(&mut g, &mut params, &description.core, phi, hc);
         let gap_mmf = g.mul(r_gap, phi);
@@ -207,6 +235,21 @@ impl Model {
             _ => None,
         }
     }
+}
+
+/// max |R′_b − R′_a| / max |R′_a| over 32 points per segment.
+fn max_slope_change(a: &Spline, b: &Spline) -> f64 {
+    let mut worst: f64 = 0.0;
+    let mut scale: f64 = 0.0;
+    for w in a.knots.windows(2) {
+        for j in 0..=32 {
+            let z = w[0] + (w[1] - w[0]) * j as f64 / 32.0;
+            let (da, db) = (a.eval(z).1, b.eval(z).1);
+            worst = worst.max((db - da).abs());
+            scale = scale.max(da.abs());
+        }
+    }
+    worst / scale
 }
 
 /// (φ̇, coil current, coil voltage) for the drive mode.

@@ -9,6 +9,10 @@
 //!
 //! Outside the table the end polynomials extend (validation requires the table
 //! to cover [z_min, z_max]).
+//!
+//! The C¹ interpolants have a discontinuous R_gap″, which enters the costate
+//! equations of the energy-optimal design; [`Spline::c2_twin`] gives the C²
+//! quintic Hermite through the same values and slopes for that design.
 
 use crate::sym::{Graph, Id};
 
@@ -17,6 +21,8 @@ pub enum SplineKind {
     Hermite,
     NotAKnot,
     Pchip,
+    /// C² quintic Hermite through the values and slopes of a C¹ interpolant.
+    QuinticTwin,
 }
 
 impl SplineKind {
@@ -25,16 +31,18 @@ impl SplineKind {
             SplineKind::Hermite => "cubic Hermite through the given r_prime (C¹)",
             SplineKind::NotAKnot => "not-a-knot cubic spline (C²)",
             SplineKind::Pchip => "monotone PCHIP (C¹; the C² spline was not monotone)",
+            SplineKind::QuinticTwin => "quintic Hermite through the same values and slopes (C²)",
         }
     }
 }
 
-/// Piecewise cubic: on segment k, p(z) = Σ c[k][j]·(z − knots[k])^j.
+/// Piecewise polynomial of degree ≤ 5: on segment k,
+/// p(z) = Σ c[k][j]·(z − knots[k])^j (cubics have c₄ = c₅ = 0).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Spline {
     pub kind: SplineKind,
     pub knots: Vec<f64>,
-    pub coeffs: Vec<[f64; 4]>,
+    pub coeffs: Vec<[f64; 6]>,
 }
 
 impl Spline {
@@ -58,7 +66,7 @@ impl Spline {
                 let delta = (r[k + 1] - r[k]) / h;
                 let c2 = (3.0 * delta - 2.0 * m[k] - m[k + 1]) / h;
                 let c3 = (m[k] + m[k + 1] - 2.0 * delta) / (h * h);
-                [r[k], m[k], c2, c3]
+                [r[k], m[k], c2, c3, 0.0, 0.0]
             })
             .collect();
         Spline {
@@ -76,23 +84,81 @@ impl Spline {
     /// Numeric value and derivative (for tests and reports).
     pub fn eval(&self, z: f64) -> (f64, f64) {
         let k = self.segment(z);
-        let [a, b, c, d] = self.coeffs[k];
-        let t = z - self.knots[k];
-        (
-            a + t * (b + t * (c + t * d)),
-            b + t * (2.0 * c + 3.0 * t * d),
-        )
+        poly_eval(&self.coeffs[k], z - self.knots[k])
     }
 
-    /// Whether the derivative is positive on every segment (end points and
-    /// the interior extremum of the quadratic p').
+    /// Second derivative (for tests and reports).
+    pub fn second_derivative(&self, z: f64) -> f64 {
+        let k = self.segment(z);
+        let c = &self.coeffs[k];
+        let t = z - self.knots[k];
+        2.0 * c[2] + t * (6.0 * c[3] + t * (12.0 * c[4] + t * 20.0 * c[5]))
+    }
+
+    /// Whether the derivative is positive on every segment: for a cubic at
+    /// the end points and the interior extremum of the quadratic p′, for a
+    /// quintic at 64 points per segment, ends included.
     fn is_increasing(&self) -> bool {
-        self.coeffs.iter().enumerate().all(|(k, &[_, b, c, d])| {
+        self.coeffs.iter().enumerate().all(|(k, c)| {
             let h = self.knots[k + 1] - self.knots[k];
-            let dp = |t: f64| b + t * (2.0 * c + 3.0 * t * d);
-            let vertex = if d != 0.0 { -c / (3.0 * d) } else { -1.0 };
+            let dp = |t: f64| poly_eval(c, t).1;
+            if c[4] != 0.0 || c[5] != 0.0 {
+                return (0..=64).all(|j| dp(h * j as f64 / 64.0) > 0.0);
+            }
+            let vertex = if c[3] != 0.0 {
+                -c[2] / (3.0 * c[3])
+            } else {
+                -1.0
+            };
             dp(0.0) > 0.0 && dp(h) > 0.0 && (!(0.0..=h).contains(&vertex) || dp(vertex) > 0.0)
         })
+    }
+
+    /// The C² twin of a C¹ interpolant (Hermite, PCHIP): the quintic Hermite
+    /// with the same values and slopes at the knots and, as second
+    /// derivatives, the mean of the C¹ one's two one-sided values. `None` when
+    /// the interpolant is already C².
+    pub fn c2_twin(&self) -> Option<Spline> {
+        if matches!(self.kind, SplineKind::NotAKnot | SplineKind::QuinticTwin) {
+            return None;
+        }
+        let n = self.knots.len();
+        let h = |k: usize| self.knots[k + 1] - self.knots[k];
+        let left = |k: usize| {
+            let c = &self.coeffs[k - 1];
+            2.0 * c[2] + 6.0 * c[3] * h(k - 1)
+        };
+        let right = |k: usize| 2.0 * self.coeffs[k][2];
+        let second: Vec<f64> = (0..n)
+            .map(|k| match k {
+                0 => right(0),
+                k if k == n - 1 => left(k),
+                k => 0.5 * (left(k) + right(k)),
+            })
+            .collect();
+        let value = |k: usize| {
+            if k < n - 1 {
+                (self.coeffs[k][0], self.coeffs[k][1])
+            } else {
+                poly_eval(&self.coeffs[k - 1], h(k - 1))
+            }
+        };
+        let coeffs = (0..n - 1)
+            .map(|k| {
+                let ((p0, m0), (p1, m1)) = (value(k), value(k + 1));
+                quintic_hermite(h(k), [p0, m0, second[k]], [p1, m1, second[k + 1]])
+            })
+            .collect();
+        Some(Spline {
+            kind: SplineKind::QuinticTwin,
+            knots: self.knots.clone(),
+            coeffs,
+        })
+    }
+
+    /// Whether the derivative stays positive (for the twin's report).
+    pub fn increasing(&self) -> bool {
+        self.is_increasing()
     }
 
     /// The interpolant as a symbolic piecewise polynomial of `z`.
@@ -101,20 +167,45 @@ impl Spline {
             .coeffs
             .iter()
             .zip(&self.knots)
-            .map(|(&[a, b, c, d], &zk)| {
+            .map(|(c, &zk)| {
                 let shift = g.constant(-zk);
                 let t = g.add(z, shift);
-                let horner = [c, b, a].iter().fold(g.constant(d), |acc, &coef| {
+                let degree = if c[4] == 0.0 && c[5] == 0.0 { 3 } else { 5 };
+                let start = g.constant(c[degree]);
+                c[..degree].iter().rev().fold(start, |acc, &coef| {
                     let prod = g.mul(acc, t);
                     let coef = g.constant(coef);
                     g.add(prod, coef)
-                });
-                horner
+                })
             })
             .collect();
         let n = self.coeffs.len();
         g.piecewise(z, &self.knots[1..n], &pieces)
     }
+}
+
+/// Value and derivative of Σ c_j·t^j.
+fn poly_eval(c: &[f64; 6], t: f64) -> (f64, f64) {
+    let v = c.iter().rev().fold(0.0, |acc, &cj| acc * t + cj);
+    let d = (1..6).rev().fold(0.0, |acc, j| acc * t + j as f64 * c[j]);
+    (v, d)
+}
+
+/// The quintic on [0, h] with value, slope and second derivative `a` at 0 and
+/// `b` at h.
+fn quintic_hermite(h: f64, a: [f64; 3], b: [f64; 3]) -> [f64; 6] {
+    let [p0, m0, s0] = a;
+    let [p1, m1, s1] = b;
+    let (h2, h3) = (h * h, h * h * h);
+    [
+        p0,
+        m0,
+        0.5 * s0,
+        (20.0 * (p1 - p0) - (8.0 * m1 + 12.0 * m0) * h - (3.0 * s0 - s1) * h2) / (2.0 * h3),
+        (30.0 * (p0 - p1) + (14.0 * m1 + 16.0 * m0) * h + (3.0 * s0 - 2.0 * s1) * h2)
+            / (2.0 * h3 * h),
+        (12.0 * (p1 - p0) - 6.0 * (m1 + m0) * h - (s0 - s1) * h2) / (2.0 * h3 * h2),
+    ]
 }
 
 /// Slopes of the not-a-knot cubic spline (third derivative continuous at the
@@ -232,6 +323,50 @@ mod tests {
             assert!(v >= last - 1e-15);
             last = v;
         }
+    }
+
+    #[test]
+    fn c2_twin_keeps_values_and_slopes_and_is_c2() {
+        let z = [0.0, 0.5, 1.0, 2.0, 3.0];
+        let r: Vec<f64> = z
+            .iter()
+            .map(|&z: &f64| z + 0.3 * z * z - 0.02 * z.powi(4))
+            .collect();
+        let m: Vec<f64> = z
+            .iter()
+            .map(|&z: &f64| 1.0 + 0.6 * z - 0.08 * z.powi(3))
+            .collect();
+        let s = Spline::fit(&z, &r, Some(&m));
+        let twin = s.c2_twin().expect("Hermite is C¹");
+        assert_eq!(twin.kind, SplineKind::QuinticTwin);
+        assert!(twin.c2_twin().is_none());
+        for k in 0..z.len() {
+            let (v, d) = twin.eval(z[k]);
+            assert!((v - r[k]).abs() < 1e-12 && (d - m[k]).abs() < 1e-12, "{k}");
+        }
+        for &zk in &z[1..z.len() - 1] {
+            let (below, above) = (
+                twin.second_derivative(zk - 1e-9),
+                twin.second_derivative(zk + 1e-9),
+            );
+            assert!(
+                (below - above).abs() < 1e-6,
+                "R″ jumps at {zk}: {below} vs {above}"
+            );
+            let (cb, ca) = (
+                s.second_derivative(zk - 1e-9),
+                s.second_derivative(zk + 1e-9),
+            );
+            assert!((0.5 * (cb + ca) - above).abs() < 1e-6);
+        }
+        // a quintic through a quintic's data reproduces it
+        let q = |z: f64| 1.0 + z - 0.5 * z * z + 0.1 * z.powi(5);
+        let c = quintic_hermite(
+            2.0,
+            [q(0.0), 1.0, -1.0],
+            [q(2.0), 1.0 - 2.0 + 0.5 * 16.0, -1.0 + 2.0 * 8.0],
+        );
+        assert!((poly_eval(&c, 1.3).0 - q(1.3)).abs() < 1e-12);
     }
 
     #[test]
