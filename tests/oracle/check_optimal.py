@@ -80,9 +80,9 @@ def hamiltonian_system(p, umin, umax):
     }
 
 
-def poly(z0, zf, t):
-    T = TF - T0
-    s = (t - T0) / T
+def poly(z0, zf, t, t0=T0, tf=TF):
+    T = tf - t0
+    s = (t - t0) / T
     d = zf - z0
     return (z0 + d * s ** 3 * (10 - 15 * s + 6 * s * s),
             d * 30 * s * s * (1 - s) ** 2 / T,
@@ -99,11 +99,11 @@ def inverse(hs, z, v, a):
     return np.array([z, v, np.sqrt(phi2)])
 
 
-def guess(hs, z0, zf, m=151):
-    t = np.linspace(T0, TF, m)
+def guess(hs, z0, zf, m=151, t0=T0, tf=TF):
+    t = np.linspace(t0, tf, m)
     X, U, G, As = [], [], [], []
     for ti in t:
-        z, v, a, j = poly(z0, zf, ti)
+        z, v, a, j = poly(z0, zf, ti, t0, tf)
         x = inverse(hs, z, v, a)
         al, be = (float(w) for w in hs["alpha_beta"](x))
         u = al + be * j
@@ -117,27 +117,29 @@ def guess(hs, z0, zf, m=151):
     p1 = np.array([-(d + As[i][1, 1] * p2[i] + As[i][2, 1] * p3[i]) / As[i][0, 1]
                    for i, d in enumerate(np.gradient(p2, t, edge_order=2))])
     P = np.column_stack([p1, p2, p3])
-    tf = np.linspace(T0, TF, 2001)
+    tfine = np.linspace(t0, tf, 2001)
     uf = []
-    for ti in tf:
-        z, v, a, j = poly(z0, zf, min(max(ti, T0 + 1e-12), TF - 1e-12))
+    for ti in tfine:
+        z, v, a, j = poly(z0, zf, min(max(ti, t0 + 1e-12 * (tf - t0)), tf - 1e-12 * (tf - t0)),
+                          t0, tf)
         x = inverse(hs, z, v, a)
         al, be = (float(w) for w in hs["alpha_beta"](x))
         uf.append(al + be * j)
     uf = np.array(uf)
     w = np.ones(2001); w[1:-1:2] = 4; w[2:-1:2] = 2
-    guess_cost = float(np.sum(w * uf ** 2) * (tf[1] - tf[0]) / 3)
+    guess_cost = float(np.sum(w * uf ** 2) * (tfine[1] - tfine[0]) / 3)
     return t, np.column_stack([X, P]).T, guess_cost, float(np.max(np.abs(uf)))
 
 
-def solve(desc, z0, zf, bound, tol):
+def solve(desc, z0, zf, bound, tol, t0=T0, tf=TF, umin=None):
+    """The free arc on [t0, tf] with u in [umin (default −bound), bound]."""
     p = load(desc)
-    hs = hamiltonian_system(p, -bound, bound)
+    hs = hamiltonian_system(p, -bound if umin is None else umin, bound)
     x0 = inverse(hs, z0, 0.0, 0.0)
     xf = inverse(hs, zf, 0.0, 0.0)
-    t, Y, gcost, gmax = guess(hs, z0, zf)
+    t, Y, gcost, gmax = guess(hs, z0, zf, t0=t0, tf=tf)
     stroke = abs(zf - z0)
-    s = np.array([stroke, 2 * stroke / (TF - T0), np.max(np.abs(Y[2]))]
+    s = np.array([stroke, 2 * stroke / (tf - t0), np.max(np.abs(Y[2]))]
                  + [np.max(np.abs(Y[3 + k])) for k in range(3)])
     rhs, jac = hs["rhs"], hs["jac"]
 
@@ -181,7 +183,7 @@ def solve(desc, z0, zf, bound, tol):
                               for i in range(xs.size - 1)] + [xs[-1:]])
     raw = np.array([ax(ti)[1] for ti in samples])
     switches = []
-    for b in (-bound, bound):
+    for b in (-bound if umin is None else umin, bound):
         for i in range(samples.size - 1):
             fa, fb = raw[i] - b, raw[i + 1] - b
             if (fa < 0) != (fb < 0):

@@ -141,7 +141,7 @@ pub enum OptimalError {
         #[source]
         source: Box<OptimalError>,
     },
-    #[error("the solver found no solution, and neither a larger bound (up to ×4, within the supply) nor a longer motion (up to ×4) has one: please report this description ({source})")]
+    #[error("the solver found no solution, and neither a larger bound (up to ×4, within the supply) nor a longer motion (up to ×16) has one: please report this description ({source})")]
     Unsolved {
         #[source]
         source: Box<OptimalError>,
@@ -178,7 +178,7 @@ pub struct HamiltonianSystem {
 }
 
 /// Indices of [`HamiltonianSystem::aux`] outputs.
-const AUX_U: usize = 0;
+pub(crate) const AUX_U: usize = 0;
 const AUX_RAW: usize = 1;
 const AUX_A: usize = 2;
 const AUX_JERK: usize = 3;
@@ -493,10 +493,15 @@ pub fn energy_optimal(
     }
 }
 
-/// Relaxations tried to tell an infeasible problem from a solver failure.
+/// Relaxations of the bound tried to tell an infeasible problem from a
+/// solver failure.
 const RELAX: [f64; 3] = [1.5, 2.5, 4.0];
+/// Relaxations of the motion time: up to ×16.
+const RELAX_TIME: [f64; 5] = [1.5, 2.5, 4.0, 8.0, 16.0];
 /// Relative accuracy of the bisection on the needed bound or duration.
-const NEED_TOL: f64 = 2e-3;
+const NEED_TOL: f64 = 5e-3;
+/// Collocation tolerance of the solves that only decide existence.
+const EXISTENCE_TOL: f64 = 1e-4;
 
 /// Why `spec` has no solution: the bound it needs (a larger u_max solves it),
 /// else the duration it needs, each found by bisection with the solver.
@@ -509,9 +514,13 @@ fn explain(
     let source = Box::new(err);
     let duration = spec.tf - spec.t0;
     let mut solves = |s: &OptimalSpec| design(model, lin, s).is_ok();
+    let coarse = OptimalSpec {
+        tol: spec.tol.max(EXISTENCE_TOL),
+        ..spec.clone()
+    };
     let with_bound = |b: f64| OptimalSpec {
         u_max: b,
-        ..spec.clone()
+        ..coarse.clone()
     };
     if spec.u_max > 0.0 {
         let candidates = RELAX.map(|k| (k * spec.u_max).min(spec.u_max_limit));
@@ -528,9 +537,9 @@ fn explain(
     }
     let with_duration = |d: f64| OptimalSpec {
         tf: spec.t0 + d,
-        ..spec.clone()
+        ..coarse.clone()
     };
-    if let Some(hi) = RELAX
+    if let Some(hi) = RELAX_TIME
         .iter()
         .map(|k| k * duration)
         .find(|&d| solves(&with_duration(d)))
@@ -576,18 +585,22 @@ fn design(
     let mut inner = spec.clone();
     for _ in 0..TWIN_BOUND_PASSES {
         let mut traj = solve(&mut twin, &twin_lin, &inner)?;
-        let f = super::feasibility::check(model, lin, &traj, (spec.u_min, spec.u_max), 2000);
-        let margin = 1e-7 * spec.u_max.abs().max(spec.u_min.abs());
-        let (over_hi, over_lo) = (f.max_input - spec.u_max, spec.u_min - f.min_input);
+        // the samples of the build's check, and a margin of its slack
+        let f = super::feasibility::check(model, lin, &traj, (spec.u_min, spec.u_max), 4000);
+        let margin = 2e-6 * spec.u_max.abs().max(spec.u_min.abs()).max(1.0);
+        let (over_hi, over_lo) = (
+            f.max_input - (spec.u_max - margin),
+            (spec.u_min + margin) - f.min_input,
+        );
         if !(over_hi > 0.0) && !(over_lo > 0.0) {
             traj.smoothed_gap = Some(what);
             return Ok(traj);
         }
         if over_hi > 0.0 {
-            inner.u_max = inner.u_max.min(spec.u_max - over_hi) - margin;
+            inner.u_max -= over_hi + margin;
         }
         if over_lo > 0.0 {
-            inner.u_min = inner.u_min.max(spec.u_min + over_lo) + margin;
+            inner.u_min += over_lo + margin;
         }
     }
     let mut traj = solve(&mut twin, &twin_lin, &inner)?;

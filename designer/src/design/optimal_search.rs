@@ -70,6 +70,8 @@ pub(crate) struct Arc {
     pub hamiltonian: [f64; 2],
     /// min and max of z at the nodes.
     pub z_range: [f64; 2],
+    /// ∫u*² dt by the trapezoid rule on the nodes (for stopping rules).
+    pub cost: f64,
 }
 
 impl Arc {
@@ -133,11 +135,21 @@ impl ArcSolver<'_> {
         let z_range = z.fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], z| {
             [lo.min(z), hi.max(z)]
         });
+        let u2: Vec<f64> = (0..=last)
+            .map(|k| self.sys.aux_at(sol.t[k], &sol.y[k])[super::optimal::AUX_U].powi(2))
+            .collect();
+        let cost = sol
+            .t
+            .windows(2)
+            .zip(u2.windows(2))
+            .map(|(t, u)| 0.5 * (t[1] - t[0]) * (u[0] + u[1]))
+            .sum();
         Ok(Arc {
             a,
             b,
             hamiltonian: [h(0), h(last)],
             z_range,
+            cost,
             sol,
         })
     }
@@ -205,6 +217,8 @@ enum Probe {
 const PROBE_MAX_NODES: usize = 4000;
 /// Relative width of the final bracket on τ.
 const TAU_TOL: f64 = 1e-9;
+/// Bound on the J still to gain by refining τ, relative to J.
+const GAIN_TOL: f64 = 1e-8;
 /// Durations tried below t_f − t₀ when the full motion fails: (0.85)^k.
 const SHRINK: f64 = 0.85;
 const SHRINK_STEPS: i32 = 14;
@@ -247,6 +261,9 @@ impl ArcSolver<'_> {
         let total = self.spec.tf - self.spec.t0;
         let first = match self.probe(rest, total, None) {
             Probe::Short(arc) => return Ok(self.finish(arc, rest)),
+            // the polynomial of the whole interval leaves the domain of T⁻¹:
+            // a shorter one would need more acceleration still
+            Probe::Failed(e @ OptimalError::Guess { .. }) => return Err(e),
             other => other,
         };
         let mut hi: (f64, Option<Arc>) = (total, long_arc(first_arc(&first)));
@@ -259,8 +276,12 @@ impl ArcSolver<'_> {
         for k in 1..=SHRINK_STEPS {
             let tau = total * SHRINK.powi(k);
             let mut probe = self.probe(rest, tau, None);
-            if let (Probe::Failed(_), Some(w)) = (&probe, warm.as_ref()) {
+            let solver_failed = matches!(&probe, Probe::Failed(e) if !matches!(e, OptimalError::OutsideStroke { .. }));
+            if let (true, Some(w)) = (solver_failed, warm.as_ref()) {
                 probe = self.probe(rest, tau, Some(w));
+            }
+            if let Probe::Failed(OptimalError::Guess { .. }) = probe {
+                break;
             }
             match probe {
                 Probe::Short(arc) => {
@@ -291,9 +312,10 @@ impl ArcSolver<'_> {
         for _ in 0..MAX_REFINE {
             let width = hi.0 - lo.0;
             let s_lo = Self::slope(&lo.1, rest);
-            // Φ(τ*) − Φ(lo) ≤ |Φ′(lo)|·width: stop when that is negligible
+            // Φ(lo) − Φ(τ*) ≲ |Φ′(lo)|·width: stop when that is negligible
+            // against J (far below the 1e-6 the oracles hold J to)
             let gain_bound = s_lo.abs() * width;
-            if width <= TAU_TOL * total || gain_bound <= TAU_TOL * rest.rate * total {
+            if width <= TAU_TOL * total || gain_bound <= GAIN_TOL * lo.1.cost {
                 break;
             }
             let tau = match &hi.1 {
@@ -309,7 +331,16 @@ impl ArcSolver<'_> {
                 }
                 _ => 0.5 * (lo.0 + hi.0),
             };
-            let moved_lo = match self.probe(rest, tau, Some(&lo.1)) {
+            // the polynomial guess is cheaper where it converges; the
+            // continuation from the short end where it does not
+            let probe = match self.probe(rest, tau, None) {
+                Probe::Failed(OptimalError::OutsideStroke { .. }) => {
+                    Probe::Failed(OptimalError::NoShortArc { total: tau })
+                }
+                Probe::Failed(_) => self.probe(rest, tau, Some(&lo.1)),
+                found => found,
+            };
+            let moved_lo = match probe {
                 Probe::Short(arc) => {
                     *lo = (tau, arc);
                     true
