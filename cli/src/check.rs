@@ -43,6 +43,15 @@ pub fn summary(model: &mut Model, file: &str) -> String {
     for (name, _, value) in model.params.iter() {
         let _ = writeln!(s, "  {name:<12} = {value:e}");
     }
+    s.push_str(&statics_text(model));
+    s.push_str(&design_text(&d));
+    s
+}
+
+/// The statics block (pull-in, drop-out, holding), also printed by `limits`.
+pub fn statics_text(model: &mut Model) -> String {
+    let mut s = String::new();
+    let d = model.description.clone();
     let st = Statics::of(model);
     let (unit, what) = match d.supply.drive {
         Drive::Voltage => ("V", "voltage"),
@@ -79,7 +88,6 @@ pub fn summary(model: &mut Model, file: &str) -> String {
             "  (Jiles–Atherton core: statics on the anhysteretic curve)"
         );
     }
-    s.push_str(&design_text(&d));
     s
 }
 

@@ -10,6 +10,7 @@ mod diagnose;
 mod diagnose_plot;
 mod eval;
 mod fit;
+mod limits;
 mod observe;
 mod plot;
 mod simulate;
@@ -55,6 +56,8 @@ enum Command {
     Fit(fit::Args),
     /// Replay a recording, name what the model gets wrong, write the extended model and plots.
     Diagnose(diagnose::Args),
+    /// The device's limits: shortest energy-optimal motion per operation, its peak current and flux, J against the motion time.
+    Limits(limits::Args),
 }
 
 fn main() -> ExitCode {
@@ -72,6 +75,7 @@ fn main() -> ExitCode {
         Command::Observe(args) => observe::run(&args),
         Command::Fit(args) => fit::run(&args),
         Command::Diagnose(args) => diagnose::run(&args),
+        Command::Limits(args) => limits::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -9,12 +9,14 @@
 //! - `optimal.rs`: the energy-optimal reference (Pontryagin, eqs. 58–66);
 //! - `optimal_guess.rs`: rest states and the polynomial initial guess of an arc;
 //! - `optimal_search.rs`: rest, move, rest: the optimum within the stroke (57);
+//! - `limits.rs`: the shortest motion and J against the motion time (`limits`);
 //! - `segments.rs`: a reference as a compact table of polynomial segments.
 
 mod bvp;
 mod feasibility;
 mod fit_segments;
 mod lie;
+mod limits;
 mod linearization;
 mod optimal;
 mod optimal_guess;
@@ -32,6 +34,7 @@ pub use fit_segments::{
     Signals, TableErrors, ACCEPT,
 };
 pub use lie::{lie, vanishing_factors, AffineSystem, OutputDerivatives};
+pub use limits::{device_limits, motion_limits, CostPoint, LimitsJob, MotionLimits};
 pub use linearization::{DesignError, Linearization};
 pub use optimal::{
     energy_optimal, CostateGuess, HamiltonianSystem, OptimalError, OptimalSpec, OptimalTrajectory,

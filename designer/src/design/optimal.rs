@@ -652,7 +652,7 @@ fn solve(
 
 /// Per-component scales of [x; p]: stroke, mean speed ×2, the guess's peak
 /// flux and chain costates.
-fn scales(spec: &OptimalSpec, guess: &super::optimal_guess::Guess) -> Vec<f64> {
+pub(crate) fn scales(spec: &OptimalSpec, guess: &super::optimal_guess::Guess) -> Vec<f64> {
     let stroke = (spec.zf - spec.z0).abs();
     let duration = spec.tf - spec.t0;
     let phi_scale = guess.y.iter().map(|y| y[2].abs()).fold(0.0, f64::max);

@@ -156,7 +156,7 @@ impl ArcSolver<'_> {
 
     /// Whether the arc stays within the stroke (to 1e-10 of it, tighter
     /// than the feasibility check's 1e-9).
-    fn within_stroke(&self, arc: &Arc) -> bool {
+    pub fn within_stroke(&self, arc: &Arc) -> bool {
         let (lo, hi) = (
             self.spec.z0.min(self.spec.zf),
             self.spec.z0.max(self.spec.zf),
