@@ -22,7 +22,7 @@ use crate::sym::Tape;
 use super::linearization::Linearization;
 use super::optimal::{HamiltonianSystem, OptimalError, OptimalSpec, AUX_U};
 use super::optimal_guess::GuessTapes;
-use super::optimal_search::{Arc, ArcSolver};
+use super::optimal_search::{Arc, ArcSolver, PROBE_MAX_NODES};
 use super::reference::Polynomial;
 
 /// One point of the J(t_f − t₀) curve.
@@ -150,6 +150,7 @@ fn limits_on(
         x0,
         xf,
         scale,
+        max_nodes: PROBE_MAX_NODES,
     };
     // a first arc, around `start`
     let first = FIRST.iter().map(|k| k * start).find_map(|d| {

@@ -46,7 +46,7 @@ use crate::sym::{Id, Tape};
 use super::bvp::{BvpError, BvpSolution};
 use super::linearization::Linearization;
 use super::optimal_guess::GuessTapes;
-use super::optimal_search::{ArcSolver, Plan, Rest};
+use super::optimal_search::{ArcSolver, Plan, Rest, PROBE_MAX_NODES, SEARCH_TOL};
 use super::reference::{Flat, Polynomial, Reference};
 
 /// How the costates p₁, p₂ of the initial guess are built.
@@ -177,6 +177,30 @@ pub struct HamiltonianSystem {
     scratch: RefCell<(Vec<f64>, Vec<f64>)>,
 }
 
+/// The position the Hamiltonian system's model sees: z itself down to
+/// z_b = z_min − Z_EPS/4, and below it z_b − δ·w/√(1 + w²), w = (z_b − z)/δ,
+/// δ = Z_EPS/2, which joins z with matching first and second derivatives and
+/// never goes below z_min − ¾·Z_EPS. Collocation midpoints, interpolated mesh
+/// nodes and Newton iterates may dip past the closing stop; the McLyman
+/// logarithm ln(k/(z + Z_EPS)) stays defined there, and the model is the
+/// description's own wherever it was defined before. Arcs that actually leave
+/// the stroke are rejected by the search (`optimal_search.rs`).
+fn stroke_extension(g: &mut crate::sym::Graph, z: Id, z_min: f64) -> Id {
+    let delta = 0.5 * crate::model::Z_EPS;
+    let z_b = z_min - 0.25 * crate::model::Z_EPS;
+    let zmin = g.constant(z_b);
+    let depth = g.sub(zmin, z);
+    let w = g.scale(1.0 / delta, depth);
+    let w2 = g.powi(w, 2);
+    let one = g.one();
+    let r = g.add(one, w2);
+    let root = g.sqrt(r);
+    let s = g.div(w, root);
+    let ds = g.scale(-delta, s);
+    let below = g.add(zmin, ds);
+    g.piecewise(z, &[z_b], &[below, z])
+}
+
 /// Indices of [`HamiltonianSystem::aux`] outputs.
 pub(crate) const AUX_U: usize = 0;
 const AUX_RAW: usize = 1;
@@ -209,9 +233,15 @@ impl HamiltonianSystem {
         }
         let x: Vec<Id> = model.states.clone();
         let (u, t) = (model.input, model.time);
-        let f = model.f.clone();
-        let gfield = lin.system.input_field.clone();
+        let z_min = model.description.mechanics.z_min;
         let g = &mut model.graph;
+        // the model seen through the stroke extension (identity on the stroke)
+        let zeta = stroke_extension(g, x[0], z_min);
+        let ext: HashMap<Id, Id> = std::iter::once((x[0], zeta)).collect();
+        let f: Vec<Id> = model.f.iter().map(|&fi| g.substitute(fi, &ext)).collect();
+        let gfield: Vec<Id> = (lin.system.input_field.iter())
+            .map(|&gi| g.substitute(gi, &ext))
+            .collect();
         let p = [g.symbol("p1"), g.symbol("p2"), g.symbol("p3")];
         // u* = clamp(−pᵀg/2, u_min, u_max)
         let pg_terms: Vec<Id> = p
@@ -627,13 +657,24 @@ fn solve(
         tf: spec.tf,
     };
     let guess = tapes.polynomial(&full, spec.nodes, spec.costate_guess)?;
-    let solver = ArcSolver {
+    let precise = ArcSolver {
         sys: &sys,
         tapes: &tapes,
         spec,
         x0,
         xf,
         scale: scales(spec, &guess),
+        max_nodes: spec.max_nodes,
+    };
+    let search_spec = OptimalSpec {
+        tol: spec.tol.max(SEARCH_TOL),
+        ..spec.clone()
+    };
+    let search = ArcSolver {
+        spec: &search_spec,
+        scale: precise.scale.clone(),
+        max_nodes: spec.max_nodes.min(PROBE_MAX_NODES),
+        ..precise
     };
     let rest_inputs = [tapes.rest_input(x0, spec.t0), tapes.rest_input(xf, spec.tf)];
     let [c0, cf] = rest_inputs.map(|u| u * u);
@@ -641,7 +682,7 @@ fn solve(
         at_end: cf <= c0,
         rate: c0.min(cf),
     };
-    let plan = solver.plan(rest)?;
+    let plan = search.plan(rest, &precise)?;
     let mut traj = trajectory(&sys, spec, plan, [x0, xf], rest_inputs);
     traj.guess_cost = guess.cost;
     traj.guess_max_abs_input = guess.max_abs_u;

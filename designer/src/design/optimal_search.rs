@@ -89,6 +89,8 @@ pub(crate) struct ArcSolver<'a> {
     pub xf: [f64; 3],
     /// Per-component scale of [x; p] for the BVP solver.
     pub scale: Vec<f64>,
+    /// Mesh cap of one arc.
+    pub max_nodes: usize,
 }
 
 impl ArcSolver<'_> {
@@ -112,7 +114,7 @@ impl ArcSolver<'_> {
         let s = &self.scale;
         let opts = BvpOptions {
             tol: self.spec.tol,
-            max_nodes: self.spec.max_nodes.min(PROBE_MAX_NODES),
+            max_nodes: self.max_nodes,
             scale: Some(s.clone()),
             bc_scale: Some(vec![s[0], s[1], s[2], s[0], s[1], s[2]]),
             ..BvpOptions::default()
@@ -157,11 +159,16 @@ impl ArcSolver<'_> {
     /// Whether the arc stays within the stroke (to 1e-10 of it, tighter
     /// than the feasibility check's 1e-9).
     pub fn within_stroke(&self, arc: &Arc) -> bool {
+        self.within_stroke_by(arc, 1e-10)
+    }
+
+    /// Whether the arc stays within the stroke to `margin` of it.
+    fn within_stroke_by(&self, arc: &Arc, margin: f64) -> bool {
         let (lo, hi) = (
             self.spec.z0.min(self.spec.zf),
             self.spec.z0.max(self.spec.zf),
         );
-        let margin = 1e-10 * (hi - lo);
+        let margin = margin * (hi - lo);
         arc.z_range[0] >= lo - margin && arc.z_range[1] <= hi + margin
     }
 }
@@ -211,10 +218,13 @@ enum Probe {
     Failed(OptimalError),
 }
 
-/// Mesh cap of one arc: converged arcs of the test grid need < 1 000 nodes;
-/// a Newton that diverges keeps refining up to the cap, which bounds the cost
-/// of a failed probe.
-const PROBE_MAX_NODES: usize = 4000;
+/// Mesh cap of a search's probes: converged arcs of the test grid need
+/// < 1 000 nodes at the search tolerance; a Newton that diverges keeps
+/// refining up to the cap, which bounds the cost of a failed probe.
+pub(crate) const PROBE_MAX_NODES: usize = 4000;
+/// Collocation tolerance of the search's probes; the chosen arc is then
+/// solved again at the design's tolerance (`polish`).
+pub(crate) const SEARCH_TOL: f64 = 1e-4;
 /// Relative width of the final bracket on τ.
 const TAU_TOL: f64 = 1e-9;
 /// Bound on the J still to gain by refining τ, relative to J.
@@ -256,10 +266,12 @@ impl ArcSolver<'_> {
         }
     }
 
-    /// The optimal duration and its arc (module docs).
-    pub fn plan(&self, rest: Rest) -> Result<Plan, OptimalError> {
+    /// The optimal duration and its arc (module docs): the whole interval by
+    /// `precise`; if that is not optimal, the search by `self` (coarser), and
+    /// the arc found solved again by `precise`.
+    pub fn plan(&self, rest: Rest, precise: &ArcSolver) -> Result<Plan, OptimalError> {
         let total = self.spec.tf - self.spec.t0;
-        let first = match self.probe(rest, total, None) {
+        let first = match precise.probe(rest, total, None) {
             Probe::Short(arc) => return Ok(self.finish(arc, rest)),
             // the polynomial of the whole interval leaves the domain of T⁻¹:
             // a shorter one would need more acceleration still
@@ -299,7 +311,21 @@ impl ArcSolver<'_> {
             return Err(first_error.unwrap_or(OptimalError::NoShortArc { total }));
         };
         self.refine(rest, &mut lo, &mut hi, total);
-        Ok(self.finish(lo.1, rest))
+        let (a, b) = (lo.1.a, lo.1.b);
+        // from the polynomial guess first (as an independent solver would),
+        // from the search's arc where that fails
+        // (to the feasibility check's slack, 1e-9 of the stroke)
+        let arc = match precise.solve(a, b, None) {
+            Ok(arc) if precise.within_stroke_by(&arc, 1e-9) => arc,
+            _ => precise.solve(a, b, Some(&lo.1))?,
+        };
+        if !precise.within_stroke_by(&arc, 1e-9) {
+            return Err(OptimalError::OutsideStroke {
+                z_range: arc.z_range,
+                duration: b - a,
+            });
+        }
+        Ok(self.finish(arc, rest))
     }
 
     /// Narrows [lo, hi] around H(τ) = c; keeps the short end's arc. Regula
