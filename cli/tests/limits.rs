@@ -239,3 +239,28 @@ fn limits_refuses_a_hysteretic_core_with_a_reason() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("not input-affine"), "{err}");
 }
+
+#[test]
+fn an_infeasible_polynomial_says_which_time_it_needs_and_that_time_works() {
+    let poly = [("shape = \"energy-optimal\"", "shape = \"polynomial\"")];
+    let short = relay_with(
+        "poly-short",
+        &[poly[0], ("landing = 11e-3", "landing = 3e-3")],
+    );
+    let (ok, err) = build(&short);
+    assert!(!ok);
+    assert!(err.contains("the closing reference is infeasible"), "{err}");
+    let needed = number_after(
+        &err,
+        "the polynomial needs trajectory.landing − trajectory.takeoff ≥",
+    );
+    // the polynomial needs more time than the energy-optimal motion (3.56 ms)
+    assert!(needed > 3.6, "{needed}");
+    let landing = format!("landing = {:e}", 1e-3 + 1.002 * needed * 1e-3);
+    let enough = relay_with("poly-enough", &[poly[0], ("landing = 11e-3", &landing)]);
+    let (ok, report) = build(&enough);
+    assert!(ok, "{report}");
+    let landing = format!("landing = {:e}", 1e-3 + 0.98 * needed * 1e-3);
+    let too_short = relay_with("poly-too-short", &[poly[0], ("landing = 11e-3", &landing)]);
+    assert!(!build(&too_short).0);
+}

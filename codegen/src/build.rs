@@ -190,10 +190,19 @@ fn design_controller(
         let feasibility =
             check_feasibility(model, &linearization, reference.as_ref(), bounds, 4000);
         if !feasibility.is_feasible() {
+            let mut report = feasibility.report();
+            if optimal.is_none() {
+                report.push_str(&polynomial_remedy(
+                    model,
+                    &linearization,
+                    &polynomial,
+                    bounds,
+                ));
+            }
             return Err(BuildError::Infeasible {
                 file,
                 operation: name,
-                report: feasibility.report(),
+                report,
             });
         }
         let breaks: Vec<f64> = optimal.iter().flat_map(|o| o.breaks()).collect();
@@ -242,6 +251,48 @@ fn design_kalman(
             estimator: "ekf/ukf",
             message: e.to_string(),
         })
+}
+
+/// What makes an infeasible polynomial feasible: the motion time it needs
+/// (bisected to 0.5 % on the feasibility check), or that no time up to ×16 does.
+fn polynomial_remedy(
+    model: &mut Model,
+    lin: &Linearization,
+    polynomial: &Polynomial,
+    bounds: (f64, f64),
+) -> String {
+    let duration = polynomial.tf - polynomial.t0;
+    let mut feasible = |d: f64| {
+        let p = Polynomial {
+            tf: polynomial.t0 + d,
+            ..*polynomial
+        };
+        check_feasibility(model, lin, &p, bounds, 1000).is_feasible()
+    };
+    let Some(mut hi) = [1.5, 2.5, 4.0, 8.0, 16.0]
+        .into_iter()
+        .map(|k| k * duration)
+        .find(|&d| feasible(d))
+    else {
+        return "  no polynomial of up to 16× this motion time is feasible within these bounds: \
+                see `reldesign limits` for what the device can do\n"
+            .to_string();
+    };
+    let mut lo = duration;
+    while hi - lo > 5e-3 * hi {
+        let mid = 0.5 * (lo + hi);
+        if feasible(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    format!(
+        "  the polynomial needs trajectory.landing − trajectory.takeoff ≥ {:.4} ms (it is {:.4} ms); \
+         shape = \"energy-optimal\" may need less (`reldesign limits` gives its shortest motion)\n",
+        hi * 1e3,
+        duration * 1e3
+    )
 }
 
 /// What an energy-optimal failure means for the description's keys.
