@@ -159,8 +159,11 @@ fn input_signal(args: &Args, drive: Drive) -> Result<(PiecewiseLinear, Vec<f64>)
     if !(args.dt > 0.0) || !(t_end > 0.0) {
         return Err(fail("--dt and --t-end must be positive"));
     }
-    let n = (t_end / args.dt).round() as usize;
-    let times = (0..=n).map(|k| (k as f64 * args.dt).min(t_end)).collect();
+    // a uniform grid ending at the last whole step within t_end (a shorter
+    // last step would make the record non-uniform, which `diagnose` and `fit`
+    // reject as measured data)
+    let n = (t_end / args.dt * (1.0 + 1e-12)).floor() as usize;
+    let times = (0..=n).map(|k| k as f64 * args.dt).collect();
     Ok((input, times))
 }
 

@@ -1,6 +1,9 @@
 //! Recorded signals in the measured-data CSV format
 //! (`shared/spec/measured-data.md`): one header row naming the columns, `#`
-//! comment lines anywhere, comma-separated numbers, column order free.
+//! comment lines anywhere, comma-separated numbers, column order free. Read
+//! as oscilloscope and DAQ software writes it: a UTF-8 byte-order mark,
+//! quoted names or cells, CRLF line ends; a file separated by semicolons (or
+//! tabs) throughout is read as such, and a decimal comma is named as such.
 //!
 //! Errors name the file, the line (1-based, as an editor shows it) and the
 //! column, and say what was expected.
@@ -84,15 +87,30 @@ impl Record {
 
     pub fn parse(text: &str, file: &str) -> Result<Record, RecordError> {
         let err_file = || file.to_owned();
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .map(|(k, l)| (k + 1, l.trim()))
-            .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let delimiter = delimiter(text);
+        let mut reader = csv::ReaderBuilder::new()
+            .delimiter(delimiter)
+            .comment(Some(b'#'))
+            .trim(csv::Trim::All)
+            .has_headers(false)
+            .flexible(true)
+            .from_reader(text.as_bytes());
+        // one record per line (numbers never hold a newline): the k-th
+        // record is the k-th line that is neither blank nor a comment
+        let mut numbers = content_lines(text);
+        let mut lines = reader.records().filter_map(|r| match r {
+            Ok(r) if r.iter().all(str::is_empty) => None,
+            Ok(r) => Some(Ok((numbers.next().unwrap_or(0), r))),
+            Err(e) => Some(Err(RecordError::Io {
+                file: err_file(),
+                message: e.to_string(),
+            })),
+        });
         let (header_line, header) = lines
             .next()
-            .ok_or(RecordError::NoHeader { file: err_file() })?;
-        let columns: Vec<String> = header.split(',').map(|c| c.trim().to_owned()).collect();
+            .ok_or(RecordError::NoHeader { file: err_file() })??;
+        let columns: Vec<String> = header.iter().map(str::to_owned).collect();
         for (k, c) in columns.iter().enumerate() {
             if columns[..k].contains(c) {
                 return Err(RecordError::DuplicateColumn {
@@ -104,8 +122,8 @@ impl Record {
         }
         let mut rows = Vec::new();
         let mut row_lines = Vec::new();
-        for (line, text) in lines {
-            let cells: Vec<&str> = text.split(',').map(str::trim).collect();
+        for entry in lines {
+            let (line, cells) = entry?;
             if cells.len() != columns.len() {
                 return Err(RecordError::RowLength {
                     file: err_file(),
@@ -117,14 +135,13 @@ impl Record {
             let row = cells
                 .iter()
                 .zip(&columns)
-                .map(|(cell, column)| match cell.parse::<f64>() {
-                    Ok(v) if v.is_finite() => Ok(v),
-                    _ => Err(RecordError::NotANumber {
+                .map(|(cell, column)| {
+                    number(cell, delimiter).map_err(|found| RecordError::NotANumber {
                         file: err_file(),
                         line,
                         column: column.clone(),
-                        found: (*cell).to_owned(),
-                    }),
+                        found,
+                    })
                 })
                 .collect::<Result<Vec<f64>, _>>()?;
             rows.push(row);
@@ -198,6 +215,50 @@ impl Record {
     }
 }
 
+/// The 1-based numbers (as an editor counts) of the lines that hold records.
+fn content_lines(text: &str) -> impl Iterator<Item = usize> + '_ {
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| {
+            let l = l.trim();
+            !l.is_empty()
+                && !l.starts_with('#')
+                && !l.split([',', ';', '\t']).all(|c| c.trim().is_empty())
+        })
+        .map(|(k, _)| k + 1)
+}
+
+/// The separator of the header row: a comma where it has one, else a
+/// semicolon or a tab where it has one (European and DAQ exports), else a
+/// comma (a single column).
+fn delimiter(text: &str) -> u8 {
+    let header = text
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#'))
+        .unwrap_or("");
+    [b',', b';', b'\t']
+        .into_iter()
+        .find(|&d| header.as_bytes().contains(&d))
+        .unwrap_or(b',')
+}
+
+/// A finite number, or what was found instead (naming a decimal comma).
+fn number(cell: &str, delimiter: u8) -> Result<f64, String> {
+    match cell.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ if delimiter != b','
+            && cell.contains(',')
+            && cell.replace(',', ".").parse::<f64>().is_ok() =>
+        {
+            Err(format!(
+                "{cell}` (a decimal comma: export with a decimal point"
+            ))
+        }
+        _ => Err(cell.to_owned()),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -253,5 +314,36 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("in.csv:5"));
+    }
+
+    /// Issue 12 §4: the forms DAQ and oscilloscope software write.
+    #[test]
+    fn reads_records_as_daq_software_writes_them() {
+        let plain = Record::parse("t,v,i\n0,1,0.5\n1e-3,2,0.25\n", "p.csv").unwrap();
+        let forms = [
+            ("byte-order mark", "\u{feff}t,v,i\n0,1,0.5\n1e-3,2,0.25\n"),
+            ("quoted header", "\"t\",\"v\",\"i\"\n0,1,0.5\n1e-3,2,0.25\n"),
+            (
+                "quoted cells",
+                "\"t\",\"v\",\"i\"\n\"0\",\"1\",\"0.5\"\n\"1e-3\",\"2\",\"0.25\"\n",
+            ),
+            ("CRLF", "t,v,i\r\n0,1,0.5\r\n1e-3,2,0.25\r\n"),
+            (
+                "BOM, quotes and CRLF",
+                "\u{feff}\"t\",\"v\",\"i\"\r\n0,1,0.5\r\n1e-3,2,0.25\r\n",
+            ),
+            ("semicolons", "t;v;i\n0;1;0.5\n1e-3;2;0.25\n"),
+            ("tabs", "t\tv\ti\n0\t1\t0.5\n1e-3\t2\t0.25\n"),
+        ];
+        for (what, text) in forms {
+            let r = Record::parse(text, "daq.csv").unwrap_or_else(|e| panic!("{what}: {e}"));
+            assert_eq!(r.columns, plain.columns, "{what}");
+            assert_eq!(r.rows, plain.rows, "{what}");
+            assert_eq!(r.lines, vec![2, 3], "{what}");
+        }
+        let e = Record::parse("t;v;i\n0;1,5;0,5\n", "eu.csv")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("eu.csv:2") && e.contains("decimal comma"), "{e}");
     }
 }
