@@ -277,6 +277,16 @@ fn text_report(
     for na in &d.not_applicable {
         let _ = writeln!(s, "  {:<17} not tried: {}", na.cause.name(), na.reason);
     }
+    for r in &d.rejected {
+        let _ = writeln!(
+            s,
+            "  {:<17} not named: it wins on the fitted part but not on the held-out end (gain {:.1} %, {} → {})",
+            r.cause.name(),
+            100.0 * r.held_out.gain,
+            percent(r.held_out.baseline_wnrmse),
+            percent(r.held_out.extended_wnrmse)
+        );
+    }
     let _ = writeln!(s, "cause: {}", d.cause);
     let _ = writeln!(s, "extended model: {}", out.extended.display());
     let _ = writeln!(
@@ -337,6 +347,10 @@ fn json_report(d: &Diagnosis, out: &Outputs, loc: &Localisation) -> Value {
             "extended_wnrmse": h.extended_wnrmse,
             "gain": h.gain,
         })),
+        "rejected": d.rejected.iter().map(|r| json!({
+            "cause": r.cause.name(),
+            "held_out_gain": r.held_out.gain,
+        })).collect::<Vec<_>>(),
         "noise_floor": d.noise_floor,
         "current_noise": d.current_noise,
         "fitted_samples": d.fitted_samples,

@@ -163,7 +163,7 @@ fn input_signal(args: &Args, drive: Drive) -> Result<(PiecewiseLinear, Vec<f64>)
     // last step would make the record non-uniform, which `diagnose` and `fit`
     // reject as measured data)
     let n = (t_end / args.dt * (1.0 + 1e-12)).floor() as usize;
-    let times = (0..=n).map(|k| k as f64 * args.dt).collect();
+    let times = (0..=n).map(|k| (k as f64 * args.dt).min(t_end)).collect();
     Ok((input, times))
 }
 

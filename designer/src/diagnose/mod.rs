@@ -94,6 +94,13 @@ impl Gain {
     }
 }
 
+/// A cause that won on the fitted part and lost on the held-out end.
+#[derive(Debug, Clone, Copy)]
+pub struct Rejected {
+    pub cause: Cause,
+    pub held_out: Gain,
+}
+
 /// The outcome of a diagnosis.
 #[derive(Debug, Clone)]
 pub struct Diagnosis {
@@ -102,6 +109,9 @@ pub struct Diagnosis {
     pub whole: Gain,
     /// On the held-out end of the record (not used by any fit).
     pub held_out: Option<Gain>,
+    /// Candidates that beat `none` on the fitted part but not on the
+    /// held-out end, best first: not named.
+    pub rejected: Vec<Rejected>,
     /// wNRMSE that the current's measurement noise alone gives.
     pub noise_floor: f64,
     /// Estimated standard deviation of the current noise [A].
@@ -214,28 +224,53 @@ pub fn diagnose(
     }
     ranking.sort_by(|a, b| a.bic.total_cmp(&b.bic).then(a.cause.cmp(&b.cause)));
 
-    let winner = choose(&ranking, noise_floor, options.floor_factor);
-    let extended = ranking
-        .iter()
-        .find(|s| s.cause == winner)
-        .and_then(|s| s.fit.as_ref().ok())
-        .map_or_else(|| baseline.clone(), |f| f.description.clone());
-    let extended_replay = replay(&extended)?;
-    let whole = Gain::new(
-        wnrmse(&baseline_replay.current, &data.i, &weights),
-        wnrmse(&extended_replay.current, &data.i, &weights),
-    );
-    let held_out = (fitted_samples < n).then(|| {
-        let k = fitted_samples;
+    // The best candidate that beats `none` and does not lose on the
+    // held-out part: a cause whose held-out gain is not positive is never
+    // named (it explains the fitted part only).
+    let whole_gain = |r: &SimOutputs| {
         Gain::new(
-            wnrmse(&baseline_replay.current[k..], &data.i[k..], &weights[k..]),
-            wnrmse(&extended_replay.current[k..], &data.i[k..], &weights[k..]),
+            wnrmse(&baseline_replay.current, &data.i, &weights),
+            wnrmse(&r.current, &data.i, &weights),
         )
-    });
+    };
+    let held_out_gain = |r: &SimOutputs| {
+        (fitted_samples < n).then(|| {
+            let k = fitted_samples;
+            Gain::new(
+                wnrmse(&baseline_replay.current[k..], &data.i[k..], &weights[k..]),
+                wnrmse(&r.current[k..], &data.i[k..], &weights[k..]),
+            )
+        })
+    };
+    let mut rejected = Vec::new();
+    let mut chosen = None;
+    for scored in eligible(&ranking, noise_floor, options.floor_factor) {
+        let Ok(fit) = scored.fit.as_ref() else {
+            continue;
+        };
+        let extended_replay = replay(&fit.description)?;
+        match held_out_gain(&extended_replay) {
+            Some(h) if !(h.gain > 0.0) => rejected.push(Rejected {
+                cause: scored.cause,
+                held_out: h,
+            }),
+            _ => {
+                chosen = Some((scored.cause, fit.description.clone(), extended_replay));
+                break;
+            }
+        }
+    }
+    let (winner, extended, extended_replay) = match chosen {
+        Some(c) => c,
+        None => (Cause::None, baseline.clone(), baseline_replay.clone()),
+    };
+    let whole = whole_gain(&extended_replay);
+    let held_out = held_out_gain(&extended_replay);
     Ok(Diagnosis {
         cause: winner,
         whole,
         held_out,
+        rejected,
         noise_floor,
         current_noise,
         extended,
@@ -318,17 +353,20 @@ fn hysteresis_starts(baseline: &Description, own: Candidate, ranking: &[Scored])
     std::iter::once(own).chain(seeded).collect()
 }
 
-/// The best-ranked extension when it beats the baseline's own best (`none`)
-/// by BIC and the baseline's error stands clear of the noise floor.
-fn choose(ranking: &[Scored], noise_floor: f64, floor_factor: f64) -> Cause {
+/// The extensions that beat the baseline's own best (`none`) by BIC, best
+/// first, when the baseline's error stands clear of the noise floor.
+fn eligible(ranking: &[Scored], noise_floor: f64, floor_factor: f64) -> Vec<&Scored> {
     let Some(none) = ranking.iter().find(|s| s.cause == Cause::None) else {
-        return Cause::None;
+        return Vec::new();
     };
-    let explained = none.wnrmse_fit <= floor_factor * noise_floor;
-    match ranking.first() {
-        Some(best) if best.cause != Cause::None && best.bic < none.bic && !explained => best.cause,
-        _ => Cause::None,
+    if none.wnrmse_fit <= floor_factor * noise_floor {
+        return Vec::new();
     }
+    ranking
+        .iter()
+        .take_while(|s| s.cause != Cause::None)
+        .filter(|s| s.bic < none.bic && s.fit.is_ok())
+        .collect()
 }
 
 /// Whether the simulated armature is in free motion at each sample (mode 2).
