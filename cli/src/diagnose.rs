@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use designer::description::edit::{annotate, write_physics};
 use designer::description::Description;
 use designer::diagnose::localise::{localise, Localisation, Signals};
-use designer::diagnose::{diagnose, Cause, Diagnosis, Options};
+use designer::diagnose::{diagnose, Cause, Diagnosis, FittedParameter, Options};
 use designer::identify::{flux_from_data, Measured, SimOutputs};
 use miette::Report;
 use serde_json::{json, Value};
@@ -104,10 +104,14 @@ pub fn run(args: &Args) -> Result<(), Report> {
     ])
     .map_err(fail)?;
 
+    let parameters = d.parameters(&description, &data);
     if args.json {
-        println!("{}", json_report(&d, &outputs, &localisation));
+        println!("{}", json_report(&d, &outputs, &localisation, &parameters));
     } else {
-        print!("{}", text_report(args, &data, &d, &localisation, &outputs));
+        print!(
+            "{}",
+            text_report(args, &data, &d, &localisation, &outputs, &parameters)
+        );
     }
     Ok(())
 }
@@ -224,6 +228,7 @@ fn text_report(
     d: &Diagnosis,
     loc: &Localisation,
     out: &Outputs,
+    parameters: &[FittedParameter],
 ) -> String {
     let mut s = String::new();
     let n = data.t.len();
@@ -288,6 +293,16 @@ fn text_report(
         );
     }
     let _ = writeln!(s, "cause: {}", d.cause);
+    for p in parameters {
+        let baseline = p
+            .baseline
+            .map_or("(new)".to_string(), |b| format!("{b:.4e}"));
+        let _ = writeln!(
+            s,
+            "  {:<24} = {:.4e} ± {:.2e} (standard error; baseline {baseline})",
+            p.path, p.value, p.std_error
+        );
+    }
     let _ = writeln!(s, "extended model: {}", out.extended.display());
     let _ = writeln!(
         s,
@@ -316,7 +331,19 @@ fn text_report(
     s
 }
 
-fn json_report(d: &Diagnosis, out: &Outputs, loc: &Localisation) -> Value {
+fn json_report(
+    d: &Diagnosis,
+    out: &Outputs,
+    loc: &Localisation,
+    parameters: &[FittedParameter],
+) -> Value {
+    let parameters: serde_json::Map<String, Value> = parameters
+        .iter()
+        .map(|p| {
+            let v = json!({"value": p.value, "std_error": p.std_error, "baseline": p.baseline});
+            (p.path.clone(), v)
+        })
+        .collect();
     let candidates: Vec<Value> = d
         .ranking
         .iter()
@@ -347,6 +374,7 @@ fn json_report(d: &Diagnosis, out: &Outputs, loc: &Localisation) -> Value {
             "extended_wnrmse": h.extended_wnrmse,
             "gain": h.gain,
         })),
+        "parameters": parameters,
         "rejected": d.rejected.iter().map(|r| json!({
             "cause": r.cause.name(),
             "held_out_gain": r.held_out.gain,

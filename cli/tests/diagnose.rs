@@ -255,6 +255,27 @@ fn json_names_hidden_saturation_and_writes_the_extended_model_in_out_dir() {
     }
     let text = std::fs::read_to_string(&extended).unwrap();
     assert!(text.contains("model = \"saturating\""), "{text}");
+    // `parameters` (measured-data.md): value, standard error and baseline by
+    // key path. (The hidden φ_sat lies 4.4 standard errors from the fitted
+    // one here: the white-noise standard error misses a 0.2 % bias; issue 12
+    // §3 asks for 3, still open.)
+    let p = &m["parameters"]["core.phi_sat"];
+    let (value, se) = (
+        p["value"].as_f64().unwrap(),
+        p["std_error"].as_f64().unwrap(),
+    );
+    assert!(se > 0.0 && se < 0.01 * value, "{p}");
+    assert!(
+        (value / truth - 1.0).abs() < 0.15,
+        "φ_sat {value:e} ± {se:e} vs hidden {truth:e}"
+    );
+    assert!(
+        p["baseline"].is_null(),
+        "the linear baseline has no φ_sat: {p}"
+    );
+    let r = &m["parameters"]["coil.resistance"];
+    assert_eq!(r["baseline"].as_f64(), Some(75.0), "{r}");
+    assert!(m["rejected"].as_array().is_some());
 }
 
 #[test]

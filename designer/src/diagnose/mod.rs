@@ -369,6 +369,74 @@ fn eligible(ranking: &[Scored], noise_floor: f64, floor_factor: f64) -> Vec<&Sco
         .collect()
 }
 
+/// One fitted parameter of the named cause's extension.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FittedParameter {
+    /// Key path in the description (`coil.eddy`).
+    pub path: String,
+    pub value: f64,
+    /// Linearised standard error at the optimum: |value| × the standard error
+    /// of ln θ from the fit's Jacobian and the residual scale
+    /// σ = ‖r‖/√(n − p) (the noise as the data show it), widened by
+    /// √((1 + ρ)/(1 − ρ)) for the lag-one autocorrelation ρ of the weighted
+    /// current residual (AR(1) effective sample count: residuals that are not
+    /// white carry fewer independent samples than there are).
+    pub std_error: f64,
+    /// The baseline description's value (None where the baseline's model has
+    /// no such key, e.g. `core.m_sat` of a new Jiles–Atherton core).
+    pub baseline: Option<f64>,
+}
+
+impl Diagnosis {
+    /// The fitted parameters of the named cause (empty for `none`).
+    pub fn parameters(&self, baseline: &Description, data: &Measured) -> Vec<FittedParameter> {
+        let widen = self.residual_correlation_factor(data);
+        if self.cause == Cause::None {
+            return Vec::new();
+        }
+        let Some(Ok(fit)) = self
+            .ranking
+            .iter()
+            .find(|s| s.cause == self.cause)
+            .map(|s| s.fit.as_ref())
+        else {
+            return Vec::new();
+        };
+        let rel = &fit.sensitivity.relative_std_errors;
+        fit.values
+            .iter()
+            .enumerate()
+            .map(|(j, (path, value))| FittedParameter {
+                path: path.clone(),
+                value: *value,
+                std_error: widen * value.abs() * rel.get(j).copied().unwrap_or(f64::INFINITY),
+                baseline: identify::params::get(baseline, path).ok(),
+            })
+            .collect()
+    }
+}
+
+impl Diagnosis {
+    /// √((1 + ρ)/(1 − ρ)), ρ the lag-one autocorrelation (≥ 0) of the
+    /// |φ̇|-weighted current residual of the extended model over the fitted
+    /// samples.
+    fn residual_correlation_factor(&self, data: &Measured) -> f64 {
+        let k = self.fitted_samples.min(data.i.len());
+        let r: Vec<f64> = (0..k)
+            .map(|j| self.weights[j].sqrt() * (self.extended_replay.current[j] - data.i[j]))
+            .collect();
+        let mean = r.iter().sum::<f64>() / r.len().max(1) as f64;
+        let var: f64 = r.iter().map(|x| (x - mean).powi(2)).sum();
+        let cov: f64 = r.windows(2).map(|w| (w[0] - mean) * (w[1] - mean)).sum();
+        let rho = if var > 0.0 {
+            (cov / var).clamp(0.0, 0.999)
+        } else {
+            0.0
+        };
+        ((1.0 + rho) / (1.0 - rho)).sqrt()
+    }
+}
+
 /// Whether the simulated armature is in free motion at each sample (mode 2).
 pub fn moving(replay: &SimOutputs) -> Vec<bool> {
     replay
