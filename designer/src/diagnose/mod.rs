@@ -226,7 +226,9 @@ pub fn diagnose(
 
     // The best candidate that beats `none` and does not lose on the
     // held-out part: a cause whose held-out gain is not positive is never
-    // named (it explains the fitted part only).
+    // named (it explains the fitted part only), unless the baseline is at the
+    // noise floor there already (the held-out part then holds no evidence
+    // either way: an effect such as a bounce can fall in the fitted part only).
     let whole_gain = |r: &SimOutputs| {
         Gain::new(
             wnrmse(&baseline_replay.current, &data.i, &weights),
@@ -250,10 +252,14 @@ pub fn diagnose(
         };
         let extended_replay = replay(&fit.description)?;
         match held_out_gain(&extended_replay) {
-            Some(h) if !(h.gain > 0.0) => rejected.push(Rejected {
-                cause: scored.cause,
-                held_out: h,
-            }),
+            Some(h)
+                if !(h.gain > 0.0) && h.baseline_wnrmse > options.floor_factor * noise_floor =>
+            {
+                rejected.push(Rejected {
+                    cause: scored.cause,
+                    held_out: h,
+                })
+            }
             _ => {
                 chosen = Some((scored.cause, fit.description.clone(), extended_replay));
                 break;
