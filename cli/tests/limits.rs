@@ -13,6 +13,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use serde_json::Value;
 
@@ -46,8 +47,12 @@ fn run(args: &[&str]) -> Output {
     Command::new(BIN).args(args).output().unwrap()
 }
 
+/// `reldesign build MODEL`, the code written to a scratch directory (never
+/// next to the model: some models are the repository's test data).
 fn build(model: &Path) -> (bool, String) {
-    let out_rs = model.with_extension("rs");
+    static BUILDS: AtomicUsize = AtomicUsize::new(0);
+    let k = BUILDS.fetch_add(1, Ordering::Relaxed);
+    let out_rs = scratch(&format!("build-{k}")).join("out.rs");
     let out = run(&[
         "build",
         model.to_str().unwrap(),
