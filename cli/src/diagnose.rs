@@ -282,6 +282,13 @@ fn text_report(
     for na in &d.not_applicable {
         let _ = writeln!(s, "  {:<17} not tried: {}", na.cause.name(), na.reason);
     }
+    for (cause, reason) in &d.not_identifiable {
+        let _ = writeln!(
+            s,
+            "  {:<17} not identifiable from this record: {reason}",
+            cause.name()
+        );
+    }
     for r in &d.rejected {
         let _ = writeln!(
             s,
@@ -375,6 +382,9 @@ fn json_report(
             "gain": h.gain,
         })),
         "parameters": parameters,
+        "not_identifiable": d.not_identifiable.iter().map(|(c, why)| json!({
+            "cause": c.name(), "reason": why,
+        })).collect::<Vec<_>>(),
         "rejected": d.rejected.iter().map(|r| json!({
             "cause": r.cause.name(),
             "held_out_gain": r.held_out.gain,

@@ -112,6 +112,10 @@ pub struct Diagnosis {
     /// Candidates that beat `none` on the fitted part but not on the
     /// held-out end, best first: not named.
     pub rejected: Vec<Rejected>,
+    /// Candidates that beat `none` but whose effect the record does not
+    /// identify (the effect parameter's confidence interval holds its null
+    /// value), with the reason: not named.
+    pub not_identifiable: Vec<(Cause, String)>,
     /// wNRMSE that the current's measurement noise alone gives.
     pub noise_floor: f64,
     /// Estimated standard deviation of the current noise [A].
@@ -246,10 +250,26 @@ pub fn diagnose(
     };
     let mut rejected = Vec::new();
     let mut chosen = None;
+    let mut not_identifiable = Vec::new();
     for scored in eligible(&ranking, noise_floor, options.floor_factor) {
         let Ok(fit) = scored.fit.as_ref() else {
             continue;
         };
+        let loopless =
+            scored.cause == Cause::Hysteresis && flux_reversals(&baseline_replay.phi) == 0;
+        if loopless {
+            not_identifiable.push((
+                scored.cause,
+                "the record's flux never reverses at non-zero flux: there is no λ–i loop to tell \
+                 a hysteretic core from a single-valued one"
+                    .to_string(),
+            ));
+            continue;
+        }
+        if let Some(reason) = unidentified(scored.cause, fit) {
+            not_identifiable.push((scored.cause, reason));
+            continue;
+        }
         let extended_replay = replay(&fit.description)?;
         match held_out_gain(&extended_replay) {
             Some(h)
@@ -277,6 +297,7 @@ pub fn diagnose(
         whole,
         held_out,
         rejected,
+        not_identifiable,
         noise_floor,
         current_noise,
         extended,
@@ -357,6 +378,90 @@ fn hysteresis_starts(baseline: &Description, own: Candidate, ranking: &[Scored])
         .and_then(|s| s.fit.as_ref().ok())
         .and_then(|f| candidate::hysteresis_from_saturation(baseline, &f.description));
     std::iter::once(own).chain(seeded).collect()
+}
+
+/// How often the flux turns (φ̇ changes sign) while |φ| is above 10 % of its
+/// peak: a hysteresis loop shows only where the flux reverses at non-zero
+/// flux. Counted on the baseline's replay (noise-free), turns closer than 1 %
+/// of the peak to the last extremum ignored.
+fn flux_reversals(phi: &[f64]) -> usize {
+    let peak = peak_abs(phi);
+    let Some(&first) = phi.first() else {
+        return 0;
+    };
+    if !(peak > 0.0) {
+        return 0;
+    }
+    let tol = 0.01 * peak;
+    let (mut turns, mut direction, mut extreme) = (0, 0i8, first);
+    for &p in phi {
+        let turned = match direction {
+            0 => {
+                if (p - extreme).abs() >= tol {
+                    direction = if p > extreme { 1 } else { -1 };
+                    extreme = p;
+                }
+                false
+            }
+            1 if p > extreme => {
+                extreme = p;
+                false
+            }
+            -1 if p < extreme => {
+                extreme = p;
+                false
+            }
+            _ => (p - extreme).abs() >= tol,
+        };
+        if turned {
+            if extreme.abs() > 0.1 * peak {
+                turns += 1;
+            }
+            direction = -direction;
+            extreme = p;
+        }
+    }
+    turns
+}
+
+/// The parameter whose null value means "no such effect", per cause: a loop
+/// width κ = 0 is no hysteresis, k_e = 0 no eddy currents, dR/dt = 0 no drift,
+/// γ = 0 no bounce, 1/φ_sat = 0 no saturation (same relative error as φ_sat).
+fn effect_parameter(cause: Cause) -> Option<&'static str> {
+    match cause {
+        Cause::Hysteresis => Some("core.kappa"),
+        Cause::EddyCurrents => Some("coil.eddy"),
+        Cause::ResistanceDrift => Some("coil.resistance_drift"),
+        Cause::Bouncing => Some("mechanics.restitution"),
+        Cause::Saturation => Some("core.phi_sat"),
+        Cause::Fringing | Cause::None => None,
+    }
+}
+
+/// Standard errors within which the effect parameter must stay clear of its
+/// null value (≈ a 95 % confidence interval).
+const IDENTIFIED_Z: f64 = 2.0;
+
+/// Why the record does not identify `cause`'s effect, if it does not: the
+/// effect parameter lies within `IDENTIFIED_Z` standard errors of its null
+/// value (linearised at the optimum, from the fit's Jacobian).
+fn unidentified(cause: Cause, fit: &FitReport) -> Option<String> {
+    let key = effect_parameter(cause)?;
+    let j = fit.values.iter().position(|(k, _)| k == key)?;
+    let value = fit.values[j].1;
+    let rel = fit.sensitivity.relative_std_errors.get(j).copied()?;
+    if rel.is_finite() && IDENTIFIED_Z * rel < 1.0 {
+        return None;
+    }
+    let null = if cause == Cause::Saturation {
+        "φ_sat = ∞ (no saturation)"
+    } else {
+        "0 (no such effect)"
+    };
+    Some(format!(
+        "{key} = {value:.4e} ± {:.2e}: its {IDENTIFIED_Z}-standard-error interval holds {null}",
+        value.abs() * rel
+    ))
 }
 
 /// The extensions that beat the baseline's own best (`none`) by BIC, best
@@ -465,4 +570,35 @@ pub fn impacts(replay: &SimOutputs, z_min: f64, z_max: f64) -> Vec<f64> {
         .filter(|(w, _)| !near(w[0]) && near(w[1]))
         .map(|(_, t)| *t)
         .collect()
+}
+
+#[cfg(test)]
+mod reversal_tests {
+    use super::flux_reversals;
+
+    #[test]
+    fn reversals_count_turns_at_non_zero_flux_only() {
+        let step: Vec<f64> = (0..100).map(|k| 1.0 - (-(k as f64) / 10.0).exp()).collect();
+        assert_eq!(flux_reversals(&step), 0, "a step response never turns");
+        // a triangle wave between 0 and 1: turns at 1 count, turns at 0 do not
+        let triangle: Vec<f64> = (0..400)
+            .map(|k| {
+                let x = (k % 100) as f64 / 100.0;
+                if (k / 100) % 2 == 0 {
+                    x
+                } else {
+                    1.0 - x
+                }
+            })
+            .collect();
+        assert_eq!(
+            flux_reversals(&triangle),
+            2,
+            "two turns at the top, none at zero flux"
+        );
+        // a triangle between −1 and 1 turns at non-zero flux every time
+        let bipolar: Vec<f64> = triangle.iter().map(|x| 2.0 * x - 1.0).collect();
+        assert_eq!(flux_reversals(&bipolar), 3);
+        assert_eq!(flux_reversals(&[]), 0);
+    }
 }
