@@ -66,6 +66,7 @@ fn synthetic(truth: &Description, t: Vec<f64>, v: Vec<f64>, seed: u64) -> Measur
         lambda: None,
         dt,
         file_name: "synthetic.csv".into(),
+        edges: None,
         t,
         v,
     };

@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use designer::description::{parse_file, Description};
+use designer::identify::edges::replay_input;
 use designer::identify::sensitivity::{check, forward, OutputSensitivities};
 use designer::identify::{params, Measured};
 use designer::model::Model;
@@ -39,29 +40,31 @@ fn record(high: f64, on: usize, n: usize) -> Measured {
         lambda: None,
         dt: 20e-6,
         file_name: "synthetic.csv".into(),
+        edges: None,
         t,
         v,
     }
 }
 
-/// The replay of `d` at relative tolerance `rtol`.
-fn replayed(d: &Description, data: &Measured, rtol: f64) -> (Model, Replay) {
+/// The replay of `d` at relative tolerance `rtol`, driven as the fit
+/// drives it (the voltage edge a step between samples), and its input.
+fn replayed(d: &Description, data: &Measured, rtol: f64) -> (Model, Replay, PiecewiseLinear) {
     let mut model = Model::build(d);
-    let input = PiecewiseLinear::new(data.t.clone(), data.v.clone()).unwrap();
+    let input = replay_input(data).unwrap();
     let options = Options {
         rtol,
         max_steps: 10_000_000,
         ..Options::default()
     };
     let r = replay(&mut model, &input, &data.t, &options).unwrap();
-    (model, r)
+    (model, r, input)
 }
 
 /// The analytic sensitivities of the replay of `d` (the fit's tolerance),
 /// and its events.
 fn analytic(d: &Description, data: &Measured) -> (OutputSensitivities, Vec<EventKind>) {
-    let (mut model, r) = replayed(d, data, 1e-10);
-    let s = forward(&mut model, &PATHS, &r.trajectory).unwrap();
+    let (mut model, r, input) = replayed(d, data, 1e-10);
+    let s = forward(&mut model, &PATHS, &r.trajectory, &input).unwrap();
     (s, r.trajectory.events.iter().map(|e| e.kind).collect())
 }
 

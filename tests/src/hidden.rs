@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use designer::description::edit::write_physics;
 use designer::description::{parse_str, Core, Description, Gap, JilesAtherton};
 use designer::diagnose::Cause;
+use designer::identify::edges::{located, replay_input};
 use designer::identify::wnrmse;
 use designer::model::{Model, Statics, MU0};
 use designer::replay::{replay, Replay};
@@ -108,6 +109,35 @@ impl Excitation {
         }
     }
 
+    /// The same excitation with its period (and width) rounded to whole
+    /// multiples of `sample_period`, so that every edge lies on a sample
+    /// instant of a record that starts at 0.
+    pub fn on_grid(self, sample_period: f64) -> Excitation {
+        let round = |x: f64| (x / sample_period).round().max(1.0) * sample_period;
+        match self {
+            Excitation::SquareWave {
+                amplitude,
+                period,
+                cycles,
+            } => Excitation::SquareWave {
+                amplitude,
+                period: 2.0 * round(0.5 * period),
+                cycles,
+            },
+            Excitation::Pulses {
+                amplitude,
+                width,
+                period,
+                count,
+            } => Excitation::Pulses {
+                amplitude,
+                width: round(width),
+                period: round(period),
+                count,
+            },
+        }
+    }
+
     /// Length of the record [s].
     pub fn duration(&self) -> f64 {
         match *self {
@@ -138,6 +168,37 @@ impl Excitation {
         } else {
             0.0
         }
+    }
+
+    /// The voltage's steps `(t, value)` from 0, in order.
+    pub fn steps(&self) -> Vec<(f64, f64)> {
+        let (amplitude, on, period, n) = match *self {
+            Excitation::SquareWave {
+                amplitude,
+                period,
+                cycles,
+            } => (amplitude, 0.5 * period, period, cycles),
+            Excitation::Pulses {
+                amplitude,
+                width,
+                period,
+                count,
+            } => (amplitude, width, period, count),
+        };
+        (0..n)
+            .flat_map(|k| {
+                let start = k as f64 * period;
+                [(start, amplitude), (start + on, 0.0)]
+            })
+            .collect()
+    }
+
+    /// The voltage as the supply applies it, every step `delay` later than
+    /// in [`Excitation::value`] (0 V before the first).
+    pub fn input(&self, delay: f64) -> PiecewiseLinear {
+        let mut points = vec![(0.0, 0.0)];
+        points.extend(self.steps().into_iter().map(|(t, v)| (t + delay, v)));
+        PiecewiseLinear::steps(&points).unwrap_or_else(|e| panic!("{self:?}: {e}"))
     }
 
     /// Sample times k·Δ on [0, duration] and the clean voltage there.
@@ -190,6 +251,22 @@ impl Default for Noise {
 }
 
 impl Noise {
+    /// σ_v = 15 mV, σ_i = 0.1 % of the steady current amplitude/R of
+    /// `excitation` (the semera paper's 1 mA at about 1 A), within
+    /// 0.05–1 mA (a relay's probe resolves 0.05 mA), σ_z = 1 µm.
+    pub fn for_device(desc: &Description, excitation: &Excitation) -> Noise {
+        let amplitude = excitation
+            .steps()
+            .iter()
+            .map(|s| s.1.abs())
+            .fold(0.0, f64::max);
+        let steady = amplitude / desc.coil.resistance;
+        Noise {
+            current: (1e-3 * steady).clamp(0.05e-3, 1e-3),
+            ..Noise::default()
+        }
+    }
+
     /// Noise-free records (for tests of the simulation itself).
     pub const NONE: Noise = Noise {
         voltage: 0.0,
@@ -501,28 +578,53 @@ pub fn simulate(desc: &Description, t: &[f64], v: &[f64]) -> Replay {
         .unwrap_or_else(|e| panic!("{}: simulation failed: {e}", desc.name))
 }
 
-/// A simulated bench record of `truth` under `excitation`, sampled every
-/// `sample_period`, as CSV text: a `#` comment line (which names neither the
-/// cause nor the parameters), the header `t,v,i` (`t,v,i,z` with `with_z`),
-/// then one row per sample in shortest round-trip notation. The noise is
-/// added to the measured columns only; the plant sees the clean voltage.
+/// How a record is sampled: every `period`, with the supply's steps
+/// `delay` after the excitation's nominal instants (0: every edge on a
+/// sample instant, as `reldesign simulate` writes; a fraction of the period:
+/// edges between samples, as on a real DAQ).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sampling {
+    pub period: f64,
+    pub delay: f64,
+}
+
+impl Sampling {
+    /// Every [`SAMPLE_PERIOD`], the edges at a random point between samples.
+    pub fn daq(rng: &mut Rng) -> Sampling {
+        Sampling {
+            period: SAMPLE_PERIOD,
+            delay: rng.uniform(0.0, SAMPLE_PERIOD),
+        }
+    }
+}
+
+/// A simulated bench record of `truth` under `excitation`, as CSV text: a
+/// `#` comment line (which names neither the cause nor the parameters), the
+/// header `t,v,i` (`t,v,i,z` with `with_z`), then one row per sample in
+/// shortest round-trip notation. The plant sees the supply's exact steps
+/// (delayed by `sampling.delay`); the samples are the instantaneous values
+/// at k·period, with noise added to the measured columns only.
 pub fn experiment(
     truth: &Description,
     excitation: &Excitation,
-    sample_period: f64,
+    sampling: Sampling,
     noise: Noise,
     with_z: bool,
     rng: &mut Rng,
 ) -> String {
-    let (t, v) = excitation.samples(sample_period);
-    let run = simulate(truth, &t, &v);
+    let input = excitation.input(sampling.delay);
+    let n = ((excitation.duration() + sampling.delay) / sampling.period).floor() as usize + 1;
+    let t: Vec<f64> = (0..n).map(|k| k as f64 * sampling.period).collect();
+    let mut model = Model::build(truth);
+    let run = replay(&mut model, &input, &t, &Options::default())
+        .unwrap_or_else(|e| panic!("{}: simulation failed: {e}", truth.name));
     let mut out = format!(
         "# simulated bench record of {}: {excitation:?}, sigma_v = {} V, sigma_i = {} A\n",
         truth.name, noise.voltage, noise.current
     );
     out.push_str(if with_z { "t,v,i,z\n" } else { "t,v,i\n" });
     for k in 0..t.len() {
-        let vm = v[k] + noise.voltage * gaussian(rng);
+        let vm = run.voltage[k] + noise.voltage * gaussian(rng);
         let im = run.current[k] + noise.current * gaussian(rng);
         out.push_str(&format!("{:e},{vm:e},{im:e}", t[k]));
         if with_z {
@@ -559,8 +661,9 @@ pub struct HiddenCase {
 }
 
 /// The case for `cause` on `examples/<example_file>` under `excitation`
-/// (sampled every [`SAMPLE_PERIOD`], default [`Noise`]), reproducible from
-/// `seed`. For `Cause::None` the data comes from the baseline itself.
+/// (sampled every [`SAMPLE_PERIOD`] with the edges between samples,
+/// default [`Noise`]), reproducible from `seed`. For `Cause::None` the data
+/// comes from the baseline itself.
 pub fn hidden_case(
     example_file: &str,
     cause: Cause,
@@ -571,20 +674,28 @@ pub fn hidden_case(
     let path = root().join("examples").join(example_file);
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("{}: cannot read: {e}", path.display()));
-    let desc = parse_str(&text, example_file).unwrap_or_else(|e| panic!("{e}"));
+    hidden_case_of(&text, example_file, cause, excitation, with_z, seed)
+}
+
+/// [`hidden_case`] for the description `text` (an example's or a generated
+/// device's) named `file_name`; the noise as [`Noise::for_device`].
+pub fn hidden_case_of(
+    text: &str,
+    file_name: &str,
+    cause: Cause,
+    excitation: &Excitation,
+    with_z: bool,
+    seed: u64,
+) -> HiddenCase {
+    let desc = parse_str(text, file_name).unwrap_or_else(|e| panic!("{e}"));
     let base = baseline(&desc);
-    let baseline_toml = write_physics(&text, example_file, &base)
+    let baseline_toml = write_physics(text, file_name, &base)
         .unwrap_or_else(|e| panic!("writing the baseline: {e}"));
     let mut rng = Rng::new(seed);
     let (truth, drawn) = with_effect_for(&base, cause, excitation, &mut rng);
-    let data_csv = experiment(
-        &truth,
-        excitation,
-        SAMPLE_PERIOD,
-        Noise::default(),
-        with_z,
-        &mut rng,
-    );
+    let sampling = Sampling::daq(&mut rng);
+    let noise = Noise::for_device(&base, excitation);
+    let data_csv = experiment(&truth, excitation, sampling, noise, with_z, &mut rng);
     HiddenCase {
         baseline_toml,
         data_csv,
@@ -624,22 +735,33 @@ impl Visibility {
     }
 }
 
-/// Replays the baseline and the truth on the measured voltage and compares
-/// their currents with the measured one by (81), weighted by |φ̇| estimated
-/// from the data as (v − R·i)/N (the coil equation, baseline R and N).
+/// Replays the baseline and the truth on the measured voltage (as the
+/// diagnosis does: its edges placed by the baseline) and compares their
+/// currents with the measured one by (81), weighted by |φ̇| estimated from
+/// the data as (v − R·i)/N (the coil equation, baseline R and N).
 pub fn visibility(case: &HiddenCase) -> Visibility {
-    let data = designer::record::Record::parse(&case.data_csv, "data.csv")
+    let record = designer::record::Record::parse(&case.data_csv, "data.csv")
         .unwrap_or_else(|e| panic!("{e}"));
-    let column = |name| data.column(name).unwrap_or_else(|e| panic!("{e}"));
-    let (t, v, i) = (column("t"), column("v"), column("i"));
+    let data = designer::identify::Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
     let base = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
+    let data = designer::identify::Measured {
+        edges: Some(located(&base, &data)),
+        ..data
+    };
+    let input = replay_input(&data).unwrap_or_else(|e| panic!("{e}"));
     let (n, r) = (base.coil.turns, base.coil.resistance);
-    let w: Vec<f64> = v
+    let w: Vec<f64> = data
+        .v
         .iter()
-        .zip(&i)
+        .zip(&data.i)
         .map(|(v, i)| ((v - r * i) / n).abs())
         .collect();
-    let error = |d: &Description| wnrmse(&simulate(d, &t, &v).current, &i, &w);
+    let error = |d: &Description| {
+        let mut model = Model::build(d);
+        let run = replay(&mut model, &input, &data.t, &Options::default())
+            .unwrap_or_else(|e| panic!("{}: simulation failed: {e}", d.name));
+        wnrmse(&run.current, &data.i, &w)
+    };
     Visibility {
         baseline_wnrmse: error(&base),
         noise_wnrmse: error(&case.truth),

@@ -10,7 +10,7 @@ use designer::sim::Limit;
 use reldesign_tests::example;
 use reldesign_tests::hidden::{
     baseline, experiment, hidden_case, visibility, write_case, Excitation, HiddenCase, Noise,
-    SAMPLE_PERIOD,
+    Sampling, SAMPLE_PERIOD,
 };
 use reldesign_tests::Rng;
 
@@ -192,7 +192,10 @@ fn record_parses_with_the_right_columns() {
     let clean = experiment(
         &c.truth,
         &ex,
-        SAMPLE_PERIOD,
+        Sampling {
+            period: SAMPLE_PERIOD,
+            delay: 0.0,
+        },
         Noise::NONE,
         false,
         &mut Rng::new(0),

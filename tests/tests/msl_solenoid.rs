@@ -136,6 +136,7 @@ fn measured(fea: &Transient, dt: f64) -> Measured {
         lambda: None,
         dt,
         file_name: "pullin-12V-fea.csv (resampled)".into(),
+        edges: None,
         t,
     }
 }

@@ -176,6 +176,12 @@ pub fn diagnose(
     if weights.iter().all(|w| *w <= 0.0) {
         return Err(DiagnoseError::NoExcitation { file });
     }
+    // The voltage edges' instants, a nuisance of the record: placed once by
+    // the baseline (identify::edges), then the same for every candidate.
+    let data = &Measured {
+        edges: Some(identify::edges::located(baseline, data)),
+        ..data.clone()
+    };
     let replay = |d: &Description| {
         identify::simulate_outputs(d, data).map_err(|source| DiagnoseError::Replay {
             file: file.clone(),

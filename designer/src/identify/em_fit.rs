@@ -33,7 +33,7 @@ use nalgebra::DMatrix;
 use crate::description::{Core, Description, Drive};
 use crate::model::{Model, ModelPlant};
 use crate::replay::{replay_plant, Replay};
-use crate::sim::{Options, PiecewiseLinear, Trajectory};
+use crate::sim::{Options, Trajectory};
 
 use super::identifiability::Sensitivity;
 use super::lm::{self, LmError, Status};
@@ -249,11 +249,10 @@ fn replay(d: &Description, data: &Measured, budget: &Budget) -> Result<Replay, F
             model: d.source.file_name.clone(),
         });
     }
-    let input =
-        PiecewiseLinear::new(data.t.clone(), data.v.clone()).map_err(|e| FitError::Input {
-            file: data.file_name.clone(),
-            message: e.to_string(),
-        })?;
+    let input = super::edges::replay_input(data).map_err(|e| FitError::Input {
+        file: data.file_name.clone(),
+        message: e.to_string(),
+    })?;
     let mut model = Model::build(d);
     let plant = ModelPlant::new(&mut model);
     let options = Options {
@@ -380,7 +379,8 @@ impl<'a> Objective<'a> {
         paths: &[&str],
         trajectory: &Trajectory,
     ) -> Option<DMatrix<f64>> {
-        let s = sensitivity::forward(&mut Model::build(d), paths, trajectory).ok()?;
+        let input = super::edges::replay_input(self.data).ok()?;
+        let s = sensitivity::forward(&mut Model::build(d), paths, trajectory, &input).ok()?;
         let (n, p) = (self.data.len(), paths.len());
         let sw: Vec<f64> = self.weights.iter().map(|w| w.sqrt()).collect();
         let mut blocks = vec![DMatrix::from_fn(n, p, |k, j| {

@@ -27,6 +27,10 @@ pub struct Measured {
     /// The (median) sampling period [s].
     pub dt: f64,
     pub file_name: String,
+    /// The voltage edges' instants when estimated once for the record
+    /// ([`super::edges::located`]); `None`: each replay places them from the
+    /// current's kink for its own model ([`super::edges::edges`]).
+    pub edges: Option<Vec<super::edges::Edge>>,
 }
 
 /// Fewest samples a recording must have to be fitted.
@@ -52,6 +56,7 @@ impl Measured {
             t,
             dt,
             file_name: record.file_name.clone(),
+            edges: None,
         })
     }
 
@@ -82,6 +87,10 @@ impl Measured {
             lambda: self.lambda.as_ref().map(cut),
             dt: self.dt,
             file_name: self.file_name.clone(),
+            edges: self
+                .edges
+                .as_ref()
+                .map(|e| e.iter().filter(|e| e.k + 1 < n).copied().collect()),
         }
     }
 }

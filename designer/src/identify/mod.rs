@@ -6,6 +6,8 @@
 //!   estimated from the data.
 //! - [`params`]: description parameters addressed by TOML key path.
 //! - [`lm`]: a bounded Levenberg–Marquardt least-squares solver.
+//! - [`edges`]: where inside its sample interval each voltage step fell
+//!   (the replays' input).
 //! - [`em_fit`]: the fit of (80) by replaying the measured voltage.
 //! - [`sensitivity`]: forward parameter sensitivities of a replay (the
 //!   fit's analytic Jacobian).
@@ -13,6 +15,7 @@
 //!   scaled Jacobian), and the reduced model's parameters (55), (57), (60).
 //! - [`gap_fit`]: the gap model fitted to a reluctance table (75)–(77).
 
+pub mod edges;
 pub mod em_fit;
 pub mod gap_fit;
 pub mod identifiability;

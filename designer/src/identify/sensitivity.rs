@@ -18,8 +18,9 @@
 //! - **Integration.** The simulator is reused as is: the sensitivity ODE is
 //!   integrated by fixed-step RK4 together with x over each sample interval,
 //!   x re-anchored at every sample on the simulator's (tight-tolerance)
-//!   state, the interval cut at the simulator's event times, and u linear
-//!   between samples exactly as the replayed input. A second Dopri pass on
+//!   state, the interval cut at the simulator's event times and at the
+//!   input's breakpoints (a voltage edge between samples), each piece with
+//!   the replayed input's own affine u. A second Dopri pass on
 //!   the augmented system would not fit `MAX_DIM` (d·(1 + p) states).
 //!
 //! Not supported (the fit falls back to finite differences): parameters
@@ -35,7 +36,7 @@ use nalgebra::DMatrix;
 
 use crate::description::{Core, Description};
 use crate::model::Model;
-use crate::sim::{EventKind, Limit, Mode, Trajectory, MAX_DIM};
+use crate::sim::{EventKind, Input, Limit, Mode, Trajectory, MAX_DIM};
 use crate::sym::{Id, Tape};
 
 /// RK4 substeps per sample interval (and per piece of one cut at events):
@@ -324,11 +325,13 @@ impl Field {
 }
 
 /// The sensitivities of `paths` along `trajectory`, a replay of `model`
-/// (with its values) whose input is linear between the output times.
-pub fn forward(
+/// (with its values) driven by `input` (the intervals are cut at its
+/// breakpoints, e.g. a voltage edge between samples).
+pub fn forward<I: Input + ?Sized>(
     model: &mut Model,
     paths: &[&str],
     trajectory: &Trajectory,
+    input: &I,
 ) -> Result<OutputSensitivities, Unsupported> {
     let theta = symbols(model, paths)?;
     let field = Field::new(model, &theta);
@@ -356,26 +359,39 @@ pub fn forward(
     let events = &tr.events;
     let mut next = events.iter().take_while(|e| e.t <= tr.t[0]).count();
     for k in 0..n - 1 {
-        let (t0, t1) = (tr.t[k], tr.t[k + 1]);
-        let (u0, u1) = (tr.u[k], tr.u[k + 1]);
-        let u = move |t: f64| match t1 > t0 {
-            true => u0 + (u1 - u0) * (t - t0) / (t1 - t0),
-            false => u1,
-        };
+        let t1 = tr.t[k + 1];
         let mut x = tr.x[k];
         let mut mode = tr.mode[k];
-        let mut a = t0;
-        while let Some(e) = events.get(next).filter(|e| e.t <= t1) {
-            if e.t > a {
-                field.integrate(a, e.t, &mut x, &mut s, &u, mode != Mode::Free);
-                a = e.t;
+        let mut a = tr.t[k];
+        // Pieces of the interval between the input's breakpoints and the
+        // events, each integrated with its own affine piece of u.
+        loop {
+            let event = events.get(next).filter(|e| e.t <= t1);
+            let b = input
+                .next_breakpoint(a)
+                .min(event.map_or(t1, |e| e.t))
+                .min(t1);
+            if b > a {
+                let piece = input.piece(a);
+                field.integrate(
+                    a,
+                    b,
+                    &mut x,
+                    &mut s,
+                    &|t| piece.value(t),
+                    mode != Mode::Free,
+                );
+                a = b;
             }
-            field.event(e.t, e.kind, e.mode_after, &mut x, &mut s, u(e.t));
-            mode = e.mode_after;
-            next += 1;
-        }
-        if t1 > a {
-            field.integrate(a, t1, &mut x, &mut s, &u, mode != Mode::Free);
+            match event {
+                Some(e) if e.t <= a => {
+                    field.event(e.t, e.kind, e.mode_after, &mut x, &mut s, input.value(e.t));
+                    mode = e.mode_after;
+                    next += 1;
+                }
+                _ if a >= t1 => break,
+                _ => {}
+            }
         }
         record(k + 1, &s, &mut out);
     }

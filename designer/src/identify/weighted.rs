@@ -146,6 +146,7 @@ mod tests {
             t,
             dt,
             file_name: "synthetic".into(),
+            edges: None,
         }
     }
 
