@@ -39,6 +39,16 @@
 //! 1.5 and its excess at least 15 %. Each region also reports its share of
 //! Σ |φ̇| r², the numerator of the eq. (81) error the diagnosis ranks by.
 //!
+//! **Edge timing**: a voltage step falls anywhere inside its sample interval;
+//! where the replay places it off by δ, the current right after it is off by
+//! about the current's slope change × δ, at most half a sample's worth:
+//! ½·|(i_{k+1} − i_k) − (i_{k−1} − i_{k−2})| for the step's first sample k.
+//! A step is *within timing* when the residual over its first
+//! [`TIMING_SAMPLES`] samples stays below that bound plus 3 σ of the current
+//! noise (σ from the median absolute second difference). When the residual
+//! concentrates after the steps and at least 80 % of them are within timing,
+//! the report says the error is edge timing, not a cause.
+//!
 //! **Drift**: cycles start at the voltage's rising edges (a Schmitt trigger at
 //! 40 % / 60 % of the range) and run to the next one (the record's last cycle
 //! counts when complete); the RMS residual of each cycle is fitted by a
@@ -74,6 +84,10 @@ const LAST_CYCLE_FRACTION: f64 = 0.95;
 /// A region holds the residual when its concentration and excess reach these.
 const DOMINANT_CONCENTRATION: f64 = 1.5;
 const DOMINANT_EXCESS: f64 = 0.15;
+/// Samples after a step whose residual edge timing may explain.
+const TIMING_SAMPLES: usize = 3;
+/// Fraction of the steps within timing for the report to blame the timing.
+const TIMING_SHARE: f64 = 0.8;
 /// The record is cut into this many windows; the worst few are reported.
 const WINDOWS: usize = 50;
 const WORST: usize = 3;
@@ -200,6 +214,22 @@ pub struct PositionError {
     pub stroke: f64,
 }
 
+/// How many voltage steps have a residual within what their timing explains.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EdgeTiming {
+    /// Steps with samples on both sides to judge.
+    pub steps: usize,
+    /// Steps whose residual stays within the edge-timing bound.
+    pub within: usize,
+}
+
+impl EdgeTiming {
+    /// Whether at least 80 % of the steps are within timing.
+    pub fn explains(&self) -> bool {
+        self.steps > 0 && self.within as f64 >= TIMING_SHARE * self.steps as f64
+    }
+}
+
 /// Where the current residual concentrates.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Localisation {
@@ -214,6 +244,8 @@ pub struct Localisation {
     pub tau: f64,
     /// Voltage step times [s].
     pub steps: Vec<f64>,
+    /// The steps' residuals against what their timing can explain.
+    pub edge_timing: EdgeTiming,
     /// Present when the record has a measured position.
     pub position: Option<PositionError>,
     /// Samples read (the length of the shortest per-sample slice).
@@ -224,6 +256,14 @@ impl Localisation {
     /// The top region when it holds the residual (see [`RegionShare::holds_residual`]).
     pub fn dominant(&self) -> Option<&RegionShare> {
         self.regions.first().filter(|r| r.holds_residual())
+    }
+
+    /// Whether the residual concentrates after the voltage steps and their
+    /// timing explains it (see the module documentation).
+    pub fn is_edge_timing(&self) -> bool {
+        self.dominant()
+            .is_some_and(|r| r.region == Region::AfterVoltageSteps)
+            && self.edge_timing.explains()
     }
 
     /// The stretches to mark on a residual plot, as (start [s], end [s], label):
@@ -268,6 +308,7 @@ pub fn localise(s: &Signals) -> Localisation {
     regions.sort_by(|a, b| b.excess().total_cmp(&a.excess()));
     let worst = worst_windows(s.t, &sums, &regions, &masks);
     Localisation {
+        edge_timing: edge_timing(s.i_measured, &r, &steps),
         drift: drift(s.t, s.v, &sums),
         rms: (sums.total_r2 / sums.count.max(1) as f64).sqrt(),
         position: s.z_measured.map(|z| position_error(s.z_simulated, z)),
@@ -556,6 +597,29 @@ fn window(
     }
 }
 
+/// The steps (first samples after each) whose residual stays within the
+/// edge-timing bound (see the module documentation).
+fn edge_timing(i: &[f64], r: &[f64], steps: &[usize]) -> EdgeTiming {
+    let second: Vec<f64> = i.windows(3).map(|w| w[2] - 2.0 * w[1] + w[0]).collect();
+    let mut abs: Vec<f64> = second.iter().map(|x| x.abs()).collect();
+    // White noise: a second difference has σ·√6; MAD → σ by 1/0.6745.
+    let sigma = median(&mut abs).unwrap_or(0.0) / (0.6745 * 6f64.sqrt());
+    let judged: Vec<bool> = steps
+        .iter()
+        .filter(|&&k| k >= 2 && k + TIMING_SAMPLES < i.len())
+        .map(|&k| {
+            let bound = 0.5 * ((i[k + 1] - i[k]) - (i[k - 1] - i[k - 2])).abs() + 3.0 * sigma;
+            r[k..k + TIMING_SAMPLES]
+                .iter()
+                .all(|x| x.is_finite() && x.abs() <= bound)
+        })
+        .collect();
+    EdgeTiming {
+        steps: judged.len(),
+        within: judged.iter().filter(|&&b| b).count(),
+    }
+}
+
 /// Indices of the voltage's rising edges (Schmitt trigger at 40 % / 60 %).
 fn rising_edges(v: &[f64]) -> Vec<usize> {
     let (lo, hi) = range(v);
@@ -699,6 +763,14 @@ impl fmt::Display for Localisation {
             "regions (residual/time; regions overlap): {}",
             list.join(", ")
         )?;
+        if self.is_edge_timing() {
+            writeln!(
+                f,
+                "edge timing: after {} of {} voltage steps the residual stays within what half a sample of \
+                 volt-seconds explains (a step placed off its instant between samples), not a cause of the model",
+                self.edge_timing.within, self.edge_timing.steps
+            )?;
+        }
         self.fmt_worst(f)?;
         writeln!(f, "{}", self.drift)?;
         if let Some(p) = self.position {
@@ -860,11 +932,16 @@ mod tests {
         }
     }
 
-    /// Localise `i_sim = i + planted + white noise`, weight 1 everywhere.
+    /// Localise `i_sim = i + planted + white noise` (σ = 10 mA), weight 1
+    /// everywhere.
     fn run(b: &Bench, planted: impl Fn(usize) -> f64) -> Localisation {
+        run_with_noise(b, planted, 0.01)
+    }
+
+    fn run_with_noise(b: &Bench, planted: impl Fn(usize) -> f64, sigma: f64) -> Localisation {
         let mut noise = Noise(0x9E37_79B9_7F4A_7C15);
         let i_sim: Vec<f64> = (0..b.t.len())
-            .map(|k| b.i[k] + planted(k) + 0.01 * noise.gauss())
+            .map(|k| b.i[k] + planted(k) + sigma * noise.gauss())
             .collect();
         let ones = vec![1.0; b.t.len()];
         let zeros = vec![0.0; b.t.len()];
@@ -901,6 +978,28 @@ mod tests {
         let l = run(&b, |k| 0.3 * (-b.since_step[k] / (0.3 * TAU)).exp());
         assert_eq!(top(&l), Region::AfterVoltageSteps, "{l}");
         assert!(l.to_string().contains("after voltage steps"));
+        // 0.3 A is far beyond what a step's timing explains (≈ 25 mA here).
+        assert!(!l.is_edge_timing(), "{l}");
+    }
+
+    /// A replay whose steps are 0.4 sample late: the current lags by the
+    /// slope change × 0.4·Δ after each step, decaying with τ.
+    #[test]
+    fn residual_of_steps_placed_off_their_instant_is_edge_timing() {
+        let b = bench();
+        // Slope change at a step: ±(24 V / 12 Ω)/τ.
+        let lag = 0.4 * DT * 2.0 / TAU;
+        let l = run_with_noise(
+            &b,
+            |k| {
+                let sign = if b.v[k] > 12.0 { -1.0 } else { 1.0 };
+                sign * lag * (-b.since_step[k] / TAU).exp()
+            },
+            0.002,
+        );
+        assert_eq!(top(&l), Region::AfterVoltageSteps, "{l}");
+        assert!(l.is_edge_timing(), "{:?}\n{l}", l.edge_timing);
+        assert!(l.to_string().contains("edge timing"), "{l}");
     }
 
     #[test]
