@@ -245,6 +245,15 @@ fn text_report(
         1e3 * d.current_noise,
         percent(d.noise_floor)
     );
+    if !d.edges.is_empty() {
+        let placed = d.edges.iter().filter(|e| e.located).count();
+        let _ = writeln!(
+            s,
+            "voltage steps between samples: {}, {placed} placed inside their sample interval by \
+             the baseline's local replays (the rest at mid-interval)",
+            d.edges.len()
+        );
+    }
     let _ = writeln!(
         s,
         "baseline current wNRMSE (eq. 81): {}",
@@ -388,6 +397,9 @@ fn json_report(
         "rejected": d.rejected.iter().map(|r| json!({
             "cause": r.cause.name(),
             "held_out_gain": r.held_out.gain,
+        })).collect::<Vec<_>>(),
+        "voltage_steps": d.edges.iter().map(|e| json!({
+            "after_sample": e.k, "t": e.tau, "placed": e.located,
         })).collect::<Vec<_>>(),
         "noise_floor": d.noise_floor,
         "current_noise": d.current_noise,

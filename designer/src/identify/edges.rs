@@ -13,9 +13,9 @@
 //!   JA model eq. 41): cubics through the samples before and after meet at
 //!   τ; where they are too noisy to place τ within 0.14 sample (RMS), or do
 //!   not meet inside the interval, the midpoint stays.
-//! - [`located`] refines τ with a reference model: the instant whose local
-//!   replay, restarted at the sample before the edge, best matches the
-//!   current after it. The kink alone cannot follow a current that bends
+//! - [`located`] refines τ with a reference model, edge after edge: the
+//!   instant whose replay from the sample before the edge (the earlier edges
+//!   placed) best matches the current after it. The kink alone cannot follow a current that bends
 //!   within a sample or two (a falling edge on a held valve; the reversal of
 //!   a Jiles–Atherton core).
 //! - [`replay_input`] is the voltage every replay uses: the samples joined
@@ -26,8 +26,8 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::description::{Description, Drive};
 use crate::model::{Model, ModelPlant};
-use crate::replay::replay_plant;
-use crate::sim::{simulate, InputError, Options, PiecewiseLinear};
+use crate::replay::rest_state;
+use crate::sim::{simulate, InputError, Mode, Options, PiecewiseLinear, State};
 
 use super::Measured;
 
@@ -142,15 +142,21 @@ const WINDOW: usize = 16;
 /// Trial instants across the interval (fractions of a sample).
 const TRIALS: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
 
-/// The edges placed by the model `d` itself: each edge's instant is the one
-/// whose replay, restarted at the sample before it from `d`'s replay of the
-/// record, best matches the measured current over the next [`WINDOW`]
-/// samples (least squares over [`TRIALS`], refined by a parabola). This is
-/// the nuisance parameter estimated once for a record and a reference model;
-/// the kink of [`edges`] starts it and cannot follow a current that bends
-/// within a sample or two (a falling edge on a held, saturated valve).
-/// Where `d` cannot replay the record, the kink's instants stay (the
-/// replays that follow report the failure).
+/// Samples before an edge whose mean residual is taken as the replay's
+/// offset there (an error carried from earlier, not the edge's).
+const OFFSET_SAMPLES: usize = 4;
+
+/// The edges placed by the model `d` itself, in time order: the replay of
+/// the record, with the edges placed so far, is advanced to the sample before
+/// the next edge; from there, each of [`TRIALS`] is replayed over the next
+/// [`WINDOW`] samples, and the instant whose current best matches the
+/// measured one (least squares, less the replay's offset before the edge;
+/// refined by a parabola) is the edge's. This is the nuisance parameter
+/// estimated once for a record and a reference model; the kink of [`edges`]
+/// cannot follow a current that bends within a sample or two (a falling
+/// edge on a held, saturated valve). Where `d` cannot replay the record, the
+/// kink's instants stay for the remaining edges (the replays that follow
+/// report the failure).
 pub fn located(d: &Description, data: &Measured) -> Vec<Edge> {
     let mut edges = edges(data, CurrentJump::of(d));
     if edges.is_empty() || d.supply.drive != Drive::Voltage {
@@ -158,70 +164,155 @@ pub fn located(d: &Description, data: &Measured) -> Vec<Edge> {
     }
     let mut model = Model::build(d);
     let plant = ModelPlant::new(&mut model);
-    let options = Options::default();
-    let Some(run) = input_with(data, &edges)
-        .ok()
-        .and_then(|input| replay_plant(&plant, &model, &input, &data.t, &options).ok())
-    else {
-        return edges;
+    let mut at = Replayed {
+        k: 0,
+        x: rest_state(&model),
+        mode: Mode::StuckMax,
+        offset: 0.0,
     };
-    let ends: Vec<usize> = edges
-        .iter()
-        .skip(1)
-        .map(|e| e.k)
-        .chain([data.len() - 1])
-        .collect();
-    for (e, &next) in edges.iter_mut().zip(&ends) {
-        let end = (e.k + WINDOW).min(next);
-        if end <= e.k + 1 {
-            continue;
-        }
-        let (t0, dt) = (data.t[e.k], data.t[e.k + 1] - data.t[e.k]);
-        let sse = |frac: f64| {
-            let tau = t0 + frac * dt;
-            let mut t = vec![t0, tau, tau];
-            let mut v = vec![data.v[e.k], data.v[e.k], data.v[e.k + 1]];
-            t.extend_from_slice(&data.t[e.k + 1..=end]);
-            v.extend_from_slice(&data.v[e.k + 1..=end]);
-            let input = PiecewiseLinear::new(t, v).ok()?;
-            let times = &data.t[e.k..=end];
-            let x0 = run.trajectory.x[e.k];
-            let mode = run.trajectory.mode[e.k];
-            let tr = simulate(&plant, &input, x0, mode, times, &options).ok()?;
-            let (current, _) = plant.currents_and_voltages(&tr.t, &tr.x, &tr.u);
-            Some(
-                current
-                    .iter()
-                    .zip(&data.i[e.k..=end])
-                    .map(|(a, b)| (a - b) * (a - b))
-                    .sum::<f64>(),
-            )
+    for n in 0..edges.len() {
+        let previous = n.checked_sub(1).map(|m| edges[m]);
+        let Some(next) = advance(&plant, data, &at, edges[n].k, previous) else {
+            break;
         };
-        let costs: Option<Vec<f64>> = TRIALS.iter().map(|&f| sse(f)).collect();
-        if let Some(frac) = costs.and_then(|c| parabola_minimum(&c)) {
-            e.tau = (t0 + frac * dt).clamp(t0, t0 + dt);
-            e.located = true;
+        at = next;
+        let end = edges
+            .get(n + 1)
+            .map_or(data.len() - 1, |e| e.k)
+            .min(at.k + WINDOW);
+        if let Some(tau) = place(&plant, data, &at, end) {
+            edges[n].tau = tau;
+            edges[n].located = true;
         }
     }
     edges
 }
 
-/// The minimum of the parabola through the lowest of `costs` (at
-/// [`TRIALS`]) and its neighbours, as a fraction of the interval.
-fn parabola_minimum(costs: &[f64]) -> Option<f64> {
-    let j = (0..costs.len()).min_by(|&a, &b| costs[a].total_cmp(&costs[b]))?;
-    let h = TRIALS[1] - TRIALS[0];
-    if j == 0 || j + 1 == costs.len() {
-        return Some(TRIALS[j]);
+/// A replay of the record stopped at sample `k`.
+struct Replayed {
+    k: usize,
+    x: State,
+    mode: Mode,
+    /// Mean simulated − measured current over the last samples before k.
+    offset: f64,
+}
+
+/// The replay from `at` to sample `k`, with `previous` (the last placed
+/// edge, if it lies at `at.k`) as a step.
+fn advance(
+    plant: &ModelPlant,
+    data: &Measured,
+    at: &Replayed,
+    k: usize,
+    previous: Option<Edge>,
+) -> Option<Replayed> {
+    let step = previous.filter(|e| e.k == at.k);
+    let input = segment(data, at.k, k, step)?;
+    let tr = simulate(
+        plant,
+        &input,
+        at.x,
+        at.mode,
+        &data.t[at.k..=k],
+        &Options::default(),
+    )
+    .ok()?;
+    let (current, _) = plant.currents_and_voltages(&tr.t, &tr.x, &tr.u);
+    let tail = current.len().min(OFFSET_SAMPLES);
+    let first = current.len() - tail;
+    let offset = (first..current.len())
+        .map(|j| current[j] - data.i[at.k + j])
+        .sum::<f64>()
+        / tail.max(1) as f64;
+    Some(Replayed {
+        k,
+        x: *tr.x.last()?,
+        mode: *tr.mode.last()?,
+        offset,
+    })
+}
+
+/// The edge after sample `at.k`: the trial instant whose replay up to sample
+/// `end` best matches the measured current, less the offset.
+fn place(plant: &ModelPlant, data: &Measured, at: &Replayed, end: usize) -> Option<f64> {
+    let k = at.k;
+    if end <= k + 1 {
+        return None;
     }
+    let (t0, dt) = (data.t[k], data.t[k + 1] - data.t[k]);
+    let cost = |frac: f64| {
+        let edge = Edge {
+            k,
+            tau: t0 + frac * dt,
+            located: true,
+        };
+        let input = segment(data, k, end, Some(edge))?;
+        let tr = simulate(
+            plant,
+            &input,
+            at.x,
+            at.mode,
+            &data.t[k..=end],
+            &Options::default(),
+        )
+        .ok()?;
+        let (current, _) = plant.currents_and_voltages(&tr.t, &tr.x, &tr.u);
+        Some(
+            current
+                .iter()
+                .zip(&data.i[k..=end])
+                .map(|(a, b)| (a - b - at.offset).powi(2))
+                .sum::<f64>(),
+        )
+    };
+    let costs: Option<Vec<f64>> = TRIALS.iter().map(|&f| cost(f)).collect();
+    // The cost is nearly quadratic in τ (the current after the edge shifts
+    // with it): a parabola through the best trial and its neighbours, then
+    // again through three points a quarter of the trials' spacing apart.
+    let coarse = parabola_minimum(&TRIALS, &costs?)?;
+    let h = 0.25 * (TRIALS[1] - TRIALS[0]);
+    // (Kept inside the interval: a trial before t_k is no edge of it.)
+    let centre = coarse.clamp(h, 1.0 - h);
+    let fine = [centre - h, centre, centre + h];
+    let costs: Option<Vec<f64>> = fine.iter().map(|&f| cost(f)).collect();
+    let frac = parabola_minimum(&fine, &costs?)?.clamp(0.0, 1.0);
+    Some(t0 + frac * dt)
+}
+
+/// The measured voltage over samples from..=to, joined linearly, with
+/// `step` (an edge after sample `from`) as a step.
+fn segment(data: &Measured, from: usize, to: usize, step: Option<Edge>) -> Option<PiecewiseLinear> {
+    let mut t = Vec::with_capacity(to - from + 3);
+    let mut v = Vec::with_capacity(to - from + 3);
+    for j in from..=to {
+        t.push(data.t[j]);
+        v.push(data.v[j]);
+        if let Some(e) = step.filter(|e| e.k == j && j < to) {
+            t.extend([e.tau, e.tau]);
+            v.extend([data.v[j], data.v[j + 1]]);
+        }
+    }
+    PiecewiseLinear::new(t, v).ok()
+}
+
+/// The vertex of the parabola through the lowest of `costs` (at the
+/// equally spaced `x`) and its two neighbours (the two nearest when it is an
+/// end), within one spacing of that point; the point itself where the three
+/// are not convex.
+fn parabola_minimum(x: &[f64], costs: &[f64]) -> Option<f64> {
+    let best = (0..costs.len()).min_by(|&a, &b| costs[a].total_cmp(&costs[b]))?;
+    if costs.len() < 3 {
+        return x.get(best).copied();
+    }
+    let j = best.clamp(1, costs.len() - 2);
+    let h = x[j + 1] - x[j];
     let (a, b, c) = (costs[j - 1], costs[j], costs[j + 1]);
     let curvature = a - 2.0 * b + c;
-    let shift = if curvature > 0.0 {
-        0.5 * h * (a - c) / curvature
-    } else {
-        0.0
-    };
-    Some(TRIALS[j] + shift.clamp(-h, h))
+    if !(curvature > 0.0) {
+        return Some(x[best]);
+    }
+    let vertex = x[j] + 0.5 * h * (a - c) / curvature;
+    Some(vertex.clamp(x[best] - h, x[best] + h))
 }
 
 /// Indices k with a step between samples k and k + 1.
