@@ -241,9 +241,11 @@ fn text_report(
     );
     let _ = writeln!(
         s,
-        "current noise σ_i ≈ {:.3} mA: noise floor of the weighted error {}",
+        "noise σ_i ≈ {:.3} mA, σ_v ≈ {:.1} mV: noise floor of the weighted error {} ({} from the voltage noise the replay integrates)",
         1e3 * d.current_noise,
-        percent(d.noise_floor)
+        1e3 * d.voltage_noise,
+        percent(d.noise_floor),
+        percent(d.voltage_floor)
     );
     if !d.edges.is_empty() {
         let placed = d.edges.iter().filter(|e| e.located).count();
@@ -299,14 +301,7 @@ fn text_report(
         );
     }
     for r in &d.rejected {
-        let _ = writeln!(
-            s,
-            "  {:<17} not named: it wins on the fitted part but not on the held-out end (gain {:.1} %, {} → {})",
-            r.cause.name(),
-            100.0 * r.held_out.gain,
-            percent(r.held_out.baseline_wnrmse),
-            percent(r.held_out.extended_wnrmse)
-        );
+        let _ = writeln!(s, "  {:<17} not named: {}", r.cause.name(), r.reason());
     }
     let _ = writeln!(s, "cause: {}", d.cause);
     for p in parameters {
@@ -396,13 +391,16 @@ fn json_report(
         })).collect::<Vec<_>>(),
         "rejected": d.rejected.iter().map(|r| json!({
             "cause": r.cause.name(),
-            "held_out_gain": r.held_out.gain,
+            "whole_gain": r.whole.gain,
+            "held_out_gain": r.held_out.map(|h| h.gain),
         })).collect::<Vec<_>>(),
         "voltage_steps": d.edges.iter().map(|e| json!({
             "after_sample": e.k, "t": e.tau, "placed": e.located,
         })).collect::<Vec<_>>(),
         "noise_floor": d.noise_floor,
         "current_noise": d.current_noise,
+        "voltage_noise": d.voltage_noise,
+        "voltage_floor": d.voltage_floor,
         "fitted_samples": d.fitted_samples,
         "candidates": candidates,
         "not_tried": not_tried,

@@ -58,8 +58,9 @@ pub enum Excitation {
 impl Excitation {
     /// Three square-wave cycles that close and open the valve: the amplitude
     /// is twice the pull-in voltage of the example's baseline (within the
-    /// supply; the supply's u_max where there is no pull-in voltage), each half period lasts five electrical time constants of the
-    /// closed valve without residual air gap (clamped to 5–100 ms), so that
+    /// supply; the supply's u_max where there is no pull-in voltage), each
+    /// half period lasts five electrical time constants of the closed valve
+    /// without residual air gap (clamped to 5–100 ms), so that
     /// the flux has decayed below the drop-out level before the next cycle
     /// even when the truth's gap (McLyman) has R_gap(0) = 0.
     pub fn square_wave(desc: &Description) -> Excitation {

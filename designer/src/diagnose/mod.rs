@@ -95,11 +95,31 @@ impl Gain {
     }
 }
 
-/// A cause that won on the fitted part and lost on the held-out end.
+/// A cause that won the ranking on the fitted part but does not improve
+/// the replay where it must: on the held-out end, or on the whole record.
 #[derive(Debug, Clone, Copy)]
 pub struct Rejected {
     pub cause: Cause,
-    pub held_out: Gain,
+    /// On the whole record (the extension on the edges it places).
+    pub whole: Gain,
+    /// On the held-out end (None: no held-out part).
+    pub held_out: Option<Gain>,
+}
+
+impl Rejected {
+    /// Why, in words.
+    pub fn reason(&self) -> String {
+        match self.held_out {
+            Some(h) if !(h.gain > 0.0) => format!(
+                "it wins on the fitted part but not on the held-out end (gain {:.1} %)",
+                100.0 * h.gain
+            ),
+            _ => format!(
+                "it does not improve the whole record (gain {:.1} %)",
+                100.0 * self.whole.gain
+            ),
+        }
+    }
 }
 
 /// The outcome of a diagnosis.
@@ -117,10 +137,15 @@ pub struct Diagnosis {
     /// identify (the effect parameter's confidence interval holds its null
     /// value), with the reason: not named.
     pub not_identifiable: Vec<(Cause, String)>,
-    /// wNRMSE that the current's measurement noise alone gives.
+    /// wNRMSE that the measurement noise alone gives: the current's, and the
+    /// voltage's as the replay passes it on.
     pub noise_floor: f64,
     /// Estimated standard deviation of the current noise [A].
     pub current_noise: f64,
+    /// Estimated standard deviation of the voltage noise [V].
+    pub voltage_noise: f64,
+    /// The part of the floor the voltage noise gives.
+    pub voltage_floor: f64,
     /// The winner's description (the baseline's when the cause is `none`).
     pub extended: Description,
     /// Every candidate, best first.
@@ -161,6 +186,10 @@ pub enum DiagnoseError {
     )]
     NoExcitation { file: String },
 }
+
+/// Seed of the noise added to the voltage to measure its floor (fixed: the
+/// same record gives the same diagnosis).
+const VOLTAGE_NOISE_SEED: u64 = 0x5EED_0F_F10;
 
 /// Fewest samples a diagnosis accepts (fits of up to seven parameters).
 pub const MIN_SAMPLES: usize = 200;
@@ -205,7 +234,26 @@ pub fn diagnose(
     };
     let baseline_replay = replay(baseline)?;
     let current_noise = rank::noise_std(&data.i);
-    let noise_floor = rank::noise_floor(current_noise, &data.i, &weights);
+    let voltage_noise = rank::noise_std(&data.v);
+    let renoised = Measured {
+        v: data
+            .v
+            .iter()
+            .zip(rank::white_noise(n, VOLTAGE_NOISE_SEED))
+            .map(|(v, e)| v + voltage_noise * e)
+            .collect(),
+        ..data.clone()
+    };
+    let voltage_floor = rank::voltage_floor(
+        &baseline_replay.current,
+        &replay_own(baseline, &renoised)?.current,
+        &data.i,
+        &weights,
+    );
+    let noise_floor = rank::combined_floor(
+        rank::noise_floor(current_noise, &data.i, &weights),
+        voltage_floor,
+    );
 
     let fitted_samples =
         fitted_samples(n, options.holdout).min(options.max_fit_samples.max(MIN_SAMPLES));
@@ -301,7 +349,8 @@ pub fn diagnose(
             {
                 rejected.push(Rejected {
                     cause: scored.cause,
-                    held_out: h,
+                    whole: whole_gain(&extended_replay),
+                    held_out: Some(h),
                 })
             }
             _ => {
@@ -320,6 +369,17 @@ pub fn diagnose(
                     Some(n) => replay_own(&n.description, &own)?,
                     None => replay_own(&fit.description, &own)?,
                 };
+                // A cause that does not improve the whole record is never
+                // named (whatever its held-out part).
+                let whole = whole_gain(&extended_replay);
+                if !(whole.gain > 0.0) {
+                    rejected.push(Rejected {
+                        cause: scored.cause,
+                        whole,
+                        held_out: held_out_gain(&extended_replay),
+                    });
+                    continue;
+                }
                 chosen = Some((
                     scored.cause,
                     named.unwrap_or_else(|| fit.clone()),
@@ -343,6 +403,8 @@ pub fn diagnose(
         not_identifiable,
         noise_floor,
         current_noise,
+        voltage_noise,
+        voltage_floor,
         extended,
         ranking,
         not_applicable,

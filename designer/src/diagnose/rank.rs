@@ -6,6 +6,13 @@
 //! samples do not count equally: the BIC uses the effective sample count
 //! n_eff = (Σw)²/Σw² of the weights (Kish), which equals n for equal weights
 //! and is smaller when the weight concentrates in the transients.
+//!
+//! The floor has two parts: the current's own measurement noise, and the
+//! voltage's, which the replay integrates (a saturated coil of small
+//! inductance passes it on to the current almost as δv/R). The second is
+//! measured, not modelled: the baseline is replayed once more on the
+//! measured voltage plus white noise of the voltage's estimated σ, and the
+//! two replayed currents compared ([`voltage_floor`]).
 
 /// Effective number of samples of weights `w` (Kish): (Σw)²/Σw².
 pub fn effective_samples(w: &[f64]) -> f64 {
@@ -40,6 +47,46 @@ pub fn noise_std(x: &[f64]) -> f64 {
     let mid = d2.len() / 2;
     let (_, median, _) = d2.select_nth_unstable_by(mid, f64::total_cmp);
     1.4826 * *median / 6f64.sqrt()
+}
+
+/// The noise floor of both columns: √(current² + voltage²).
+pub fn combined_floor(current: f64, voltage: f64) -> f64 {
+    current.hypot(voltage)
+}
+
+/// The wNRMSE between a replay on the measured voltage and one on the
+/// measured voltage plus fresh noise of the same σ: what the voltage's own
+/// noise costs any model replayed on it.
+pub fn voltage_floor(replayed: &[f64], renoised: &[f64], i: &[f64], w: &[f64]) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for (((a, b), i), w) in replayed.iter().zip(renoised).zip(i).zip(w) {
+        num += w * (a - b).powi(2);
+        den += w * i * i;
+    }
+    if den > 0.0 && num.is_finite() {
+        (num / den).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// `n` standard normal samples, reproducible from `seed` (splitmix64 and
+/// Box–Muller).
+pub fn white_noise(n: usize, seed: u64) -> Vec<f64> {
+    let mut state = seed;
+    let mut uniform = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..n)
+        .map(|_| {
+            let (u1, u2) = (uniform().max(f64::MIN_POSITIVE), uniform());
+            (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+        })
+        .collect()
 }
 
 /// The wNRMSE (81) that white current noise of standard deviation `sigma`
