@@ -3,12 +3,19 @@
 //! current error (eq. 81), fit every extension of the vocabulary on the first
 //! part of the record, rank them by BIC against the baseline's own best
 //! (its resistance refitted), and check the winner on the held-out rest.
+//! A cause is named only where the record identifies it (`record_lacks`,
+//! `unidentified`), it improves the held-out rest and the whole record, and
+//! the baseline stands clear of the noise floor (current noise, and the
+//! voltage noise the replay passes on). The record's voltage edges are
+//! placed once by the baseline (`identify::edges`); the named cause is then
+//! polished on its own placement ([`polish`]).
 //!
 //! Only the two inputs are read: the description and the recording.
 
 pub mod candidate;
 pub mod cause;
 pub mod localise;
+mod polish;
 pub mod rank;
 
 pub use candidate::{Candidate, NotApplicable, Scales};
@@ -325,18 +332,8 @@ pub fn diagnose(
         let Ok(fit) = scored.fit.as_ref() else {
             continue;
         };
-        let loopless =
-            scored.cause == Cause::Hysteresis && flux_reversals(&baseline_replay.phi) == 0;
-        if loopless {
-            not_identifiable.push((
-                scored.cause,
-                "the record's flux never reverses at non-zero flux: there is no λ–i loop to tell \
-                 a hysteretic core from a single-valued one"
-                    .to_string(),
-            ));
-            continue;
-        }
-        if let Some(reason) = unidentified(scored.cause, fit) {
+        let lacking = record_lacks(scored.cause, &baseline_replay, data, baseline);
+        if let Some(reason) = lacking.or_else(|| unidentified(scored.cause, fit)) {
             not_identifiable.push((scored.cause, reason));
             continue;
         }
@@ -358,13 +355,9 @@ pub fn diagnose(
                 // as the baseline did (eddy currents change the current's
                 // jump at a step), is fitted again on them, and is replayed
                 // on them for the report.
-                let own = Measured {
-                    edges: Some(identify::edges::located(&fit.description, data)),
-                    ..data.clone()
-                };
                 let candidate = all_candidates.iter().find(|c| c.cause == scored.cause);
-                let own_fit = own.head(fitted_samples);
-                let named = polish(candidate, fit, &own_fit, &fit_options);
+                let (named, own) =
+                    polish::with_edges(candidate, fit, data, fitted_samples, &fit_options);
                 let extended_replay = match &named {
                     Some(n) => replay_own(&n.description, &own)?,
                     None => replay_own(&fit.description, &own)?,
@@ -475,28 +468,6 @@ fn score(c: &Candidate, data: &Measured, options: &FitOptions, n_eff: f64) -> Sc
     }
 }
 
-/// The named candidate fitted again from its optimum on the record with
-/// the edges its own fitted model places (`own`, the fitted samples): the
-/// ranking's fits all replayed the baseline's placement, which biases the
-/// named cause's values by more than their standard errors. Not for the
-/// Jiles–Atherton core (finite-difference Jacobian: seconds per fit; its
-/// values are not compared with a truth). None: nothing better.
-fn polish(
-    candidate: Option<&Candidate>,
-    fit: &FitReport,
-    own: &Measured,
-    options: &FitOptions,
-) -> Option<FitReport> {
-    let c = candidate.filter(|c| c.cause != Cause::Hysteresis)?;
-    let options = FitOptions {
-        starts: 1,
-        ..options.clone()
-    };
-    identify::fit(&fit.description, own, &c.params, &options, &|_| {})
-        .ok()
-        .filter(|p| p.wnrmse_current.is_finite())
-}
-
 /// The hysteresis candidate's starts: its own, and one from the fitted
 /// saturating core when there is one (the saturation fit finds the flux
 /// scale reliably; the Jiles–Atherton objective has local minima).
@@ -551,6 +522,57 @@ fn flux_reversals(phi: &[f64]) -> usize {
         }
     }
     turns
+}
+
+/// Fraction of the stroke the armature must cover for the gap to be seen at
+/// more than one length.
+const MOTION_FRACTION: f64 = 0.1;
+
+/// What the record must contain for `cause` to show, if it lacks it
+/// (decided from the data's own signals where it has them, else from the
+/// baseline's replay of them): a hysteresis needs flux reversals at non-zero
+/// flux (a λ–i loop), fringing a gap seen at several lengths (motion), a
+/// bounce an impact.
+fn record_lacks(
+    cause: Cause,
+    replay: &SimOutputs,
+    data: &Measured,
+    baseline: &Description,
+) -> Option<String> {
+    let m = &baseline.mechanics;
+    let stroke = m.z_max - m.z_min;
+    let z = data.z.as_deref().unwrap_or(&replay.z);
+    match cause {
+        Cause::Hysteresis if flux_reversals(&replay.phi) == 0 => Some(
+            "the record's flux never reverses at non-zero flux: there is no λ–i loop to tell a \
+             hysteretic core from a single-valued one"
+                .to_string(),
+        ),
+        Cause::Fringing if span(z) < MOTION_FRACTION * stroke => Some(format!(
+            "the armature moves over {:.1} % of the stroke only: the gap is seen at one length, \
+             where fringing is a change of the linear gap",
+            100.0 * span(z) / stroke
+        )),
+        Cause::Bouncing if impacts(replay, m.z_min, m.z_max).is_empty() => Some(
+            "the armature reaches no stop in the record: there is no impact to bounce".to_string(),
+        ),
+        _ => None,
+    }
+}
+
+/// max − min of the finite values.
+fn span(x: &[f64]) -> f64 {
+    let (lo, hi) = x
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if hi >= lo {
+        hi - lo
+    } else {
+        0.0
+    }
 }
 
 /// The parameter whose null value means "no such effect", per cause: a loop
