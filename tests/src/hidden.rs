@@ -147,9 +147,9 @@ impl Excitation {
         }
     }
 
-    /// The voltage at `t` (right-continuous at the edges).
-    pub fn value(&self, t: f64) -> f64 {
-        let (amplitude, on, period, n) = match *self {
+    /// (amplitude [V], on-time [s], period [s], periods).
+    fn shape(&self) -> (f64, f64, f64, usize) {
+        match *self {
             Excitation::SquareWave {
                 amplitude,
                 period,
@@ -161,7 +161,12 @@ impl Excitation {
                 period,
                 count,
             } => (amplitude, width, period, count),
-        };
+        }
+    }
+
+    /// The voltage at `t` (right-continuous at the edges).
+    pub fn value(&self, t: f64) -> f64 {
+        let (amplitude, on, period, n) = self.shape();
         let k = (t / period).floor();
         let within = k >= 0.0 && (k as usize) < n && t - k * period < on;
         if within {
@@ -173,19 +178,7 @@ impl Excitation {
 
     /// The voltage's steps `(t, value)` from 0, in order.
     pub fn steps(&self) -> Vec<(f64, f64)> {
-        let (amplitude, on, period, n) = match *self {
-            Excitation::SquareWave {
-                amplitude,
-                period,
-                cycles,
-            } => (amplitude, 0.5 * period, period, cycles),
-            Excitation::Pulses {
-                amplitude,
-                width,
-                period,
-                count,
-            } => (amplitude, width, period, count),
-        };
+        let (amplitude, on, period, n) = self.shape();
         (0..n)
             .flat_map(|k| {
                 let start = k as f64 * period;
@@ -637,6 +630,15 @@ pub fn experiment(
         out.push('\n');
     }
     out
+}
+
+/// The candidates' fitted errors, best first: `cause:wNRMSE%` each.
+pub fn ranking_summary(d: &designer::diagnose::Diagnosis) -> String {
+    d.ranking
+        .iter()
+        .map(|s| format!("{}:{:.3}%", s.cause, 100.0 * s.wnrmse_fit))
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// A standard normal sample (Box–Muller).

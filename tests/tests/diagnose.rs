@@ -135,11 +135,7 @@ fn check(&(example, cause, drive, with_z, seed): &Case) -> Option<String> {
         100.0 * d.whole.baseline_wnrmse,
         100.0 * d.whole.extended_wnrmse,
         100.0 * d.noise_floor,
-        d.ranking
-            .iter()
-            .map(|s| format!("{}:{:.3}%", s.cause, 100.0 * s.wnrmse_fit))
-            .collect::<Vec<_>>()
-            .join(" "),
+        reldesign_tests::hidden::ranking_summary(&d),
         d.not_identifiable,
         d.rejected
             .iter()

@@ -69,11 +69,7 @@ fn run(subject: &Subject, period: f64, edges: Edges, seed: u64) -> (Diagnosis, S
         100.0 * d.whole.gain,
         100.0 * d.whole.baseline_wnrmse,
         100.0 * d.noise_floor,
-        d.ranking
-            .iter()
-            .map(|s| format!("{}:{:.3}%", s.cause, 100.0 * s.wnrmse_fit))
-            .collect::<Vec<_>>()
-            .join(" ")
+        reldesign_tests::hidden::ranking_summary(&d)
     );
     eprintln!("{summary}");
     (d, summary)
