@@ -172,6 +172,9 @@ pub struct Diagnosis {
     /// The named cause's fit, polished on the record's edges as the
     /// extension places them (None for `none`).
     pub named_fit: Option<FitReport>,
+    /// Variances of the named values from the voltage noise and the edge
+    /// placement (`polish::propagated_variances`), in the fit's order.
+    pub propagated: Option<Vec<f64>>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -358,6 +361,12 @@ pub fn diagnose(
                 let candidate = all_candidates.iter().find(|c| c.cause == scored.cause);
                 let (named, own) =
                     polish::with_edges(candidate, fit, data, fitted_samples, &fit_options);
+                let propagated = polish::propagated_variances(
+                    candidate,
+                    named.as_ref().unwrap_or(fit),
+                    &own.head(fitted_samples),
+                    &fit_options,
+                );
                 let extended_replay = match &named {
                     Some(n) => replay_own(&n.description, &own)?,
                     None => replay_own(&fit.description, &own)?,
@@ -377,14 +386,27 @@ pub fn diagnose(
                     scored.cause,
                     named.unwrap_or_else(|| fit.clone()),
                     extended_replay,
+                    propagated,
                 ));
                 break;
             }
         }
     }
-    let (winner, named_fit, extended, extended_replay) = match chosen {
-        Some((cause, fit, replay)) => (cause, Some(fit.clone()), fit.description, replay),
-        None => (Cause::None, None, baseline.clone(), baseline_replay.clone()),
+    let (winner, named_fit, extended, extended_replay, propagated) = match chosen {
+        Some((cause, fit, replay, propagated)) => (
+            cause,
+            Some(fit.clone()),
+            fit.description,
+            replay,
+            propagated,
+        ),
+        None => (
+            Cause::None,
+            None,
+            baseline.clone(),
+            baseline_replay.clone(),
+            None,
+        ),
     };
     let whole = whole_gain(&extended_replay);
     let held_out = held_out_gain(&extended_replay);
@@ -407,6 +429,7 @@ pub fn diagnose(
         fitted_samples,
         edges,
         named_fit,
+        propagated,
     })
 }
 
@@ -666,7 +689,13 @@ impl Diagnosis {
             .map(|(j, (path, value))| FittedParameter {
                 path: path.clone(),
                 value: *value,
-                std_error: widen * value.abs() * rel.get(j).copied().unwrap_or(f64::INFINITY),
+                std_error: (widen * value.abs() * rel.get(j).copied().unwrap_or(f64::INFINITY))
+                    .hypot(
+                        self.propagated
+                            .as_ref()
+                            .and_then(|v| v.get(j))
+                            .map_or(0.0, |v| v.sqrt()),
+                    ),
                 baseline: identify::params::get(baseline, path).ok(),
             })
             .collect()

@@ -614,6 +614,45 @@ pub fn sensitivity_at(
     ))
 }
 
+/// The residuals of (80) and their Jacobian ∂r/∂θ (forward differences)
+/// at the description's values of `params` (no fit).
+pub fn linearisation(
+    description: &Description,
+    data: &Measured,
+    params: &[FitParam],
+    options: &FitOptions,
+) -> Result<(DMatrix<f64>, Vec<f64>), FitError> {
+    let setup = Setup::new(description, data, params, options)?;
+    let residual = |theta: &[f64]| setup.residuals(description, params, theta);
+    let lm_options = lm::Options {
+        max_iterations: 0,
+        fd_step: options.fd_step,
+        ..lm::Options::default()
+    };
+    let report = lm::minimize(residual, &setup.x0, &setup.bounds, &lm_options, &mut |_| {})
+        .map_err(|e| FitError::Solver {
+            file: data.file_name.clone(),
+            message: e.to_string(),
+        })?;
+    Ok((report.jacobian, report.residuals))
+}
+
+/// The residuals of (80) at the description's values of `params`.
+pub fn residuals_at(
+    description: &Description,
+    data: &Measured,
+    params: &[FitParam],
+    options: &FitOptions,
+) -> Result<Vec<f64>, FitError> {
+    let setup = Setup::new(description, data, params, options)?;
+    setup
+        .residuals(description, params, &setup.x0)
+        .ok_or_else(|| FitError::Solver {
+            file: data.file_name.clone(),
+            message: "the model cannot replay the record at these values".into(),
+        })
+}
+
 /// The checked start values, the objective (80) and the box of one fit.
 struct Setup<'a> {
     x0: Vec<f64>,

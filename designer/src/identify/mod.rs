@@ -26,8 +26,8 @@ pub mod sensitivity;
 pub mod weighted;
 
 pub use em_fit::{
-    current_wnrmse, fit, simulate_outputs, FitError, FitOptions, FitParam, FitProgress, FitReport,
-    Sensitivities, SimOutputs,
+    current_wnrmse, fit, linearisation, residuals_at, simulate_outputs, FitError, FitOptions,
+    FitParam, FitProgress, FitReport, Sensitivities, SimOutputs,
 };
 pub use identifiability::{reduced_parameters, ReducedParameters, Sensitivity};
 pub use measured::Measured;
