@@ -84,6 +84,45 @@ impl Excitation {
         }
     }
 
+    /// One step to the square wave's amplitude, held for two of its periods
+    /// to the end of the record: the flux rises and never turns (no λ–i
+    /// loop).
+    pub fn step(desc: &Description) -> Excitation {
+        let (amplitude, half) = drive_levels(desc);
+        Excitation::Pulses {
+            amplitude,
+            width: 4.0 * half,
+            period: 4.0 * half,
+            count: 1,
+        }
+    }
+
+    /// The same excitation at `factor` times its amplitude.
+    pub fn scaled(self, factor: f64) -> Excitation {
+        match self {
+            Excitation::SquareWave {
+                amplitude,
+                period,
+                cycles,
+            } => Excitation::SquareWave {
+                amplitude: factor * amplitude,
+                period,
+                cycles,
+            },
+            Excitation::Pulses {
+                amplitude,
+                width,
+                period,
+                count,
+            } => Excitation::Pulses {
+                amplitude: factor * amplitude,
+                width,
+                period,
+                count,
+            },
+        }
+    }
+
     /// The same excitation repeated `n` times as often (longer records).
     pub fn repeated(self, n: usize) -> Excitation {
         match self {

@@ -262,14 +262,25 @@ const DEVICE_SEED: u64 = 12;
 
 /// A hidden-effect case on generated device `index`.
 fn device_case(index: u64, cause: Cause, drive: Drive, with_z: bool, seed: u64) -> HiddenCase {
+    device_case_with(index, cause, with_z, seed, |base| match drive {
+        Drive::Square => Excitation::square_wave(base),
+        Drive::Pulses => Excitation::pulses(base),
+    })
+}
+
+/// A hidden-effect case on generated device `index` under the excitation
+/// `drive` makes of its baseline.
+fn device_case_with(
+    index: u64,
+    cause: Cause,
+    with_z: bool,
+    seed: u64,
+    drive: impl Fn(&designer::description::Description) -> Excitation,
+) -> HiddenCase {
     let device = reldesign_tests::devices::device(DEVICE_SEED, index, false);
     let file = format!("{}.toml", device.name);
-    let desc = device.description();
-    let base = reldesign_tests::hidden::baseline(&desc);
-    let excitation = match drive {
-        Drive::Square => Excitation::square_wave(&base),
-        Drive::Pulses => Excitation::pulses(&base),
-    };
+    let base = reldesign_tests::hidden::baseline(&device.description());
+    let excitation = drive(&base);
     reldesign_tests::hidden::hidden_case_of(&device.toml, &file, cause, &excitation, with_z, seed)
 }
 
@@ -395,4 +406,49 @@ fn confusion_matrix_on_generated_devices() {
         cases.len(),
         m.failures.join("\n")
     );
+}
+
+/// Identifiability from the record, on generated devices (issue 12 §2, §5):
+/// a hysteretic core under one held step (the flux never turns) and fringing
+/// under a drive too weak to move the armature (the gap is seen at one
+/// length) are never named; the record says why where they would have won.
+#[test]
+fn effects_the_record_cannot_show_are_not_named() {
+    let cases: [(
+        u64,
+        Cause,
+        fn(&designer::description::Description) -> Excitation,
+    ); 4] = [
+        (0, Cause::Hysteresis, Excitation::step),
+        (7, Cause::Hysteresis, Excitation::step),
+        (1, Cause::Fringing, |b| {
+            Excitation::square_wave(b).scaled(0.2)
+        }),
+        (8, Cause::Fringing, |b| {
+            Excitation::square_wave(b).scaled(0.2)
+        }),
+    ];
+    let mut failures = Vec::new();
+    for (k, &(index, cause, drive)) in cases.iter().enumerate() {
+        let case = device_case_with(index, cause, false, 400 + k as u64, drive);
+        let (d, _) = run(&case);
+        let why = d.not_identifiable.iter().find(|(c, _)| *c == cause);
+        eprintln!(
+            "device_{DEVICE_SEED}_{index} {cause} hidden: answered {} (ranking {}); not identifiable: {why:?}",
+            d.cause,
+            reldesign_tests::hidden::ranking_summary(&d)
+        );
+        if d.cause == cause {
+            failures.push(format!("device_{DEVICE_SEED}_{index}: {cause} named"));
+        }
+        // The effect must show in the record, or the test proves nothing.
+        if d.whole.baseline_wnrmse < HELD_OUT_VISIBLE * d.noise_floor {
+            failures.push(format!(
+                "device_{DEVICE_SEED}_{index}: hidden {cause} does not show ({:.3} % vs floor {:.3} %)",
+                100.0 * d.whole.baseline_wnrmse,
+                100.0 * d.noise_floor
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
