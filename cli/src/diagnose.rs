@@ -251,8 +251,8 @@ fn text_report(
         let placed = d.edges.iter().filter(|e| e.located).count();
         let _ = writeln!(
             s,
-            "voltage steps between samples: {}, {placed} placed inside their sample interval by \
-             the baseline's local replays (the rest at mid-interval)",
+            "voltage steps between samples: {}, {placed} placed inside their sample interval \
+             (the rest at mid-interval)",
             d.edges.len()
         );
     }

@@ -99,54 +99,14 @@ impl Excitation {
 
     /// The same excitation at `factor` times its amplitude.
     pub fn scaled(self, factor: f64) -> Excitation {
-        match self {
-            Excitation::SquareWave {
-                amplitude,
-                period,
-                cycles,
-            } => Excitation::SquareWave {
-                amplitude: factor * amplitude,
-                period,
-                cycles,
-            },
-            Excitation::Pulses {
-                amplitude,
-                width,
-                period,
-                count,
-            } => Excitation::Pulses {
-                amplitude: factor * amplitude,
-                width,
-                period,
-                count,
-            },
-        }
+        let (amplitude, on, period, n) = self.shape();
+        self.reshaped(factor * amplitude, on, period, n)
     }
 
     /// The same excitation repeated `n` times as often (longer records).
     pub fn repeated(self, n: usize) -> Excitation {
-        match self {
-            Excitation::SquareWave {
-                amplitude,
-                period,
-                cycles,
-            } => Excitation::SquareWave {
-                amplitude,
-                period,
-                cycles: cycles * n,
-            },
-            Excitation::Pulses {
-                amplitude,
-                width,
-                period,
-                count,
-            } => Excitation::Pulses {
-                amplitude,
-                width,
-                period,
-                count: count * n,
-            },
-        }
+        let (amplitude, on, period, periods) = self.shape();
+        self.reshaped(amplitude, on, period, periods * n)
     }
 
     /// The same excitation with its period (and width) rounded to whole
@@ -154,35 +114,32 @@ impl Excitation {
     /// instant of a record that starts at 0.
     pub fn on_grid(self, sample_period: f64) -> Excitation {
         let round = |x: f64| (x / sample_period).round().max(1.0) * sample_period;
-        match self {
-            Excitation::SquareWave {
-                amplitude,
-                period,
-                cycles,
-            } => Excitation::SquareWave {
-                amplitude,
-                period: 2.0 * round(0.5 * period),
-                cycles,
-            },
-            Excitation::Pulses {
-                amplitude,
-                width,
-                period,
-                count,
-            } => Excitation::Pulses {
-                amplitude,
-                width: round(width),
-                period: round(period),
-                count,
-            },
-        }
+        let (amplitude, on, period, n) = self.shape();
+        self.reshaped(amplitude, round(on), round(period), n)
     }
 
     /// Length of the record [s].
     pub fn duration(&self) -> f64 {
-        match *self {
-            Excitation::SquareWave { period, cycles, .. } => period * cycles as f64,
-            Excitation::Pulses { period, count, .. } => period * count as f64,
+        let (_, _, period, n) = self.shape();
+        period * n as f64
+    }
+
+    /// The same kind of excitation with the shape `(amplitude, on-time,
+    /// period, periods)` of [`Excitation::shape`]; a square wave's period is
+    /// twice its on-time.
+    fn reshaped(self, amplitude: f64, on: f64, period: f64, n: usize) -> Excitation {
+        match self {
+            Excitation::SquareWave { .. } => Excitation::SquareWave {
+                amplitude,
+                period: 2.0 * on,
+                cycles: n,
+            },
+            Excitation::Pulses { .. } => Excitation::Pulses {
+                amplitude,
+                width: on,
+                period,
+                count: n,
+            },
         }
     }
 

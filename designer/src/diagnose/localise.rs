@@ -45,9 +45,9 @@
 //! ½·|(i_{k+1} − i_k) − (i_{k−1} − i_{k−2})| for the step's first sample k.
 //! A step is *within timing* when the residual over its first
 //! [`TIMING_SAMPLES`] samples stays below that bound plus 3 σ of the current
-//! noise (σ from the median absolute second difference). When the residual
-//! concentrates after the steps and at least 80 % of them are within timing,
-//! the report says the error is edge timing, not a cause.
+//! noise ([`super::rank::noise_std`]: the median absolute second difference).
+//! When the residual concentrates after the steps and at least 80 % of them
+//! are within timing, the report says the error is edge timing, not a cause.
 //!
 //! **Drift**: cycles start at the voltage's rising edges (a Schmitt trigger at
 //! 40 % / 60 % of the range) and run to the next one (the record's last cycle
@@ -600,10 +600,7 @@ fn window(
 /// The steps (first samples after each) whose residual stays within the
 /// edge-timing bound (see the module documentation).
 fn edge_timing(i: &[f64], r: &[f64], steps: &[usize]) -> EdgeTiming {
-    let second: Vec<f64> = i.windows(3).map(|w| w[2] - 2.0 * w[1] + w[0]).collect();
-    let mut abs: Vec<f64> = second.iter().map(|x| x.abs()).collect();
-    // White noise: a second difference has σ·√6; MAD → σ by 1/0.6745.
-    let sigma = median(&mut abs).unwrap_or(0.0) / (0.6745 * 6f64.sqrt());
+    let sigma = super::rank::noise_std(i);
     let judged: Vec<bool> = steps
         .iter()
         .filter(|&&k| k >= 2 && k + TIMING_SAMPLES < i.len())

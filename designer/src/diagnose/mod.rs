@@ -138,7 +138,7 @@ pub struct Diagnosis {
     /// On the held-out end of the record (not used by any fit).
     pub held_out: Option<Gain>,
     /// Candidates that beat `none` on the fitted part but not on the
-    /// held-out end, best first: not named.
+    /// held-out end or the whole record, best first: not named.
     pub rejected: Vec<Rejected>,
     /// Candidates that beat `none` but whose effect the record does not
     /// identify (the effect parameter's confidence interval holds its null
@@ -236,22 +236,12 @@ pub fn diagnose(
             source,
         })
     };
-    let replay = |d: &Description| {
-        identify::simulate_outputs(d, data).map_err(|source| DiagnoseError::Replay {
-            file: file.clone(),
-            source,
-        })
-    };
+    let replay = |d: &Description| replay_own(d, data);
     let baseline_replay = replay(baseline)?;
     let current_noise = rank::noise_std(&data.i);
     let voltage_noise = rank::noise_std(&data.v);
     let renoised = Measured {
-        v: data
-            .v
-            .iter()
-            .zip(rank::white_noise(n, VOLTAGE_NOISE_SEED))
-            .map(|(v, e)| v + voltage_noise * e)
-            .collect(),
+        v: rank::with_noise(&data.v, voltage_noise, VOLTAGE_NOISE_SEED),
         ..data.clone()
     };
     let voltage_floor = rank::voltage_floor(
@@ -361,16 +351,8 @@ pub fn diagnose(
                 let candidate = all_candidates.iter().find(|c| c.cause == scored.cause);
                 let (named, own) =
                     polish::with_edges(candidate, fit, data, fitted_samples, &fit_options);
-                let propagated = polish::propagated_variances(
-                    candidate,
-                    named.as_ref().unwrap_or(fit),
-                    &own.head(fitted_samples),
-                    &fit_options,
-                );
-                let extended_replay = match &named {
-                    Some(n) => replay_own(&n.description, &own)?,
-                    None => replay_own(&fit.description, &own)?,
-                };
+                let named = named.unwrap_or_else(|| fit.clone());
+                let extended_replay = replay_own(&named.description, &own)?;
                 // A cause that does not improve the whole record is never
                 // named (whatever its held-out part).
                 let whole = whole_gain(&extended_replay);
@@ -382,24 +364,22 @@ pub fn diagnose(
                     });
                     continue;
                 }
-                chosen = Some((
-                    scored.cause,
-                    named.unwrap_or_else(|| fit.clone()),
-                    extended_replay,
-                    propagated,
-                ));
+                let propagated = polish::propagated_variances(
+                    candidate,
+                    &named,
+                    &own.head(fitted_samples),
+                    &fit_options,
+                );
+                chosen = Some((scored.cause, named, extended_replay, propagated));
                 break;
             }
         }
     }
     let (winner, named_fit, extended, extended_replay, propagated) = match chosen {
-        Some((cause, fit, replay, propagated)) => (
-            cause,
-            Some(fit.clone()),
-            fit.description,
-            replay,
-            propagated,
-        ),
+        Some((cause, fit, replay, propagated)) => {
+            let extended = fit.description.clone();
+            (cause, Some(fit), extended, replay, propagated)
+        }
         None => (
             Cause::None,
             None,

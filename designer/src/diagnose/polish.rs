@@ -101,21 +101,14 @@ pub(super) fn propagated_variances(
     let d = &named.description;
     let (jacobian, r0) = identify::linearisation(d, own, &c.params, options).ok()?;
     let pinv = jacobian.pseudo_inverse(1e-12).ok()?;
-    let n = own.len();
     let (sigma_v, sigma_i) = (rank::noise_std(&own.v), rank::noise_std(&own.i));
     let mut sum = vec![0.0; pinv.nrows()];
     for draw in 0..DRAWS as u64 {
         let seed = PROPAGATION_SEED.wrapping_add(2 * draw);
-        let add = |x: &[f64], sigma: f64, seed: u64| -> Vec<f64> {
-            x.iter()
-                .zip(rank::white_noise(n, seed))
-                .map(|(x, e)| x + sigma * e)
-                .collect()
-        };
-        let v = add(&own.v, sigma_v, seed);
+        let v = rank::with_noise(&own.v, sigma_v, seed);
         let noisy = Measured {
             v: v.clone(),
-            i: add(&own.i, sigma_i, seed + 1),
+            i: rank::with_noise(&own.i, sigma_i, seed + 1),
             edges: None,
             ..own.clone()
         };

@@ -89,6 +89,15 @@ pub fn white_noise(n: usize, seed: u64) -> Vec<f64> {
         .collect()
 }
 
+/// `x` with white noise of standard deviation `sigma` added, reproducible
+/// from `seed`.
+pub fn with_noise(x: &[f64], sigma: f64, seed: u64) -> Vec<f64> {
+    x.iter()
+        .zip(white_noise(x.len(), seed))
+        .map(|(x, e)| x + sigma * e)
+        .collect()
+}
+
 /// The wNRMSE (81) that white current noise of standard deviation `sigma`
 /// alone gives against the measured current `i` with weights `w`.
 pub fn noise_floor(sigma: f64, i: &[f64], w: &[f64]) -> f64 {
@@ -105,27 +114,9 @@ pub fn noise_floor(sigma: f64, i: &[f64], w: &[f64]) -> f64 {
 mod tests {
     use super::*;
 
-    /// A deterministic Gaussian sample (Box–Muller on a splitmix64 stream).
-    fn gaussian(n: usize, seed: u64) -> Vec<f64> {
-        let mut s = seed;
-        let mut uniform = move || {
-            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = s;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        };
-        (0..n)
-            .map(|_| {
-                let (u1, u2) = (uniform().max(1e-300), uniform());
-                (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-            })
-            .collect()
-    }
-
     #[test]
     fn noise_std_sees_through_a_square_wave() {
-        let noise = gaussian(20_000, 7);
+        let noise = white_noise(20_000, 7);
         let x: Vec<f64> = noise
             .iter()
             .enumerate()
@@ -142,7 +133,7 @@ mod tests {
     #[test]
     fn floor_matches_the_wnrmse_of_pure_noise() {
         let n = 50_000;
-        let noise = gaussian(n, 3);
+        let noise = white_noise(n, 3);
         let i: Vec<f64> = (0..n)
             .map(|k| 0.1 + 0.05 * (k as f64 * 1e-3).sin())
             .collect();

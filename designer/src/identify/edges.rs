@@ -27,7 +27,7 @@ use nalgebra::{SMatrix, SVector};
 use crate::description::{Description, Drive};
 use crate::model::{Model, ModelPlant};
 use crate::replay::rest_state;
-use crate::sim::{simulate, InputError, Mode, Options, PiecewiseLinear, State};
+use crate::sim::{simulate, InputError, Mode, Options, PiecewiseLinear, State, Trajectory};
 
 use super::Measured;
 
@@ -118,18 +118,27 @@ pub fn edges(data: &Measured, jump: CurrentJump) -> Vec<Edge> {
 /// linearly, and a step at τ across each of the record's placed edges
 /// ([`Measured::edges`]; none placed: linear interpolation throughout).
 pub fn replay_input(data: &Measured) -> Result<PiecewiseLinear, InputError> {
-    input_with(data, data.edges.as_deref().unwrap_or(&[]))
+    match data.len() {
+        0 => PiecewiseLinear::new(Vec::new(), Vec::new()),
+        n => input_with(data, 0, n - 1, data.edges.as_deref().unwrap_or(&[])),
+    }
 }
 
-/// The samples joined linearly, a step at τ across each of `edges`.
-fn input_with(data: &Measured, edges: &[Edge]) -> Result<PiecewiseLinear, InputError> {
-    let mut t = Vec::with_capacity(data.len() + 2 * edges.len());
-    let mut v = Vec::with_capacity(data.len() + 2 * edges.len());
-    let mut edges = edges.iter().peekable();
-    for k in 0..data.len() {
+/// The measured voltage over samples from..=to, joined linearly, a step at
+/// τ across each of `edges` (in order; those not inside the range skipped).
+fn input_with(
+    data: &Measured,
+    from: usize,
+    to: usize,
+    edges: &[Edge],
+) -> Result<PiecewiseLinear, InputError> {
+    let mut t = Vec::with_capacity(to + 1 - from + 2 * edges.len());
+    let mut v = Vec::with_capacity(to + 1 - from + 2 * edges.len());
+    let mut edges = edges.iter().skip_while(|e| e.k < from).peekable();
+    for k in from..=to {
         t.push(data.t[k]);
         v.push(data.v[k]);
-        if let Some(e) = edges.next_if(|e| e.k == k && k + 1 < data.len()) {
+        if let Some(e) = edges.next_if(|e| e.k == k && k < to) {
             t.extend([e.tau, e.tau]);
             v.extend([data.v[k], data.v[k + 1]]);
         }
@@ -210,18 +219,7 @@ fn advance(
     k: usize,
     previous: Option<Edge>,
 ) -> Option<Replayed> {
-    let step = previous.filter(|e| e.k == at.k);
-    let input = segment(data, at.k, k, step)?;
-    let tr = simulate(
-        plant,
-        &input,
-        at.x,
-        at.mode,
-        &data.t[at.k..=k],
-        &Options::default(),
-    )
-    .ok()?;
-    let (current, _) = plant.currents_and_voltages(&tr.t, &tr.x, &tr.u);
+    let (tr, current) = replay_segment(plant, data, at, k, previous)?;
     let tail = current.len().min(OFFSET_SAMPLES);
     let first = current.len() - tail;
     let offset = (first..current.len())
@@ -250,17 +248,7 @@ fn place(plant: &ModelPlant, data: &Measured, at: &Replayed, end: usize) -> Opti
             tau: t0 + frac * dt,
             located: true,
         };
-        let input = segment(data, k, end, Some(edge))?;
-        let tr = simulate(
-            plant,
-            &input,
-            at.x,
-            at.mode,
-            &data.t[k..=end],
-            &Options::default(),
-        )
-        .ok()?;
-        let (current, _) = plant.currents_and_voltages(&tr.t, &tr.x, &tr.u);
+        let (_, current) = replay_segment(plant, data, at, end, Some(edge))?;
         Some(
             current
                 .iter()
@@ -283,20 +271,24 @@ fn place(plant: &ModelPlant, data: &Measured, at: &Replayed, end: usize) -> Opti
     Some(t0 + frac * dt)
 }
 
-/// The measured voltage over samples from..=to, joined linearly, with
-/// `step` (an edge after sample `from`) as a step.
-fn segment(data: &Measured, from: usize, to: usize, step: Option<Edge>) -> Option<PiecewiseLinear> {
-    let mut t = Vec::with_capacity(to - from + 3);
-    let mut v = Vec::with_capacity(to - from + 3);
-    for j in from..=to {
-        t.push(data.t[j]);
-        v.push(data.v[j]);
-        if let Some(e) = step.filter(|e| e.k == j && j < to) {
-            t.extend([e.tau, e.tau]);
-            v.extend([data.v[j], data.v[j + 1]]);
-        }
-    }
-    PiecewiseLinear::new(t, v).ok()
+/// The replay from `at` to sample `to` with `step` (an edge after sample
+/// `at.k`, if any), and its coil current at the samples.
+fn replay_segment(
+    plant: &ModelPlant,
+    data: &Measured,
+    at: &Replayed,
+    to: usize,
+    step: Option<Edge>,
+) -> Option<(Trajectory, Vec<f64>)> {
+    let steps: &[Edge] = match &step {
+        Some(e) => std::slice::from_ref(e),
+        None => &[],
+    };
+    let input = input_with(data, at.k, to, steps).ok()?;
+    let times = &data.t[at.k..=to];
+    let tr = simulate(plant, &input, at.x, at.mode, times, &Options::default()).ok()?;
+    let (current, _) = plant.currents_and_voltages(&tr.t, &tr.x, &tr.u);
+    Some((tr, current))
 }
 
 /// The vertex of the parabola through the lowest of `costs` (at the

@@ -593,18 +593,7 @@ pub fn sensitivity_at(
     params: &[FitParam],
     options: &FitOptions,
 ) -> Result<Sensitivity, FitError> {
-    let setup = Setup::new(description, data, params, options)?;
-    let residual = |theta: &[f64]| setup.residuals(description, params, theta);
-    let lm_options = lm::Options {
-        max_iterations: 0,
-        fd_step: options.fd_step,
-        ..lm::Options::default()
-    };
-    let report = lm::minimize(residual, &setup.x0, &setup.bounds, &lm_options, &mut |_| {})
-        .map_err(|e| FitError::Solver {
-            file: data.file_name.clone(),
-            message: e.to_string(),
-        })?;
+    let report = linearised(description, data, params, options)?;
     let names: Vec<String> = params.iter().map(|p| p.path.clone()).collect();
     Ok(Sensitivity::from_jacobian(
         &names,
@@ -622,6 +611,18 @@ pub fn linearisation(
     params: &[FitParam],
     options: &FitOptions,
 ) -> Result<(DMatrix<f64>, Vec<f64>), FitError> {
+    let report = linearised(description, data, params, options)?;
+    Ok((report.jacobian, report.residuals))
+}
+
+/// The solver's report after no iteration: residuals and Jacobian at the
+/// description's values.
+fn linearised(
+    description: &Description,
+    data: &Measured,
+    params: &[FitParam],
+    options: &FitOptions,
+) -> Result<lm::Report, FitError> {
     let setup = Setup::new(description, data, params, options)?;
     let residual = |theta: &[f64]| setup.residuals(description, params, theta);
     let lm_options = lm::Options {
@@ -629,12 +630,12 @@ pub fn linearisation(
         fd_step: options.fd_step,
         ..lm::Options::default()
     };
-    let report = lm::minimize(residual, &setup.x0, &setup.bounds, &lm_options, &mut |_| {})
-        .map_err(|e| FitError::Solver {
+    lm::minimize(residual, &setup.x0, &setup.bounds, &lm_options, &mut |_| {}).map_err(|e| {
+        FitError::Solver {
             file: data.file_name.clone(),
             message: e.to_string(),
-        })?;
-    Ok((report.jacobian, report.residuals))
+        }
+    })
 }
 
 /// The residuals of (80) at the description's values of `params`.

@@ -27,9 +27,9 @@ pub struct Measured {
     /// The (median) sampling period [s].
     pub dt: f64,
     pub file_name: String,
-    /// The voltage edges' instants when estimated once for the record
-    /// ([`super::edges::located`]); `None`: each replay places them from the
-    /// current's kink for its own model ([`super::edges::edges`]).
+    /// The voltage edges' instants when placed for the record
+    /// ([`super::edges::located`]): every replay steps there; `None`: the
+    /// replays join the samples linearly.
     pub edges: Option<Vec<super::edges::Edge>>,
 }
 
