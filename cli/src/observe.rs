@@ -46,7 +46,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
         return Err(fail(format!(
             "{model}: no [observer] section: `observe` runs the estimators it lists \
              (estimators = [\"semera\", \"integral\"], with [observer.semera] / \
-             [observer.integral]; see the README)"
+             [observer.integral]; see docs/reference/description.md)"
         )));
     };
     let semera = observer

@@ -22,4 +22,5 @@ pub mod observe;
 pub mod record;
 pub mod replay;
 pub mod sim;
-pub mod sym;
+/// The symbolic core, its own crate (`reldesign-sym`): it knows nothing of actuators.
+pub use reldesign_sym as sym;

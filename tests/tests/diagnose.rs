@@ -201,7 +201,7 @@ fn full_matrix() {
 
 /// Misses the whole matrix allows: the one nested confusion it has
 /// (a saturation on the perfect-tracking valve's pulses with `z`, answered
-/// hysteresis: docs/diagnose-validation.md), and one recovered value beyond
+/// hysteresis: docs/validation/diagnose.md), and one recovered value beyond
 /// 3 standard errors (a calibrated error exceeds 3 in 0.27 % of 79 values;
 /// measured: 1 at 3.1).
 const FULL_MATRIX_MISSES: usize = 2;
@@ -381,7 +381,7 @@ fn causes_are_found_on_generated_devices() {
 }
 
 /// Every cause on 15 generated devices (every class × gap model), both
-/// excitations alternating: the confusion matrix of docs/diagnose-validation.md.
+/// excitations alternating: the confusion matrix of docs/validation/diagnose.md.
 #[test]
 #[ignore = "slow: 105 hidden-effect records on generated devices"]
 fn confusion_matrix_on_generated_devices() {

@@ -13,7 +13,7 @@
 
 use toml_edit::{DocumentMut, Item, TableLike, Value};
 
-use super::{parse_str, Coil, Core, Description, DescriptionError, Gap, Mechanics};
+use super::{parse_str, schema, Coil, Core, Description, DescriptionError, Gap, Mechanics};
 
 /// Why the physics could not be written into a description's text.
 #[derive(Debug, thiserror::Error)]
@@ -101,12 +101,18 @@ fn section<'a>(
     let table = item
         .as_table_like_mut()
         .ok_or_else(|| err("a value that is not a table"))?;
-    Ok(Sect { table, commented })
+    Ok(Sect {
+        name,
+        table,
+        commented,
+    })
 }
 
 /// One table being rewritten; `commented` is false for inline tables, where
 /// no comment can follow a value.
 struct Sect<'a> {
+    /// The section's name (`coil`, …): with a key, its schema path.
+    name: &'static str,
     table: &'a mut dyn TableLike,
     commented: bool,
 }
@@ -317,7 +323,9 @@ impl Sect<'_> {
         }
         if self.commented {
             value.decor_mut().set_prefix(" ");
-            value.decor_mut().set_suffix(format!("  # {}", unit(key)));
+            value
+                .decor_mut()
+                .set_suffix(format!("  # {}", unit(self.name, key)));
         }
         self.table.insert(key, Item::Value(value));
     }
@@ -359,26 +367,13 @@ fn parse_value(text: &str) -> Value {
         .unwrap_or_else(|e| unreachable!("`{text}` is not a TOML value: {e}"))
 }
 
-/// The unit comment of a key appended to a physics section.
-fn unit(key: &str) -> &'static str {
-    match key {
-        "turns" | "c" | "alpha" | "epsilon" | "restitution" | "model" => "[-]",
-        "resistance" => "[Ω]",
-        "eddy" => "[A/V]",
-        "resistance_drift" => "[Ω/s]",
-        "slope" | "r0_prime" | "r_prime" => "[H⁻¹/m]",
-        "offset" | "r0" | "r" => "[H⁻¹]",
-        "area" => "[m²]",
-        "k1" => "[1/m]",
-        "phi_sat" => "[Wb]",
-        "m_sat" | "kappa" => "[A/m]",
-        "b" => "[T]",
-        "mass" => "[kg]",
-        "stiffness" => "[N/m]",
-        "damping" => "[N·s/m]",
-        "preload" => "[N]",
-        "bounce_threshold" => "[m/s]",
-        _ => "[m]", // winding_length, k2, z, length, rest_position, z_min, z_max
+/// The unit comment of a key appended to a physics section: the schema's
+/// unit (`[-]` for dimensionless values and for `model`).
+fn unit(section: &str, key: &str) -> String {
+    let unit = schema::lookup(&format!("{section}.{key}")).map_or("", |k| k.unit);
+    match unit {
+        "" => "[-]".to_string(),
+        u => format!("[{u}]"),
     }
 }
 

@@ -8,6 +8,7 @@
 pub mod edit;
 mod error;
 mod parse;
+pub mod schema;
 
 pub use error::DescriptionError;
 pub use parse::{parse_file, parse_str};

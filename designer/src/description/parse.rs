@@ -11,6 +11,7 @@ use std::path::Path;
 use toml::de::{DeString, DeTable, DeValue};
 use toml::Spanned;
 
+use super::schema;
 use super::{
     Coil, Controller, Core, Description, DescriptionError, Drive, Estimator, FloatType, Gains, Gap,
     IntegralSettings, JilesAtherton, KalmanSection, Law, Mechanics, Observer, Operation,
@@ -19,74 +20,6 @@ use super::{
 
 type Res<T> = Result<T, DescriptionError>;
 
-const TOP_KEYS: [&str; 9] = [
-    "name",
-    "coil",
-    "gap",
-    "core",
-    "mechanics",
-    "supply",
-    "trajectory",
-    "controller",
-    "observer",
-];
-const GAP_MODELS: [&str; 4] = ["linear", "mclyman", "mclyman-fit", "table"];
-const CORE_MODELS: [&str; 3] = ["linear", "saturating", "jiles-atherton"];
-const DRIVES: [&str; 2] = ["voltage", "current"];
-const TRAJECTORY_KEYS: [&str; 5] = ["operations", "takeoff", "landing", "shape", "u_bound"];
-const OPERATIONS: [&str; 2] = ["closing", "opening"];
-const SHAPES: [&str; 2] = ["energy-optimal", "polynomial"];
-const CONTROLLER_KEYS: [&str; 6] = [
-    "law",
-    "settling_time",
-    "poles",
-    "sample_period",
-    "float",
-    "creep_speed",
-];
-const LAWS: [&str; 1] = ["feedback-linearization"];
-const FLOATS: [&str; 2] = ["f32", "f64"];
-const OBSERVER_KEYS: [&str; 8] = [
-    "estimators",
-    "sample_period",
-    "float",
-    "voltage_noise",
-    "current_noise",
-    "semera",
-    "integral",
-    "kalman",
-];
-const ESTIMATORS: [&str; 4] = ["semera", "integral", "ekf", "ukf"];
-const SEMERA_KEYS: [&str; 7] = [
-    "initial_resistance",
-    "initial_resistance_std",
-    "initial_inductance",
-    "initial_inductance_std",
-    "resistance_rate_std",
-    "inductance_accel_std",
-    "ci_sigmas",
-];
-const INTEGRAL_KEYS: [&str; 5] = [
-    "initial_resistance",
-    "initial_inductance",
-    "initial_flux_linkage",
-    "ci_sigmas",
-    "energize_threshold",
-];
-const KALMAN_KEYS: [&str; 12] = [
-    "estimate_resistance",
-    "resistance_rate_std",
-    "initial_resistance_std",
-    "process_z",
-    "process_phi",
-    "process_hc",
-    "initial_z_std",
-    "initial_phi_std",
-    "initial_hc_std",
-    "ukf_alpha",
-    "ukf_beta",
-    "ukf_kappa",
-];
 /// The motion [takeoff, landing] must last at least this many sample periods.
 const MIN_SAMPLES_PER_MOTION: f64 = 10.0;
 /// Grid size of the fringing-denominator check on (0, z_max].
@@ -114,7 +47,7 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         table: doc.get_ref(),
         span: 0..0,
     };
-    root.check_keys(&TOP_KEYS, "at the top level")?;
+    root.check_keys(None, "at the top level")?;
     let name = parse_name(&root)?;
     let coil = parse_coil(&root.section("coil")?)?;
     let gap_sect = root.section("gap")?;
@@ -215,47 +148,44 @@ const RUST_KEYWORDS: [&str; 51] = [
 ];
 
 fn parse_coil(s: &Sect) -> Res<Coil> {
-    s.check_keys(
-        &["turns", "resistance", "eddy", "resistance_drift"],
-        "in [coil]",
-    )?;
+    s.check_keys(None, "in [coil]")?;
     Ok(Coil {
-        turns: s.num("turns", Bound::Positive, "turns")?,
-        resistance: s.num("resistance", Bound::Positive, "Ω")?,
-        eddy: s.num("eddy", Bound::NonNegative, "A/V")?,
-        resistance_drift: s.num_or("resistance_drift", Bound::Any, "Ω/s", 0.0)?,
+        turns: s.req("turns")?,
+        resistance: s.req("resistance")?,
+        eddy: s.req("eddy")?,
+        resistance_drift: s.or_default("resistance_drift")?,
     })
 }
 
 fn parse_gap(s: &Sect) -> Res<Gap> {
-    let model = s.choice("model", "gap model", &GAP_MODELS)?;
+    let model = s.choice("model", "gap model")?;
     let context = format!("in [gap] with model \"{model}\"");
     let gap = match model {
         "linear" => {
-            s.check_keys(&["model", "slope", "offset"], &context)?;
+            s.check_keys(Some(model), &context)?;
             Gap::Linear {
-                slope: s.num("slope", Bound::Positive, "H⁻¹/m")?,
-                offset: s.num_or("offset", Bound::NonNegative, "H⁻¹", 0.0)?,
+                slope: s.req("slope")?,
+                offset: s.or_default("offset")?,
             }
         }
         "mclyman" => {
-            s.check_keys(&["model", "area", "winding_length"], &context)?;
+            s.check_keys(Some(model), &context)?;
             Gap::McLyman {
-                area: s.num("area", Bound::Positive, "m²")?,
-                winding_length: s.num("winding_length", Bound::Positive, "m")?,
+                area: s.req("area")?,
+                winding_length: s.req("winding_length")?,
             }
         }
         "mclyman-fit" => {
-            s.check_keys(&["model", "r0", "r0_prime", "k1", "k2"], &context)?;
+            s.check_keys(Some(model), &context)?;
             Gap::McLymanFit {
-                r0: s.num("r0", Bound::NonNegative, "H⁻¹")?,
-                r0_prime: s.num("r0_prime", Bound::Positive, "H⁻¹/m")?,
-                k1: s.num("k1", Bound::NonNegative, "1/m")?,
-                k2: s.num("k2", Bound::Positive, "m")?,
+                r0: s.req("r0")?,
+                r0_prime: s.req("r0_prime")?,
+                k1: s.req("k1")?,
+                k2: s.req("k2")?,
             }
         }
         _ => {
-            s.check_keys(&["model", "z", "r", "r_prime"], &context)?;
+            s.check_keys(Some(model), &context)?;
             parse_table(s)?
         }
     };
@@ -263,9 +193,9 @@ fn parse_gap(s: &Sect) -> Res<Gap> {
 }
 
 fn parse_table(s: &Sect) -> Res<Gap> {
-    let z = s.array("z", Bound::Any, "m")?;
-    let r = s.array("r", Bound::NonNegative, "H⁻¹")?;
-    let r_prime = s.opt_array("r_prime", Bound::Positive, "H⁻¹/m")?;
+    let z = s.req_array("z")?;
+    let r = s.req_array("r")?;
+    let r_prime = s.opt_numbers("r_prime")?;
     if z.len() < 4 {
         let msg = format!("expected at least 4 points, found {}", z.len());
         return Err(s.err("z", msg, "too few points"));
@@ -281,36 +211,31 @@ fn parse_table(s: &Sect) -> Res<Gap> {
 }
 
 fn parse_core(s: &Sect) -> Res<Core> {
-    let model = s.choice("model", "core model", &CORE_MODELS)?;
+    let model = s.choice("model", "core model")?;
     let context = format!("in [core] with model \"{model}\"");
     let core = match model {
         "linear" => {
-            s.check_keys(&["model", "r0"], &context)?;
-            Core::Linear {
-                r0: s.num("r0", Bound::Positive, "H⁻¹")?,
-            }
+            s.check_keys(Some(model), &context)?;
+            Core::Linear { r0: s.req("r0")? }
         }
         "saturating" => {
-            s.check_keys(&["model", "r0", "phi_sat"], &context)?;
+            s.check_keys(Some(model), &context)?;
             Core::Saturating {
-                r0: s.num("r0", Bound::Positive, "H⁻¹")?,
-                phi_sat: s.num("phi_sat", Bound::Positive, "Wb")?,
+                r0: s.req("r0")?,
+                phi_sat: s.req("phi_sat")?,
             }
         }
         _ => {
-            let keys = [
-                "model", "length", "area", "m_sat", "b", "c", "kappa", "alpha", "epsilon",
-            ];
-            s.check_keys(&keys, &context)?;
+            s.check_keys(Some(model), &context)?;
             Core::JilesAtherton(JilesAtherton {
-                length: s.num("length", Bound::Positive, "m")?,
-                area: s.num("area", Bound::Positive, "m²")?,
-                m_sat: s.num("m_sat", Bound::Positive, "A/m")?,
-                b: s.num("b", Bound::Positive, "T")?,
-                c: s.num("c", Bound::UnitOpen, "-")?,
-                kappa: s.num("kappa", Bound::Positive, "A/m")?,
-                alpha: s.num("alpha", Bound::NonNegative, "-")?,
-                epsilon: s.num_or("epsilon", Bound::Positive, "-", 1e-3)?,
+                length: s.req("length")?,
+                area: s.req("area")?,
+                m_sat: s.req("m_sat")?,
+                b: s.req("b")?,
+                c: s.req("c")?,
+                kappa: s.req("kappa")?,
+                alpha: s.req("alpha")?,
+                epsilon: s.or_default("epsilon")?,
             })
         }
     };
@@ -318,24 +243,13 @@ fn parse_core(s: &Sect) -> Res<Core> {
 }
 
 fn parse_mechanics(s: &Sect) -> Res<Mechanics> {
-    let keys = [
-        "mass",
-        "stiffness",
-        "damping",
-        "preload",
-        "rest_position",
-        "z_min",
-        "z_max",
-        "restitution",
-        "bounce_threshold",
-    ];
-    s.check_keys(&keys, "in [mechanics]")?;
-    let mass = s.num("mass", Bound::Positive, "kg")?;
-    let stiffness = s.num("stiffness", Bound::NonNegative, "N/m")?;
-    let damping = s.num("damping", Bound::NonNegative, "N·s/m")?;
+    s.check_keys(None, "in [mechanics]")?;
+    let mass = s.req("mass")?;
+    let stiffness = s.req("stiffness")?;
+    let damping = s.req("damping")?;
     let preload = resolve_preload(s, stiffness)?;
-    let z_min = s.num("z_min", Bound::NonNegative, "m")?;
-    let z_max = s.num("z_max", Bound::Above("z_min", z_min), "m")?;
+    let z_min = s.req("z_min")?;
+    let z_max = s.req_above("z_max", z_min)?;
     Ok(Mechanics {
         mass,
         stiffness,
@@ -343,15 +257,15 @@ fn parse_mechanics(s: &Sect) -> Res<Mechanics> {
         preload,
         z_min,
         z_max,
-        restitution: s.num("restitution", Bound::Unit, "-")?,
-        bounce_threshold: s.num("bounce_threshold", Bound::NonNegative, "m/s")?,
+        restitution: s.req("restitution")?,
+        bounce_threshold: s.req("bounce_threshold")?,
     })
 }
 
 /// F0: `preload`, or −k_s·`rest_position`; exactly one of them.
 fn resolve_preload(s: &Sect, stiffness: f64) -> Res<f64> {
-    let preload = s.opt_num("preload", Bound::Any, "N")?;
-    let rest = s.opt_num("rest_position", Bound::Any, "m")?;
+    let preload = s.opt("preload")?;
+    let rest = s.opt("rest_position")?;
     match (preload, rest) {
         (Some(f0), None) => Ok(f0),
         (None, Some(z_s)) => Ok(-stiffness * z_s),
@@ -370,14 +284,14 @@ fn resolve_preload(s: &Sect, stiffness: f64) -> Res<f64> {
 }
 
 fn parse_supply(s: &Sect) -> Res<Supply> {
-    s.check_keys(&["drive", "u_min", "u_max"], "in [supply]")?;
-    let drive = match s.choice("drive", "drive", &DRIVES)? {
+    s.check_keys(None, "in [supply]")?;
+    let drive = match s.choice("drive", "drive")? {
         "voltage" => Drive::Voltage,
         _ => Drive::Current,
     };
     let unit = if drive == Drive::Voltage { "V" } else { "A" };
-    let u_min = s.num("u_min", Bound::Any, unit)?;
-    let u_max = s.num("u_max", Bound::Above("u_min", u_min), unit)?;
+    let u_min = s.req_in("u_min", unit)?;
+    let u_max = s.req_above_in("u_max", u_min, unit)?;
     Ok(Supply {
         drive,
         u_min,
@@ -386,14 +300,9 @@ fn parse_supply(s: &Sect) -> Res<Supply> {
 }
 
 fn parse_trajectory(s: &Sect, supply: &Supply) -> Res<Trajectory> {
-    s.check_keys(&TRAJECTORY_KEYS, "in [trajectory]")?;
+    s.check_keys(None, "in [trajectory]")?;
     let operations = s
-        .names(
-            "operations",
-            "operation",
-            &OPERATIONS,
-            "at least one operation",
-        )?
+        .names("operations", "operation", "at least one operation")?
         .ok_or_else(|| {
             s.missing(
                 "operations",
@@ -406,9 +315,9 @@ fn parse_trajectory(s: &Sect, supply: &Supply) -> Res<Trajectory> {
             _ => Operation::Opening,
         })
         .collect();
-    let takeoff = s.num("takeoff", Bound::Positive, "s")?;
-    let landing = s.num("landing", Bound::Above("takeoff", takeoff), "s")?;
-    let shape = match s.choice("shape", "trajectory shape", &SHAPES)? {
+    let takeoff = s.req("takeoff")?;
+    let landing = s.req_above("landing", takeoff)?;
+    let shape = match s.choice("shape", "trajectory shape")? {
         "energy-optimal" => Shape::EnergyOptimal,
         _ => Shape::Polynomial,
     };
@@ -417,7 +326,7 @@ fn parse_trajectory(s: &Sect, supply: &Supply) -> Res<Trajectory> {
     } else {
         "A"
     };
-    let u_bound = s.num("u_bound", Bound::Positive, unit)?;
+    let u_bound = s.req_in("u_bound", unit)?;
     check_u_bound(s, u_bound, supply, unit)?;
     Ok(Trajectory {
         operations,
@@ -429,13 +338,13 @@ fn parse_trajectory(s: &Sect, supply: &Supply) -> Res<Trajectory> {
 }
 
 fn parse_controller(s: &Sect) -> Res<Controller> {
-    s.check_keys(&CONTROLLER_KEYS, "in [controller]")?;
-    s.choice("law", "control law", &LAWS)?;
-    let law = Law::FeedbackLinearization; // the only entry of LAWS
+    s.check_keys(None, "in [controller]")?;
+    s.choice("law", "control law")?;
+    let law = Law::FeedbackLinearization; // the only value of controller.law
     let gains = parse_gains(s)?;
-    let sample_period = s.num("sample_period", Bound::Positive, "s")?;
+    let sample_period = s.req("sample_period")?;
     let floats = parse_floats(s)?;
-    let creep_speed = s.opt_num("creep_speed", Bound::Positive, "m/s")?;
+    let creep_speed = s.opt("creep_speed")?;
     Ok(Controller {
         law,
         gains,
@@ -448,8 +357,8 @@ fn parse_controller(s: &Sect) -> Res<Controller> {
 /// `float`: optional, default both; sorted, no duplicates.
 fn parse_floats(s: &Sect) -> Res<Vec<FloatType>> {
     let mut floats: Vec<FloatType> = s
-        .names("float", "float type", &FLOATS, "at least one float type")?
-        .unwrap_or(FLOATS.to_vec())
+        .names("float", "float type", "at least one float type")?
+        .unwrap_or(schema::values("controller.float").to_vec())
         .into_iter()
         .map(|f| match f {
             "f32" => FloatType::F32,
@@ -464,14 +373,9 @@ fn parse_floats(s: &Sect) -> Res<Vec<FloatType>> {
 /// `[observer.kalman]`: each sub-section is required exactly when one of its
 /// estimators is listed (and refused otherwise).
 fn parse_observer(s: &Sect, supply: &Supply, core_sect: &Sect, core: &Core) -> Res<Observer> {
-    s.check_keys(&OBSERVER_KEYS, "in [observer]")?;
+    s.check_keys(None, "in [observer]")?;
     let estimators: Vec<Estimator> = s
-        .names(
-            "estimators",
-            "estimator",
-            &ESTIMATORS,
-            "at least one estimator",
-        )?
+        .names("estimators", "estimator", "at least one estimator")?
         .ok_or_else(|| {
             s.missing(
                 "estimators",
@@ -486,10 +390,10 @@ fn parse_observer(s: &Sect, supply: &Supply, core_sect: &Sect, core: &Core) -> R
             _ => Estimator::Ukf,
         })
         .collect();
-    let sample_period = s.num("sample_period", Bound::Positive, "s")?;
+    let sample_period = s.req("sample_period")?;
     let floats = parse_floats(s)?;
-    let voltage_noise = s.num("voltage_noise", Bound::Positive, "V")?;
-    let current_noise = s.num("current_noise", Bound::Positive, "A")?;
+    let voltage_noise = s.req("voltage_noise")?;
+    let current_noise = s.req("current_noise")?;
     let has = |e: Estimator| estimators.contains(&e);
     let semera = s
         .sub_section(
@@ -532,25 +436,25 @@ fn parse_observer(s: &Sect, supply: &Supply, core_sect: &Sect, core: &Core) -> R
 
 /// `[observer.semera]`: semera Table II / Table V.
 fn parse_semera(s: &Sect) -> Res<SemeraSettings> {
-    s.check_keys(&SEMERA_KEYS, "in [observer.semera]")?;
+    s.check_keys(None, "in [observer.semera]")?;
     Ok(SemeraSettings {
-        initial_resistance: s.num("initial_resistance", Bound::Positive, "Ω")?,
-        initial_resistance_std: s.num("initial_resistance_std", Bound::Positive, "Ω")?,
-        initial_inductance: s.num("initial_inductance", Bound::Positive, "H")?,
-        initial_inductance_std: s.num("initial_inductance_std", Bound::Positive, "H")?,
-        resistance_rate_std: s.num("resistance_rate_std", Bound::NonNegative, "Ω/s")?,
-        inductance_accel_std: s.num("inductance_accel_std", Bound::NonNegative, "H/s²")?,
-        ci_sigmas: s.num("ci_sigmas", Bound::Positive, "-")?,
+        initial_resistance: s.req("initial_resistance")?,
+        initial_resistance_std: s.req("initial_resistance_std")?,
+        initial_inductance: s.req("initial_inductance")?,
+        initial_inductance_std: s.req("initial_inductance_std")?,
+        resistance_rate_std: s.req("resistance_rate_std")?,
+        inductance_accel_std: s.req("inductance_accel_std")?,
+        ci_sigmas: s.req("ci_sigmas")?,
     })
 }
 
 /// `[observer.integral]`: what semera Algorithm 2 needs.
 fn parse_integral(s: &Sect, supply: &Supply) -> Res<IntegralSettings> {
-    s.check_keys(&INTEGRAL_KEYS, "in [observer.integral]")?;
-    let initial_resistance = s.num("initial_resistance", Bound::Positive, "Ω")?;
-    let initial_inductance = s.num("initial_inductance", Bound::Positive, "H")?;
-    let initial_flux_linkage = s.num_or("initial_flux_linkage", Bound::Any, "Wb", 0.0)?;
-    let ci_sigmas = s.num("ci_sigmas", Bound::Positive, "-")?;
+    s.check_keys(None, "in [observer.integral]")?;
+    let initial_resistance = s.req("initial_resistance")?;
+    let initial_inductance = s.req("initial_inductance")?;
+    let initial_flux_linkage = s.or_default("initial_flux_linkage")?;
+    let ci_sigmas = s.req("ci_sigmas")?;
     let default_threshold =
         (supply.drive == Drive::Voltage && supply.u_max > 0.0).then_some(0.5 * supply.u_max);
     let energize_threshold = match default_threshold {
@@ -578,9 +482,9 @@ fn parse_integral(s: &Sect, supply: &Supply) -> Res<IntegralSettings> {
 /// `[observer.kalman]`: `process_hc` and `initial_hc_std` exist exactly with a
 /// Jiles–Atherton core (whose state has H_c).
 fn parse_kalman(s: &Sect, core_sect: &Sect, core: &Core) -> Res<KalmanSection> {
-    s.check_keys(&KALMAN_KEYS, "in [observer.kalman]")?;
-    let process_z = s.num("process_z", Bound::Positive, "m")?;
-    let process_phi = s.num("process_phi", Bound::Positive, "Wb")?;
+    s.check_keys(None, "in [observer.kalman]")?;
+    let process_z = s.req("process_z")?;
+    let process_phi = s.req("process_phi")?;
     let ja = matches!(core, Core::JilesAtherton(_));
     let hc = |key: &str| -> Res<Option<f64>> {
         if ja {
@@ -604,8 +508,8 @@ fn parse_kalman(s: &Sect, core_sect: &Sect, core: &Core) -> Res<KalmanSection> {
         Ok(None)
     };
     let process_hc = hc("process_hc")?;
-    let initial_z_std = s.num("initial_z_std", Bound::Positive, "m")?;
-    let initial_phi_std = s.num("initial_phi_std", Bound::Positive, "Wb")?;
+    let initial_z_std = s.req("initial_z_std")?;
+    let initial_phi_std = s.req("initial_phi_std")?;
     let initial_hc_std = hc("initial_hc_std")?;
     let resistance = parse_resistance_estimate(s, ja)?;
     Ok(KalmanSection {
@@ -615,9 +519,9 @@ fn parse_kalman(s: &Sect, core_sect: &Sect, core: &Core) -> Res<KalmanSection> {
         initial_z_std,
         initial_phi_std,
         initial_hc_std,
-        ukf_alpha: s.num_or("ukf_alpha", Bound::UnitLeftOpen, "-", 1.0)?,
-        ukf_beta: s.num_or("ukf_beta", Bound::NonNegative, "-", 2.0)?,
-        ukf_kappa: s.num_or("ukf_kappa", Bound::Any, "-", 0.0)?,
+        ukf_alpha: s.or_default("ukf_alpha")?,
+        ukf_beta: s.or_default("ukf_beta")?,
+        ukf_kappa: s.or_default("ukf_kappa")?,
         resistance,
     })
 }
@@ -653,15 +557,15 @@ fn parse_resistance_estimate(s: &Sect, ja: bool) -> Res<Option<ResistanceEstimat
         return Err(s.err(KEY, msg, "too many states"));
     }
     Ok(Some(ResistanceEstimate {
-        rate_std: s.num(keys[0], Bound::Positive, "Ω/s")?,
-        initial_std: s.num(keys[1], Bound::Positive, "Ω")?,
+        rate_std: s.req(keys[0])?,
+        initial_std: s.req(keys[1])?,
     }))
 }
 
 /// K of eq. 48: exactly one of `settling_time` and `poles`.
 fn parse_gains(s: &Sect) -> Res<Gains> {
-    let settling = s.opt_num("settling_time", Bound::Positive, "s")?;
-    let poles = s.opt_array("poles", Bound::Negative, "1/s")?;
+    let settling = s.opt("settling_time")?;
+    let poles = s.opt_numbers("poles")?;
     match (settling, poles) {
         (Some(t), None) => Ok(Gains::SettlingTime(t)),
         (None, Some(p)) => match <[f64; 3]>::try_from(p.as_slice()) {
@@ -852,6 +756,23 @@ enum Bound {
 }
 
 impl Bound {
+    /// The parser's bound for a schema domain; `lower` is the value of the
+    /// key an `Above` domain names.
+    fn of(domain: schema::Domain, lower: f64) -> Bound {
+        match domain {
+            schema::Domain::Any => Bound::Any,
+            schema::Domain::Positive => Bound::Positive,
+            schema::Domain::Negative => Bound::Negative,
+            schema::Domain::NonNegative => Bound::NonNegative,
+            schema::Domain::Unit => Bound::Unit,
+            schema::Domain::UnitOpen => Bound::UnitOpen,
+            schema::Domain::UnitLeftOpen => Bound::UnitLeftOpen,
+            schema::Domain::Above(other) => {
+                Bound::Above(other.rsplit_once('.').map_or(other, |(_, k)| k), lower)
+            }
+        }
+    }
+
     fn admits(self, x: f64) -> bool {
         match self {
             Bound::Any => true,
@@ -1067,7 +988,7 @@ impl<'a> Sect<'a> {
             }
             let msg = format!(
                 "missing required section [{full}]: {}.estimators lists {needed_by}, which \
-                 needs its parameters (see the README)",
+                 needs its parameters (see docs/reference/description.md)",
                 self.name
             );
             return Err(self
@@ -1104,13 +1025,8 @@ impl<'a> Sect<'a> {
 
     /// An optional, non-empty array of distinct strings among `allowed`, in
     /// the order given.
-    fn names(
-        &self,
-        key: &str,
-        what: &str,
-        allowed: &[&'static str],
-        at_least: &str,
-    ) -> Res<Option<Vec<&'static str>>> {
+    fn names(&self, key: &str, what: &str, at_least: &str) -> Res<Option<Vec<&'static str>>> {
+        let allowed = schema::values(&self.full_key(key));
         let Some((_, value)) = self.entry(key) else {
             return Ok(None);
         };
@@ -1156,8 +1072,10 @@ impl<'a> Sect<'a> {
         Ok(Some(out))
     }
 
-    /// Rejects keys not in `allowed`, reporting the first in document order.
-    fn check_keys(&self, allowed: &[&str], context: &str) -> Res<()> {
+    /// Rejects keys the schema does not allow in this section (with its
+    /// `model` = `variant`), reporting the first in document order.
+    fn check_keys(&self, variant: Option<&str>, context: &str) -> Res<()> {
+        let allowed = schema::keys_of(self.name, variant);
         let unknown = self
             .table
             .iter()
@@ -1172,10 +1090,65 @@ impl<'a> Sect<'a> {
         );
         let full = self.full_key(key.get_ref());
         let err = self.ctx.err(full, key.span(), msg, "unknown key");
-        match closest(key.get_ref(), allowed) {
+        match closest(key.get_ref(), &allowed) {
             Some(near) => Err(err.with_help(format!("did you mean `{near}`?"))),
             None => Err(err),
         }
+    }
+
+    /// The schema's entry for `key` of this section.
+    fn spec(&self, key: &str) -> &'static schema::Key {
+        schema::key(&self.full_key(key))
+    }
+
+    /// The schema's bound of `key` (an `Above` bound needs its value: see
+    /// [`Sect::req_above`]).
+    fn bound(&self, key: &str) -> Bound {
+        Bound::of(self.spec(key).domain, f64::NEG_INFINITY)
+    }
+
+    /// An optional number, with the schema's bound and unit.
+    fn opt(&self, key: &str) -> Res<Option<f64>> {
+        self.opt_num(key, self.bound(key), self.spec(key).unit)
+    }
+
+    /// A required number, with the schema's bound and unit.
+    fn req(&self, key: &str) -> Res<f64> {
+        self.num(key, self.bound(key), self.spec(key).unit)
+    }
+
+    /// A required number in `unit` (where the unit follows `supply.drive`).
+    fn req_in(&self, key: &str, unit: &str) -> Res<f64> {
+        self.num(key, self.bound(key), unit)
+    }
+
+    /// A required number above `lower`, the value of the key the schema's
+    /// `Above` bound names.
+    fn req_above(&self, key: &str, lower: f64) -> Res<f64> {
+        self.req_above_in(key, lower, self.spec(key).unit)
+    }
+
+    fn req_above_in(&self, key: &str, lower: f64, unit: &str) -> Res<f64> {
+        self.num(key, Bound::of(self.spec(key).domain, lower), unit)
+    }
+
+    /// An optional number with the schema's default.
+    fn or_default(&self, key: &str) -> Res<f64> {
+        let spec = self.spec(key);
+        let schema::Presence::Default(default) = spec.presence else {
+            unreachable!("`{}` has no default in the schema", spec.path);
+        };
+        self.num_or(key, self.bound(key), spec.unit, default)
+    }
+
+    /// A required array of numbers, with the schema's bound and unit.
+    fn req_array(&self, key: &str) -> Res<Vec<f64>> {
+        self.array(key, self.bound(key), self.spec(key).unit)
+    }
+
+    /// An optional array of numbers, with the schema's bound and unit.
+    fn opt_numbers(&self, key: &str) -> Res<Option<Vec<f64>>> {
+        self.opt_array(key, self.bound(key), self.spec(key).unit)
     }
 
     fn opt_num(&self, key: &str, bound: Bound, unit: &str) -> Res<Option<f64>> {
@@ -1196,7 +1169,8 @@ impl<'a> Sect<'a> {
     }
 
     /// A required string among `allowed`.
-    fn choice(&self, key: &str, what: &str, allowed: &[&'static str]) -> Res<&'static str> {
+    fn choice(&self, key: &str, what: &str) -> Res<&'static str> {
+        let allowed = schema::values(&self.full_key(key));
         let list = quoted_list(allowed);
         let Some((_, value)) = self.entry(key) else {
             return Err(self.missing(key, &format!("one of {list}")));

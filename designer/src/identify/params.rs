@@ -4,48 +4,13 @@
 //!
 //! Only the keys of the description's current model variants exist: `core.b`
 //! needs `core.model = "jiles-atherton"`, `gap.k1` needs `"mclyman-fit"`.
-//! Values are checked against the same domains the parser enforces (mass > 0,
-//! c in [0, 1), …) so a fit never builds a model the parser would reject.
+//! The keys and their domains are the description schema's
+//! (`description::schema`), the ones the parser enforces (mass > 0,
+//! c in [0, 1), …), so a fit never builds a model the parser would reject.
 
-use crate::description::{Core, Description, Gap};
+use crate::description::{schema, Core, Description, Gap};
 
-/// What a parameter's value must satisfy.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Domain {
-    /// Any finite number.
-    Any,
-    /// > 0
-    Positive,
-    /// ≥ 0
-    NonNegative,
-    /// In [0, 1].
-    Unit,
-    /// In [0, 1).
-    UnitOpen,
-}
-
-impl Domain {
-    pub fn contains(self, x: f64) -> bool {
-        x.is_finite()
-            && match self {
-                Domain::Any => true,
-                Domain::Positive => x > 0.0,
-                Domain::NonNegative => x >= 0.0,
-                Domain::Unit => (0.0..=1.0).contains(&x),
-                Domain::UnitOpen => (0.0..1.0).contains(&x),
-            }
-    }
-
-    fn text(self) -> &'static str {
-        match self {
-            Domain::Any => "a finite number",
-            Domain::Positive => "a number > 0",
-            Domain::NonNegative => "a number >= 0",
-            Domain::Unit => "a number in [0, 1]",
-            Domain::UnitOpen => "a number in [0, 1)",
-        }
-    }
-}
+pub use crate::description::schema::Domain;
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamError {
@@ -59,65 +24,23 @@ pub enum ParamError {
     OutOfDomain {
         path: String,
         value: f64,
-        expected: &'static str,
+        expected: String,
     },
 }
 
-const COIL: [(&str, Domain); 4] = [
-    ("coil.turns", Domain::Positive),
-    ("coil.resistance", Domain::Positive),
-    ("coil.eddy", Domain::NonNegative),
-    ("coil.resistance_drift", Domain::Any),
-];
-const MECHANICS: [(&str, Domain); 6] = [
-    ("mechanics.mass", Domain::Positive),
-    ("mechanics.stiffness", Domain::NonNegative),
-    ("mechanics.damping", Domain::NonNegative),
-    ("mechanics.preload", Domain::Any),
-    ("mechanics.restitution", Domain::Unit),
-    ("mechanics.bounce_threshold", Domain::NonNegative),
-];
-const GAP_LINEAR: [(&str, Domain); 2] =
-    [("gap.slope", Domain::Positive), ("gap.offset", Domain::Any)];
-const GAP_MCLYMAN: [(&str, Domain); 2] = [
-    ("gap.area", Domain::Positive),
-    ("gap.winding_length", Domain::Positive),
-];
-const GAP_FIT: [(&str, Domain); 4] = [
-    ("gap.r0", Domain::NonNegative),
-    ("gap.r0_prime", Domain::Positive),
-    ("gap.k1", Domain::NonNegative),
-    ("gap.k2", Domain::Positive),
-];
-const CORE_LINEAR: [(&str, Domain); 1] = [("core.r0", Domain::Positive)];
-const CORE_SATURATING: [(&str, Domain); 2] = [
-    ("core.r0", Domain::Positive),
-    ("core.phi_sat", Domain::Positive),
-];
-const CORE_JA: [(&str, Domain); 7] = [
-    ("core.length", Domain::Positive),
-    ("core.area", Domain::Positive),
-    ("core.m_sat", Domain::Positive),
-    ("core.b", Domain::Positive),
-    ("core.c", Domain::UnitOpen),
-    ("core.kappa", Domain::Positive),
-    ("core.alpha", Domain::NonNegative),
-];
-
-/// The parameters of `d`'s model variants, with their domains.
+/// The parameters of `d`'s model variants, with their domains: the schema's
+/// fittable keys of the physics sections.
 pub fn table(d: &Description) -> Vec<(&'static str, Domain)> {
-    let gap: &[(&str, Domain)] = match d.gap {
-        Gap::Linear { .. } => &GAP_LINEAR,
-        Gap::McLyman { .. } => &GAP_MCLYMAN,
-        Gap::McLymanFit { .. } => &GAP_FIT,
-        Gap::Table { .. } => &[],
-    };
-    let core: &[(&str, Domain)] = match d.core {
-        Core::Linear { .. } => &CORE_LINEAR,
-        Core::Saturating { .. } => &CORE_SATURATING,
-        Core::JilesAtherton(_) => &CORE_JA,
-    };
-    [&COIL[..], gap, core, &MECHANICS[..]].concat()
+    schema::KEYS
+        .iter()
+        .filter(|k| k.fittable)
+        .filter(|k| match k.section() {
+            "gap" => k.in_variant(Some(gap_model(d))),
+            "core" => k.in_variant(Some(core_model(d))),
+            _ => true,
+        })
+        .map(|k| (k.path, k.domain))
+        .collect()
 }
 
 /// The paths valid for `d`'s model variants.
@@ -168,18 +91,27 @@ fn unknown(d: &Description, path: &str) -> ParamError {
 
 /// "gap.model = "…", core.model = "…"" for messages.
 fn model_name(d: &Description) -> String {
-    let gap = match d.gap {
+    let (gap, core) = (gap_model(d), core_model(d));
+    format!("the model with gap.model = \"{gap}\" and core.model = \"{core}\"")
+}
+
+/// `gap.model` of `d`.
+fn gap_model(d: &Description) -> &'static str {
+    match d.gap {
         Gap::Linear { .. } => "linear",
         Gap::McLyman { .. } => "mclyman",
         Gap::McLymanFit { .. } => "mclyman-fit",
         Gap::Table { .. } => "table",
-    };
-    let core = match d.core {
+    }
+}
+
+/// `core.model` of `d`.
+fn core_model(d: &Description) -> &'static str {
+    match d.core {
         Core::Linear { .. } => "linear",
         Core::Saturating { .. } => "saturating",
         Core::JilesAtherton(_) => "jiles-atherton",
-    };
-    format!("the model with gap.model = \"{gap}\" and core.model = \"{core}\"")
+    }
 }
 
 /// The field behind `path`, for the description's current variants.

@@ -22,12 +22,12 @@ pub const LANGEVIN_SERIES_BELOW: f64 = 0.1;
 pub fn mmf(g: &mut Graph, params: &mut Params, core: &Core, phi: Id, hc: Option<Id>) -> Id {
     match core {
         Core::Linear { r0 } => {
-            let r0 = params.add(g, "R_core0", *r0);
+            let r0 = params.key(g, "core.r0", *r0);
             g.mul(r0, phi)
         }
         Core::Saturating { r0, phi_sat } => {
-            let r0 = params.add(g, "R_core0", *r0);
-            let ps = params.add(g, "phi_sat", *phi_sat);
+            let r0 = params.key(g, "core.r0", *r0);
+            let ps = params.key(g, "core.phi_sat", *phi_sat);
             // (7) R_core = R_core0 / (1 − |φ|/φ_sat)
             let abs = g.abs(phi);
             let frac = g.div(abs, ps);
@@ -38,7 +38,7 @@ pub fn mmf(g: &mut Graph, params: &mut Params, core: &Core, phi: Id, hc: Option<
         }
         Core::JilesAtherton(ja) => {
             let hc = hc.expect("the Jiles–Atherton core has the state H_c");
-            let lc = params.add(g, "l_c", ja.length);
+            let lc = params.key(g, "core.length", ja.length);
             // (15) ∫_core H dl = H_c·l_c
             g.mul(hc, lc)
         }
@@ -144,13 +144,13 @@ pub fn ja_field_rate(
     hc: Id,
     phi_dot: Id,
 ) -> Id {
-    let ac = params.add(g, "A_c", ja.area);
-    let m_sat = params.add(g, "M_sat", ja.m_sat);
-    let b = params.add(g, "b_ja", ja.b);
-    let c = params.add(g, "c_ja", ja.c);
-    let kappa = params.add(g, "kappa_ja", ja.kappa);
-    let alpha = params.add(g, "alpha_ja", ja.alpha);
-    let eps = params.add(g, "eps_ja", ja.epsilon);
+    let ac = params.key(g, "core.area", ja.area);
+    let m_sat = params.key(g, "core.m_sat", ja.m_sat);
+    let b = params.key(g, "core.b", ja.b);
+    let c = params.key(g, "core.c", ja.c);
+    let kappa = params.key(g, "core.kappa", ja.kappa);
+    let alpha = params.key(g, "core.alpha", ja.alpha);
+    let eps = params.key(g, "core.epsilon", ja.epsilon);
     let mu0 = g.constant(MU0);
     let one = g.one();
     // (32) B_c = φ/A_c, M_c = B_c/μ0 − H_c

@@ -34,8 +34,8 @@ pub const Z_EPS: f64 = 1e-9;
 pub fn reluctance(g: &mut Graph, params: &mut Params, gap: &Gap, z: Id) -> Id {
     match gap {
         Gap::Linear { slope, offset } => {
-            let k = params.add(g, "k_gap", *slope);
-            let r0 = params.add(g, "R_gap0", *offset);
+            let k = params.key(g, "gap.slope", *slope);
+            let r0 = params.key(g, "gap.offset", *offset);
             let kz = g.mul(k, z);
             g.add(r0, kz)
         }
@@ -63,8 +63,8 @@ fn fringing_log(g: &mut Graph, k: Id, z: Id) -> Id {
 
 /// (6): R_gap = (z/(μ0·A)) / (1 + z/√A · ln(2·l_w/z)).
 fn mclyman(g: &mut Graph, params: &mut Params, area: f64, winding_length: f64, z: Id) -> Id {
-    let a = params.add(g, "A_gap", area);
-    let lw = params.add(g, "l_w", winding_length);
+    let a = params.key(g, "gap.area", area);
+    let lw = params.key(g, "gap.winding_length", winding_length);
     let mu0 = g.constant(MU0);
     let two = g.constant(2.0);
     let two_lw = g.mul(two, lw);
@@ -81,10 +81,10 @@ fn mclyman(g: &mut Graph, params: &mut Params, area: f64, winding_length: f64, z
 
 /// jiles-atherton-actuator-model (11): R_gap = R_g0 + R'_g0·z / (1 + k1·z·ln(k2/z)).
 fn mclyman_fit(g: &mut Graph, params: &mut Params, [r0, r0p, k1, k2]: [f64; 4], z: Id) -> Id {
-    let r0 = params.add(g, "R_g0", r0);
-    let r0p = params.add(g, "R_g0_prime", r0p);
-    let k1 = params.add(g, "k1", k1);
-    let k2 = params.add(g, "k2", k2);
+    let r0 = params.key(g, "gap.r0", r0);
+    let r0p = params.key(g, "gap.r0_prime", r0p);
+    let k1 = params.key(g, "gap.k1", k1);
+    let k2 = params.key(g, "gap.k2", k2);
     let log = fringing_log(g, k2, z);
     let k1z = g.mul(k1, z);
     let fringe = g.mul(k1z, log);

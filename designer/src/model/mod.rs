@@ -107,11 +107,11 @@ impl Model {
         let mmf = g.add(gap_mmf, mmf_core);
 
         let coil = &description.coil;
-        let n = params.add(&mut g, "N", coil.turns);
-        let r_nominal = params.add(&mut g, "R", coil.resistance);
-        let k_e = params.add(&mut g, "k_e", coil.eddy);
+        let n = params.key(&mut g, "coil.turns", coil.turns);
+        let r_nominal = params.key(&mut g, "coil.resistance", coil.resistance);
+        let k_e = params.key(&mut g, "coil.eddy", coil.eddy);
         let resistance = if coil.resistance_drift != 0.0 {
-            let drift = params.add(&mut g, "R_drift", coil.resistance_drift);
+            let drift = params.key(&mut g, "coil.resistance_drift", coil.resistance_drift);
             let dr = g.mul(drift, t);
             g.add(r_nominal, dr)
         } else {
@@ -125,10 +125,10 @@ impl Model {
         );
 
         let m = &description.mechanics;
-        let mass = params.add(&mut g, "m", m.mass);
-        let k_s = params.add(&mut g, "k_s", m.stiffness);
-        let damping = params.add(&mut g, "c", m.damping);
-        let f0 = params.add(&mut g, "F0", m.preload);
+        let mass = params.key(&mut g, "mechanics.mass", m.mass);
+        let k_s = params.key(&mut g, "mechanics.stiffness", m.stiffness);
+        let damping = params.key(&mut g, "mechanics.damping", m.damping);
+        let f0 = params.key(&mut g, "mechanics.preload", m.preload);
         // (10) F(z, v) = k_s·z + c·v + F0
         let ksz = g.mul(k_s, z);
         let cv = g.mul(damping, v);

@@ -4,6 +4,7 @@
 
 use std::collections::HashMap;
 
+use crate::description::schema;
 use crate::sym::{Graph, Id};
 
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -20,6 +21,16 @@ impl Params {
             None => self.entries.push((name.to_owned(), id, value)),
         }
         id
+    }
+
+    /// Registers the description key `path` (`coil.resistance`) under its
+    /// schema symbol (`R`) with `value` and returns the symbol.
+    pub fn key(&mut self, g: &mut Graph, path: &str, value: f64) -> Id {
+        let key = schema::key(path);
+        let symbol = key
+            .symbol
+            .unwrap_or_else(|| unreachable!("`{path}` is not a model parameter in the schema"));
+        self.add(g, symbol, value)
     }
 
     pub fn iter(&self) -> impl Iterator<Item = (&str, Id, f64)> {

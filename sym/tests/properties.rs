@@ -5,8 +5,8 @@
 //! - `factor_sums` (common factors out of sums) keeps the values of an
 //!   expression and of its derivatives, where sums share the most factors.
 
-use designer::sym::{Graph, Id, Tape};
 use proptest::prelude::*;
+use reldesign_sym::{Graph, Id, Tape};
 
 /// A random expression in x and y, evaluated two ways: directly in f64 and
 /// through the graph. Every operation is smooth and defined on all of R².

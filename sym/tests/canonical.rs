@@ -1,6 +1,6 @@
 //! Canonical forms, piecewise nodes and deterministic printing of the symbolic core.
 
-use designer::sym::{Graph, Id, Tape};
+use reldesign_sym::{Graph, Id, Tape};
 
 fn xyz(g: &mut Graph) -> (Id, Id, Id) {
     (g.symbol("x"), g.symbol("y"), g.symbol("z"))

@@ -3,7 +3,9 @@
 //! and compilation to a flat f64 tape.
 //!
 //! It knows nothing of actuators: symbols are just names. Models, controllers
-//! and observers are built on top of it (see `crate::model`).
+//! and observers are built on top of it (`reldesign-designer`'s `model`). It
+//! is its own crate so that the compiler holds that invariant: it depends on
+//! nothing of reldesign.
 //!
 //! | file | concept |
 //! | --- | --- |
