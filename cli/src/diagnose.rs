@@ -12,12 +12,12 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use designer::description::edit::{annotate, write_physics};
 use designer::description::Description;
-use designer::diagnose::localise::{localise, Localisation, Signals};
-use designer::diagnose::{diagnose, Cause, Diagnosis, FittedParameter, Options};
-use designer::identify::{flux_from_data, Measured, SimOutputs};
 use miette::Report;
+use reldesign_identify::diagnose::localise::{localise, Localisation, Signals};
+use reldesign_identify::diagnose::{diagnose, Cause, Diagnosis, FittedParameter, Options};
+use reldesign_identify::edit::{annotate, write_physics};
+use reldesign_identify::{flux_from_data, Measured, SimOutputs};
 use serde_json::{json, Value};
 
 use crate::{diagnose_plot, fail};
@@ -155,9 +155,9 @@ fn signals<'a>(
 /// Where the baseline's current error concentrates.
 fn localisation(d: &Diagnosis, data: &Measured) -> Localisation {
     let replay = &d.baseline_replay;
-    let moving = designer::diagnose::moving(replay);
+    let moving = reldesign_identify::diagnose::moving(replay);
     let m = &d.extended.mechanics;
-    let impacts = designer::diagnose::impacts(replay, m.z_min, m.z_max);
+    let impacts = reldesign_identify::diagnose::impacts(replay, m.z_min, m.z_max);
     localise(&signals(d, data, replay, &moving, &impacts))
 }
 

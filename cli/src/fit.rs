@@ -14,13 +14,14 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use designer::description::{edit::write_physics, Description};
-use designer::identify::em_fit::{FitProgress, FitReport, Sensitivities};
-use designer::identify::gap_fit::{fit_gap, GapFit, GapModel, GapTable};
-use designer::identify::params::{self, Domain};
-use designer::identify::{current_wnrmse, fit, FitOptions, FitParam, Measured};
+use designer::description::Description;
 use designer::record::Record;
 use miette::Report;
+use reldesign_identify::edit::write_physics;
+use reldesign_identify::em_fit::{FitProgress, FitReport, Sensitivities};
+use reldesign_identify::gap_fit::{fit_gap, GapFit, GapModel, GapTable};
+use reldesign_identify::params::{self, Domain};
+use reldesign_identify::{current_wnrmse, fit, FitOptions, FitParam, Measured};
 use serde_json::{json, Value};
 
 use crate::fail;

@@ -8,10 +8,11 @@ use std::fmt::Write;
 use std::path::PathBuf;
 
 use designer::description::{Description, Drive};
-use designer::design::{device_limits, LimitsJob, Linearization, MotionLimits};
+use designer::design::{motion_limits, Linearization, MotionLimits, OptimalError};
 use designer::model::Model;
 use miette::Report;
 use plotters::prelude::*;
+use rayon::prelude::*;
 
 use crate::{atomic, fail};
 
@@ -254,4 +255,23 @@ fn plot(ops: &[Operation], d: &Description) -> Result<String, String> {
         root.present().map_err(e)?;
     }
     Ok(out)
+}
+
+/// One motion to find the limits of: (z₀, z_f, (u_min, u_max)).
+type LimitsJob = (f64, f64, (f64, f64));
+
+/// [`motion_limits`] of several motions in parallel (one model each).
+fn device_limits(
+    description: &Description,
+    jobs: &[LimitsJob],
+    start: f64,
+) -> Vec<Result<MotionLimits, OptimalError>> {
+    jobs.par_iter()
+        .map(|&(z0, zf, bounds)| {
+            let mut model = Model::build(description);
+            let lin = Linearization::derive(&mut model)
+                .map_err(|e| OptimalError::InvalidSpec(e.to_string()))?;
+            motion_limits(&mut model, &lin, z0, zf, bounds, start)
+        })
+        .collect()
 }

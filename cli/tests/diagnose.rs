@@ -19,7 +19,7 @@ use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use designer::description::{parse_file, parse_str, Core, Description};
-use designer::diagnose::Cause;
+use reldesign_identify::diagnose::Cause;
 use reldesign_tests::hidden::{baseline, hidden_case, write_case, Excitation, HiddenCase};
 use serde_json::Value;
 

@@ -6,8 +6,6 @@
 //! - [`design`]: controller derivations (Lie derivatives, feedback linearization).
 //! - [`description`]: the validated actuator description (`valve.toml`).
 //! - [`model`]: the actuator's state-space model, built symbolically.
-//! - [`identify`]: parameters fitted to measured data (`fit`).
-//! - [`diagnose`]: what a model gets wrong on measured data, and why.
 //! - [`observe`]: observers (SEMERA, integral estimator, EKF, UKF).
 //! - [`record`]: recorded signals in the measured-data CSV format.
 //! - [`replay`]: an input replayed through the hybrid model (`simulate`).
@@ -15,8 +13,6 @@
 
 pub mod description;
 pub mod design;
-pub mod diagnose;
-pub mod identify;
 pub mod model;
 pub mod observe;
 pub mod record;

@@ -18,14 +18,14 @@
 
 use std::path::{Path, PathBuf};
 
-use designer::description::edit::write_physics;
 use designer::description::{parse_str, Core, Description, Gap, JilesAtherton};
-use designer::diagnose::Cause;
-use designer::identify::edges::{located, replay_input};
-use designer::identify::wnrmse;
 use designer::model::{Model, Statics, MU0};
 use designer::replay::{replay, Replay};
 use designer::sim::{EventKind, Limit, Options, PiecewiseLinear};
+use reldesign_identify::diagnose::Cause;
+use reldesign_identify::edges::{located, replay_input};
+use reldesign_identify::edit::write_physics;
+use reldesign_identify::wnrmse;
 
 use crate::{root, Rng};
 
@@ -629,7 +629,7 @@ pub fn experiment(
 }
 
 /// The candidates' fitted errors, best first: `cause:wNRMSE%` each.
-pub fn ranking_summary(d: &designer::diagnose::Diagnosis) -> String {
+pub fn ranking_summary(d: &reldesign_identify::diagnose::Diagnosis) -> String {
     d.ranking
         .iter()
         .map(|s| format!("{}:{:.3}%", s.cause, 100.0 * s.wnrmse_fit))
@@ -749,9 +749,9 @@ impl Visibility {
 pub fn visibility(case: &HiddenCase) -> Visibility {
     let record = designer::record::Record::parse(&case.data_csv, "data.csv")
         .unwrap_or_else(|e| panic!("{e}"));
-    let data = designer::identify::Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
+    let data = reldesign_identify::Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
     let base = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
-    let data = designer::identify::Measured {
+    let data = reldesign_identify::Measured {
         edges: Some(located(&base, &data)),
         ..data
     };

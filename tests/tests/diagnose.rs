@@ -12,9 +12,9 @@
 //! runs every cause × actuator × excitation × column combination.
 
 use designer::description::parse_str;
-use designer::diagnose::{diagnose, Cause, Diagnosis, FittedParameter, Options};
-use designer::identify::Measured;
 use designer::record::Record;
+use reldesign_identify::diagnose::{diagnose, Cause, Diagnosis, FittedParameter, Options};
+use reldesign_identify::Measured;
 use reldesign_tests::hidden::{hidden_case, Excitation, HiddenCase};
 
 #[derive(Debug, Clone, Copy)]

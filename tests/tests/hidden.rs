@@ -4,9 +4,9 @@
 //! visible in the current beyond the noise (what the diagnosis needs).
 
 use designer::description::{parse_str, Core, Description, Gap};
-use designer::diagnose::Cause;
 use designer::record::Record;
 use designer::sim::Limit;
+use reldesign_identify::diagnose::Cause;
 use reldesign_tests::example;
 use reldesign_tests::hidden::{
     baseline, experiment, hidden_case, visibility, write_case, Excitation, HiddenCase, Noise,
@@ -166,7 +166,7 @@ fn truth_differs_in_the_chosen_extension_only() {
             assert_only_extension(&base, &truth, cause);
             assert_eq!(c.drawn.is_empty(), cause == Cause::None);
             // The truth is a valid description too.
-            designer::description::edit::write_physics(&c.baseline_toml, file, &c.truth)
+            reldesign_identify::edit::write_physics(&c.baseline_toml, file, &c.truth)
                 .unwrap_or_else(|e| panic!("{file} {cause}: {e}"));
         }
     }

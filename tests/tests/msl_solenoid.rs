@@ -14,10 +14,10 @@
 use std::path::{Path, PathBuf};
 
 use designer::description::{Description, Gap};
-use designer::diagnose::{diagnose, Cause, Options};
-use designer::identify::gap_fit::{fit_gap, GapModel, GapTable};
-use designer::identify::{simulate_outputs, Measured, SimOutputs};
 use designer::record::Record;
+use reldesign_identify::diagnose::{diagnose, Cause, Options};
+use reldesign_identify::gap_fit::{fit_gap, GapModel, GapTable};
+use reldesign_identify::{simulate_outputs, Measured, SimOutputs};
 
 /// Coil current of the quasi-static FEA [A] (12 V on 10 Ω; data README).
 const I_STATIC: f64 = 1.2;

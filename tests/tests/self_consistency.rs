@@ -7,9 +7,9 @@
 //! CI runs a representative part; the whole set is
 //! `cargo test --release -p reldesign-tests --test self_consistency -- --ignored`.
 
-use designer::diagnose::{diagnose, Cause, Diagnosis, Options};
-use designer::identify::Measured;
 use designer::record::Record;
+use reldesign_identify::diagnose::{diagnose, Cause, Diagnosis, Options};
+use reldesign_identify::Measured;
 use reldesign_tests::devices::device;
 use reldesign_tests::hidden::{experiment, Excitation, Noise, Sampling};
 use reldesign_tests::Rng;

@@ -5,7 +5,6 @@
 //! that names the file, the key, the line/column and what was expected.
 //! Everything downstream (model, simulator, designers) reads only these types.
 
-pub mod edit;
 mod error;
 mod parse;
 pub mod schema;

@@ -13,9 +13,6 @@
 //!   (`optimal_search.rs`); beyond, the optimal motion is that arc followed
 //!   by rest, and J grows by u_rest² per second.
 
-use rayon::prelude::*;
-
-use crate::description::Description;
 use crate::model::Model;
 use crate::sym::Tape;
 
@@ -66,25 +63,6 @@ const CURVE_STEP: f64 = 1.15;
 /// Collocation tolerance of the curve's arcs (J to ~1e-6 relative).
 const CURVE_TOL: f64 = 1e-5;
 const CURVE_SPAN: f64 = 5.0;
-
-/// One motion to find the limits of: (z₀, z_f, (u_min, u_max)).
-pub type LimitsJob = (f64, f64, (f64, f64));
-
-/// [`motion_limits`] of several motions in parallel (one model each).
-pub fn device_limits(
-    description: &Description,
-    jobs: &[LimitsJob],
-    start: f64,
-) -> Vec<Result<MotionLimits, OptimalError>> {
-    jobs.par_iter()
-        .map(|&(z0, zf, bounds)| {
-            let mut model = Model::build(description);
-            let lin = Linearization::derive(&mut model)
-                .map_err(|e| OptimalError::InvalidSpec(e.to_string()))?;
-            motion_limits(&mut model, &lin, z0, zf, bounds, start)
-        })
-        .collect()
-}
 
 /// The limits of the motion z0 → zf within `bounds`; `start` is a motion
 /// time to begin the search from (e.g. the description's t_f − t₀).

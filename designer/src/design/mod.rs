@@ -34,7 +34,7 @@ pub use fit_segments::{
     Signals, TableErrors, ACCEPT,
 };
 pub use lie::{lie, vanishing_factors, AffineSystem, OutputDerivatives};
-pub use limits::{device_limits, motion_limits, CostPoint, LimitsJob, MotionLimits};
+pub use limits::{motion_limits, CostPoint, MotionLimits};
 pub use linearization::{DesignError, Linearization};
 pub use optimal::{
     energy_optimal, CostateGuess, HamiltonianSystem, OptimalError, OptimalSpec, OptimalTrajectory,

@@ -18,6 +18,7 @@
 
 mod hybrid;
 mod input;
+mod locate;
 mod rk;
 mod sampled;
 mod switching;

@@ -35,8 +35,8 @@
 // `!(a >= b)` comparisons are deliberate: they also catch NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use super::hybrid::locate;
 use super::input::Affine;
+use super::locate::locate;
 use super::{Branches, Plant, State, MAX_SWITCHES};
 
 /// Consecutive quick switches after which locking is dropped (see the module docs).

@@ -5,12 +5,12 @@
 use std::path::Path;
 
 use designer::description::{parse_file, Description};
-use designer::identify::edges::replay_input;
-use designer::identify::sensitivity::{check, forward, OutputSensitivities};
-use designer::identify::{params, Measured};
 use designer::model::Model;
 use designer::replay::{replay, Replay};
 use designer::sim::{EventKind, Options, PiecewiseLinear};
+use reldesign_identify::edges::replay_input;
+use reldesign_identify::sensitivity::{check, forward, OutputSensitivities};
+use reldesign_identify::{params, Measured};
 
 const PATHS: [&str; 5] = [
     "coil.resistance",

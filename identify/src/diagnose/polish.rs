@@ -20,7 +20,7 @@
 
 use super::candidate::Candidate;
 use super::{rank, Cause};
-use crate::identify::{self, FitOptions, FitReport, Measured};
+use crate::{FitOptions, FitReport, Measured};
 
 /// Rounds of (place the edges with the model, fit the model on them).
 const ROUNDS: usize = 3;
@@ -41,7 +41,7 @@ pub(super) fn with_edges(
     let mut own = data.clone();
     for _ in 0..ROUNDS {
         let current = named.as_ref().unwrap_or(fit);
-        own.edges = Some(identify::edges::located(&current.description, data));
+        own.edges = Some(crate::edges::located(&current.description, data));
         match polish(candidate, current, &own.head(fitted_samples), options) {
             Some(p) => named = Some(p),
             None => break,
@@ -78,7 +78,7 @@ fn polish(
         max_steps_per_sample: STEPS_PER_SAMPLE,
         ..options.clone()
     };
-    identify::fit(&fit.description, own, &c.params, &options, &|_| {})
+    crate::fit(&fit.description, own, &c.params, &options, &|_| {})
         .ok()
         .filter(|p| p.wnrmse_current.is_finite())
 }
@@ -99,7 +99,7 @@ pub(super) fn propagated_variances(
 ) -> Option<Vec<f64>> {
     let c = candidate?;
     let d = &named.description;
-    let (jacobian, r0) = identify::linearisation(d, own, &c.params, options).ok()?;
+    let (jacobian, r0) = crate::linearisation(d, own, &c.params, options).ok()?;
     let pinv = jacobian.pseudo_inverse(1e-12).ok()?;
     let (sigma_v, sigma_i) = (rank::noise_std(&own.v), rank::noise_std(&own.i));
     let mut sum = vec![0.0; pinv.nrows()];
@@ -114,10 +114,10 @@ pub(super) fn propagated_variances(
         };
         let perturbed = Measured {
             v,
-            edges: Some(identify::edges::located(d, &noisy)),
+            edges: Some(crate::edges::located(d, &noisy)),
             ..own.clone()
         };
-        let r = identify::residuals_at(d, &perturbed, &c.params, options).ok()?;
+        let r = crate::residuals_at(d, &perturbed, &c.params, options).ok()?;
         if r.len() != r0.len() {
             return None;
         }

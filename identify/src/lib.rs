@@ -1,5 +1,11 @@
-//! Identification from measured data (`reldesign fit`): parameters of a
-//! description fitted to a bench recording (jiles-atherton-actuator-model §4–5).
+//! The path back from data: identification (`reldesign fit`: parameters of
+//! a description fitted to a bench recording, jiles-atherton-actuator-model
+//! §4–5), diagnosis (`reldesign diagnose`: what a model gets wrong on
+//! measured data, and why) and the TOML editor that writes results back.
+//!
+//! Its own crate so that what a firmware crate's build script pulls in (the
+//! designer and the code generator) stays small: nalgebra, rayon's fits and
+//! toml_edit live here.
 //!
 //! - [`measured`]: the recording (t, v, i and optional z, φ, λ).
 //! - [`weighted`]: the |φ̇|-weighted NRMSE (81), its weights and the flux
@@ -14,8 +20,15 @@
 //! - [`identifiability`]: what the data can and cannot separate (SVD of the
 //!   scaled Jacobian), and the reduced model's parameters (55), (57), (60).
 //! - [`gap_fit`]: the gap model fitted to a reluctance table (75)–(77).
+//! - [`diagnose`]: the diagnosis of a recording against a description.
+//! - [`edit`]: physics written back over the original TOML text, comments kept.
 
+// The designer's modules, under the names this crate's files use.
+use designer::{description, model, record, replay, sim, sym};
+
+pub mod diagnose;
 pub mod edges;
+pub mod edit;
 pub mod em_fit;
 pub mod gap_fit;
 pub mod identifiability;

@@ -8,8 +8,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use designer::description::{parse_file, Description};
-use designer::identify::gap_fit::{fit_gap, reluctance_and_slope, GapModel, GapTable};
-use designer::identify::{
+use reldesign_identify::gap_fit::{fit_gap, reluctance_and_slope, GapModel, GapTable};
+use reldesign_identify::{
     current_wnrmse, fit, params, reduced_parameters, simulate_outputs, FitOptions, FitParam,
     Measured, Sensitivities,
 };
@@ -274,7 +274,7 @@ fn descriptions_with_the_same_reduced_parameters_give_the_same_current() {
         reduced_parameters(&a).unwrap(),
         reduced_parameters(&b).unwrap(),
     );
-    let fields = |r: designer::identify::ReducedParameters| {
+    let fields = |r: reldesign_identify::ReducedParameters| {
         [
             r.k_e,
             r.r_g0,
@@ -342,7 +342,7 @@ fn the_sensitivity_report_flags_the_over_parameterisation() {
     ];
     let fitted: Vec<FitParam> = paths.iter().map(|p| bounds(&truth, p, 3.0, 3.0)).collect();
     let s =
-        designer::identify::em_fit::sensitivity_at(&truth, &data, &fitted, &FitOptions::default())
+        reldesign_identify::em_fit::sensitivity_at(&truth, &data, &fitted, &FitOptions::default())
             .unwrap();
     eprintln!("{s}");
     assert_eq!(s.weak_directions.len(), 1, "{s}");
@@ -353,7 +353,7 @@ fn the_sensitivity_report_flags_the_over_parameterisation() {
     }
     assert!(s.to_string().contains("cannot separate"));
     // Without A_c the remaining four are separated.
-    let s4 = designer::identify::em_fit::sensitivity_at(
+    let s4 = reldesign_identify::em_fit::sensitivity_at(
         &truth,
         &data,
         &[

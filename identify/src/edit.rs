@@ -13,7 +13,9 @@
 
 use toml_edit::{DocumentMut, Item, TableLike, Value};
 
-use super::{parse_str, schema, Coil, Core, Description, DescriptionError, Gap, Mechanics};
+use crate::description::{
+    parse_str, schema, Coil, Core, Description, DescriptionError, Gap, Mechanics,
+};
 
 /// Why the physics could not be written into a description's text.
 #[derive(Debug, thiserror::Error)]

@@ -7,7 +7,7 @@
 //! `unidentified`), it improves the held-out rest and the whole record, and
 //! the baseline stands clear of the noise floor (current noise, and the
 //! voltage noise the replay passes on). The record's voltage edges are
-//! placed once by the baseline (`identify::edges`); the named cause is then
+//! placed once by the baseline (`crate::edges`); the named cause is then
 //! polished on its own placement ([`polish`]).
 //!
 //! Only the two inputs are read: the description and the recording.
@@ -24,10 +24,8 @@ pub use cause::Cause;
 use rayon::prelude::*;
 
 use crate::description::Description;
-use crate::identify::edges::Edge;
-use crate::identify::{
-    self, flux_rate_weights, wnrmse, FitError, FitOptions, FitReport, Measured, SimOutputs,
-};
+use crate::edges::Edge;
+use crate::{flux_rate_weights, wnrmse, FitError, FitOptions, FitReport, Measured, SimOutputs};
 
 /// Settings of a diagnosis.
 #[derive(Debug, Clone)]
@@ -224,14 +222,14 @@ pub fn diagnose(
         return Err(DiagnoseError::NoExcitation { file });
     }
     // The voltage edges' instants, a nuisance of the record: placed once by
-    // the baseline (identify::edges), then the same for every candidate.
-    let edges = identify::edges::located(baseline, data);
+    // the baseline (crate::edges), then the same for every candidate.
+    let edges = crate::edges::located(baseline, data);
     let data = &Measured {
         edges: Some(edges.clone()),
         ..data.clone()
     };
     let replay_own = |d: &Description, data: &Measured| {
-        identify::simulate_outputs(d, data).map_err(|source| DiagnoseError::Replay {
+        crate::simulate_outputs(d, data).map_err(|source| DiagnoseError::Replay {
             file: file.clone(),
             source,
         })
@@ -448,7 +446,7 @@ fn score(c: &Candidate, data: &Measured, options: &FitOptions, n_eff: f64) -> Sc
         starts: c.starts,
         ..options.clone()
     };
-    let fit = identify::fit(&c.start, data, &c.params, &options, &|_| {});
+    let fit = crate::fit(&c.start, data, &c.params, &options, &|_| {});
     let parameters = c.params.len();
     match fit {
         Ok(report) => {
@@ -676,7 +674,7 @@ impl Diagnosis {
                             .and_then(|v| v.get(j))
                             .map_or(0.0, |v| v.sqrt()),
                     ),
-                baseline: identify::params::get(baseline, path).ok(),
+                baseline: crate::params::get(baseline, path).ok(),
             })
             .collect()
     }

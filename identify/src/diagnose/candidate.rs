@@ -8,8 +8,8 @@
 //! extension with the best the baseline itself can do.
 
 use crate::description::{Core, Description, Gap, JilesAtherton};
-use crate::identify::FitParam;
 use crate::model::MU0;
+use crate::FitParam;
 
 use super::Cause;
 
