@@ -1,5 +1,5 @@
-//! Generates the estimators of `examples/semera-valve.toml` with
-//! `codegen::emit_semera` into `OUT_DIR/semera.rs`, and the bench input
+//! Generates the estimators of `examples/semera-valve.toml` (the file
+//! `reldesign build` emits) into `OUT_DIR/semera.rs`, and the bench input
 //! `OUT_DIR/record.csv`: two 20 ms cycles of the 0/30 V square wave through
 //! the valve (designer's hybrid simulator), sampled every Δ = 50 µs with the
 //! description's noise σ_v, σ_i (fixed seed), as `v i` lines.
@@ -19,8 +19,10 @@ fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR"));
     let d = parse_file(&toml).unwrap_or_else(|e| panic!("{e}"));
-    let input = codegen::SemeraInput::from_description(&d).expect("[observer] with semera and integral");
-    let code = codegen::emit_semera(&input).unwrap_or_else(|e| panic!("{e}"));
+    // the whole file `reldesign build` writes: `params!`, then `pub mod estimators`
+    let code = codegen::Design::new(&d)
+        .and_then(|design| design.emit())
+        .unwrap_or_else(|e| panic!("{e}"));
     std::fs::write(out.join("semera.rs"), code).unwrap();
 
     let o = d.observer.as_ref().unwrap();

@@ -18,7 +18,9 @@ use designer::design::{
 use designer::model::Model;
 use designer::observe::discrete::{DiscreteModel, KalmanSettings, ResistanceSettings};
 
-use crate::controller::{emit_controller, gains, ControllerError, ControllerInput, OperationTable};
+use crate::controller::{
+    emit_controller, gains, params_macro, ControllerError, ControllerInput, OperationTable,
+};
 use crate::header::Header;
 use crate::observer::{emit_ekf, emit_ukf, wrap_module, ObserverError, ObserverInput};
 use crate::semera::{emit_semera, SemeraError, SemeraInput};
@@ -368,11 +370,21 @@ impl Design {
     /// then `pub mod estimators` (SEMERA, integral), `pub mod ekf`, `pub mod ukf`.
     pub fn emit(&self) -> Result<String, BuildError> {
         let d = &self.description;
+        let file = || d.source.file_name.clone();
         let mut out = match &self.controller {
             Some(c) => self.emit_controller(c)?,
             None => self.header(),
         };
-        let file = || d.source.file_name.clone();
+        // the estimators take N from `params!` (the controller's file has it already)
+        if self.controller.is_none() && SemeraInput::from_description(d).is_some() {
+            let params: Vec<_> = self.model.params.iter().collect();
+            let text = params_macro(&d.name, &params).map_err(|source| BuildError::Emit {
+                file: file(),
+                source,
+            })?;
+            out.push('\n');
+            out.push_str(&text);
+        }
         let floats = d
             .observer
             .as_ref()

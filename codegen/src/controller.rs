@@ -246,7 +246,7 @@ pub fn emit_controller(input: &ControllerInput) -> Result<String, ControllerErro
 
     let mut out = header;
     out.push('\n');
-    out.push_str(&params_macro(input)?);
+    out.push_str(&params_macro(input.name, &input.params)?);
     let mut floats: Vec<Float> = Vec::new();
     for &f in &input.floats {
         if !floats.contains(&f) {
@@ -487,9 +487,9 @@ fn f64_text(v: f64) -> String {
 /// `macro_rules! params` with one `pub const NAME: $f = value;` line per
 /// parameter (the value in shortest round-trip f64 form: in an `f32`
 /// module the literal rounds to the nearest `f32`).
-fn params_macro(input: &ControllerInput) -> Result<String, ControllerError> {
+pub(crate) fn params_macro(model: &str, params: &[Param]) -> Result<String, ControllerError> {
     let mut body = String::new();
-    for &(name, _, value) in &input.params {
+    for &(name, _, value) in params {
         let cname = const_name(name)?;
         if DESIGN_CONSTS.contains(&cname.as_str()) {
             return Err(ControllerError::NameTaken(cname));
@@ -514,7 +514,7 @@ fn params_macro(input: &ControllerInput) -> Result<String, ControllerError> {
         "/// The model parameters of `{name}` (SI units), one per line, declared in\n\
          /// each float module as `params!(f64)` / `params!(f32)`.\n\
          macro_rules! params {{\n    ($f:ty) => {{\n{body}    }};\n}}\n",
-        name = input.name
+        name = model
     ))
 }
 

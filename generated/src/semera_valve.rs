@@ -3,698 +3,104 @@
 // source: semera-valve.toml
 // source sha256: 5b5ac2e439bbd268742d8bd33d33c7ab97f956a7a77e8f65af44c1ee4f26ca2b
 
+/// The model parameters of `semera_valve` (SI units), one per line, declared in
+/// each float module as `params!(f64)` / `params!(f32)`.
+macro_rules! params {
+    ($f:ty) => {
+        /// `k_gap`
+        pub const K_GAP: $f = 27000000000.0;
+        /// `R_gap0`
+        pub const R_GAP0: $f = 0.0;
+        /// `R_core0`
+        pub const R_CORE0: $f = 3250000.0;
+        /// `phi_sat`
+        pub const PHI_SAT: $f = 2e-5;
+        pub const N: $f = 1200.0;
+        pub const R: $f = 75.0;
+        /// `k_e`
+        pub const K_E: $f = 0.0;
+        /// `m`
+        pub const M: $f = 0.0016;
+        /// `k_s`
+        pub const K_S: $f = 37.0;
+        /// `c`
+        pub const C: $f = 0.4;
+        pub const F0: $f = -0.8325;
+    };
+}
+
 /// The model-free electrical estimators (semera-electromagnetic-estimation):
 /// SEMERA (Algorithm 1) and the integral estimator (Algorithm 2).
 pub mod estimators {
+    /// The estimators' settings of `semera_valve`, one value per line, declared in each float
+    /// module as `settings!(f64)` / `settings!(f32)` (N is `params!`'s).
+    macro_rules! settings {
+        ($f:ty) => {
+            /// `observer.sample_period`: Δ [s], call `step` once per sample.
+            pub const SAMPLE_PERIOD: $f = 5e-5;
+            /// `observer.voltage_noise`: σ_v [V], in the gain (43).
+            pub const VOLTAGE_NOISE: $f = 0.015;
+            /// `observer.current_noise`: σ_i [A], the CI detector's unit.
+            pub const CURRENT_NOISE: $f = 0.001;
+            /// SEMERA (Algorithm 1): `[observer.semera]`.
+            pub const SEMERA: semera::Settings<$f> = semera::Settings {
+                sample_period: SAMPLE_PERIOD,
+                voltage_noise: VOLTAGE_NOISE,
+                current_noise: CURRENT_NOISE,
+                turns: N,
+                initial_resistance: 77.5,          // r̄₀ [Ω] (25)
+                initial_resistance_std: 1.0,       // σ_r0 [Ω] (26)
+                initial_inductance: 0.05,          // l̄₀ [H] (25), the expert rule's l̂
+                initial_inductance_std: 0.005,     // σ_l0 [H] (26)
+                resistance_rate_std: 1.0,          // σ_ṙ [Ω/s] (24)
+                inductance_accel_std: 100000000.0, // σ_l̈ [H/s²] (24)
+                ci_sigmas: 3.29,                   // n_σ: the CI detector's half-width in σ_i
+            };
+            /// The integral estimator (Algorithm 2): `[observer.integral]`.
+            pub const INTEGRAL: integral::Settings<$f> = integral::Settings {
+                sample_period: SAMPLE_PERIOD,
+                current_noise: CURRENT_NOISE,
+                turns: N,
+                initial_resistance: 77.5,  // r̄₀ [Ω] until the first (47)
+                initial_inductance: 0.05,  // l̄₀ [H], the expert rule's l̂
+                initial_flux_linkage: 0.0, // λ₀ [Wb] at each reset (46)
+                ci_sigmas: 3.29,           // n_σ: the CI detector's half-width in σ_i
+                energize_threshold: 15.0,  // [V]: u rising above it starts an operation
+            };
+        };
+    }
+
     /// The model-free estimators of `semera_valve` in f32 (semera-electromagnetic-estimation §II).
     pub mod f32 {
-        use reldesign_runtime::math::Real;
+        use reldesign_runtime::{integral, semera};
 
-        /// Δ [s]: call `step` once per sample, every Δ.
-        pub const SAMPLE_PERIOD: f32 = 5e-5;
+        params!(f32);
+        settings!(f32);
 
-        /// σ_v [V]: standard deviation of the voltage measurement noise (43).
-        pub const VOLTAGE_NOISE: f32 = 0.015;
+        /// The estimate of one sample: r̂, l̂, λ̂, φ̂ = λ̂/N, R̂ = N²/l̂ and the CI detector's `valid`.
+        pub type Estimate = semera::Estimate<f32>;
 
-        /// σ_i [A]: standard deviation of the current measurement noise (the CI detector).
-        pub const CURRENT_NOISE: f32 = 0.001;
+        /// SEMERA (Algorithm 1): `Semera::new(&SEMERA)`, then `step(v, i)` every Δ.
+        pub type Semera = semera::Semera<f32>;
 
-        /// N, the coil's turns: φ = λ/N, R = N²/l (§II-C).
-        pub const TURNS: f32 = 1200.0;
-
-        /// 1/N.
-        pub const INV_TURNS: f32 = 1.0 / TURNS;
-
-        /// N².
-        pub const TURNS_SQ: f32 = TURNS * TURNS;
-
-        /// r̄₀ [Ω]: expected initial resistance (25).
-        pub const SEMERA_INITIAL_RESISTANCE: f32 = 77.5;
-
-        /// σ_r0 [Ω] (26).
-        pub const SEMERA_INITIAL_RESISTANCE_STD: f32 = 1.0;
-
-        /// l̄₀ [H]: inductance at rest (25); the expert rule's l̂.
-        pub const SEMERA_INITIAL_INDUCTANCE: f32 = 0.05;
-
-        /// σ_l0 [H] (26).
-        pub const SEMERA_INITIAL_INDUCTANCE_STD: f32 = 0.005;
-
-        /// σ_ṙ [Ω/s] (24).
-        pub const SEMERA_RESISTANCE_RATE_STD: f32 = 1.0;
-
-        /// σ_l̈ [H/s²] (24).
-        pub const SEMERA_INDUCTANCE_ACCEL_STD: f32 = 100000000.0;
-
-        /// n_σ: half-width of the current's noise interval in σ_i.
-        pub const SEMERA_CI_SIGMAS: f32 = 3.29;
-
-        /// 1/Δ (11).
-        pub const SEMERA_INV_SAMPLE_PERIOD: f32 = 1.0 / SAMPLE_PERIOD;
-
-        /// σ_v² (43).
-        pub const SEMERA_VOLTAGE_VARIANCE: f32 = VOLTAGE_NOISE * VOLTAGE_NOISE;
-
-        /// (σ_ṙ·Δ)²: G Q Gᵀ (1, 1), (23)–(24).
-        pub const SEMERA_PROCESS_R: f32 = (SEMERA_RESISTANCE_RATE_STD * SAMPLE_PERIOD)
-            * (SEMERA_RESISTANCE_RATE_STD * SAMPLE_PERIOD);
-
-        /// (σ_l̈·Δ²)²: G Q Gᵀ (2, 2), (23)–(24).
-        pub const SEMERA_PROCESS_L: f32 = (SEMERA_INDUCTANCE_ACCEL_STD * SAMPLE_PERIOD
-            * SAMPLE_PERIOD) * (SEMERA_INDUCTANCE_ACCEL_STD * SAMPLE_PERIOD * SAMPLE_PERIOD);
-
-        /// n_σ·σ_i [A]: the CI detector's bound.
-        pub const SEMERA_CI: f32 = SEMERA_CI_SIGMAS * CURRENT_NOISE;
-
-        /// σ²_r0: P₀ (1, 1) of (26) (ERRATA: the text prints σ_r0).
-        pub const SEMERA_VAR_R0: f32 = SEMERA_INITIAL_RESISTANCE_STD
-            * SEMERA_INITIAL_RESISTANCE_STD;
-
-        /// σ²_l0: the l block of P₀ (26) is [[σ²_l0, σ²_l0], [σ²_l0, σ²_l0]] (l₋₁ = l₀).
-        pub const SEMERA_VAR_L0: f32 = SEMERA_INITIAL_INDUCTANCE_STD
-            * SEMERA_INITIAL_INDUCTANCE_STD;
-
-        /// r̄₀ [Ω]: the resistance until the first update (47).
-        pub const INTEGRAL_INITIAL_RESISTANCE: f32 = 77.5;
-
-        /// l̄₀ [H]: the expert rule's l̂.
-        pub const INTEGRAL_INITIAL_INDUCTANCE: f32 = 0.05;
-
-        /// λ₀ [Wb]: the flux linkage at each reset (46).
-        pub const INTEGRAL_INITIAL_FLUX_LINKAGE: f32 = 0.0;
-
-        /// n_σ: half-width of the current's noise interval in σ_i.
-        pub const INTEGRAL_CI_SIGMAS: f32 = 3.29;
-
-        /// [V]: the voltage rising above it starts an energizing operation.
-        pub const INTEGRAL_ENERGIZE_THRESHOLD: f32 = 15.0;
-
-        /// n_σ·σ_i [A]: the CI detector's bound.
-        pub const INTEGRAL_CI: f32 = INTEGRAL_CI_SIGMAS * CURRENT_NOISE;
-
-        /// (n_σ·σ_i)²: (47) is used when S_ι² > (n_σ·σ_i)²·m (the sum is more than noise).
-        pub const INTEGRAL_CI_SQ: f32 = INTEGRAL_CI * INTEGRAL_CI;
-
-        /// The estimate of one sample.
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Estimate {
-            /// r̂ [Ω], the coil resistance.
-            pub r: f32,
-            /// l̂ [H], the apparent inductance (l̄₀ under the expert rule).
-            pub l: f32,
-            /// λ̂ [Wb], the flux linkage.
-            pub lambda: f32,
-            /// φ̂ = λ̂/N [Wb], the magnetic flux.
-            pub phi: f32,
-            /// R̂ = N²/l̂ [H⁻¹], the reluctance.
-            pub reluctance: f32,
-            /// The confidence-interval detector: |ι_k| and |ι_{k−1}| both exceed n_σ·σ_i
-            /// (and the sample was usable), so r̂ and l̂ come from the estimator; false
-            /// under the expert rule (r̂ held, l̂ = l̄₀).
-            pub valid: bool,
-        }
-
-        /// SEMERA (semera Algorithm 1): Kalman estimation of x = [r, l, l₋₁] (10) from the
-        /// observation u_k = H_k x_k + v_k (8)–(12), H_k = [ι_k, ι_k/Δ, −ι_{k−1}/Δ], with
-        /// F of (21) (r constant, l linear in time), Q of (24) and the gain (43)
-        /// K̂ = Σ Hᵀ (H Σ Hᵀ + σ_v²)⁻¹. r̂ and l̂ are the a posteriori estimates when the
-        /// CI detector finds |ι_k| and |ι_{k−1}| above n_σ·σ_i; otherwise the expert rule
-        /// r̂_k = r̂_{k−1}, l̂_k = l̄₀. λ̂ = l̂·ι, φ̂ = λ̂/N, R̂ = N²/l̂.
-        ///
-        /// A sample whose update is not finite (NaN or infinite v or i) is a missing
-        /// measurement: prediction only, and the expert rule.
-        #[derive(Clone, Debug, PartialEq)]
-        pub struct Semera {
-            /// x̂_{k+1/k} = [r, l, l₋₁]
-            r: f32,
-            l: f32,
-            lp: f32,
-            /// Σ_{k+1/k}, symmetric
-            p11: f32,
-            p12: f32,
-            p13: f32,
-            p22: f32,
-            p23: f32,
-            p33: f32,
-            /// ι_{k−1}
-            i_prev: f32,
-            /// r̂_{k−1}
-            r_hat: f32,
-        }
-
-        impl Semera {
-            /// At rest (Algorithm 1, lines 1–3): x̂_{1/0} = [r̄₀, l̄₀, l̄₀] (25),
-            /// Σ_{1/0} = P₀ (26), ι₀ = 0.
-            #[must_use]
-            pub const fn new() -> Self {
-                Semera {
-                    r: SEMERA_INITIAL_RESISTANCE,
-                    l: SEMERA_INITIAL_INDUCTANCE,
-                    lp: SEMERA_INITIAL_INDUCTANCE,
-                    p11: SEMERA_VAR_R0,
-                    p12: 0.0,
-                    p13: 0.0,
-                    p22: SEMERA_VAR_L0,
-                    p23: SEMERA_VAR_L0,
-                    p33: SEMERA_VAR_L0,
-                    i_prev: 0.0,
-                    r_hat: SEMERA_INITIAL_RESISTANCE,
-                }
-            }
-
-            /// One sample k (Algorithm 1, lines 5–16): the coil voltage u_k = `v` [V] and
-            /// current ι_k = `i` [A], taken every Δ.
-            #[must_use]
-            pub fn step(&mut self, v: f32, i: f32) -> Estimate {
-                // line 7: H_k (11)
-                let h1 = i;
-                let h2 = i * SEMERA_INV_SAMPLE_PERIOD;
-                let h3 = -(self.i_prev * SEMERA_INV_SAMPLE_PERIOD);
-                // line 8: K̂ (43) = g/s with g = Σ Hᵀ, s = H Σ Hᵀ + σ_v²
-                let g1 = self.p11 * h1 + self.p12 * h2 + self.p13 * h3;
-                let g2 = self.p12 * h1 + self.p22 * h2 + self.p23 * h3;
-                let g3 = self.p13 * h1 + self.p23 * h2 + self.p33 * h3;
-                let s = h1 * g1 + h2 * g2 + h3 * g3 + SEMERA_VOLTAGE_VARIANCE;
-                let w = 1.0 / s;
-                // line 9: x̂_{k/k} = x̂_{k/k−1} + K̂·(z_k − H_k x̂_{k/k−1}), K̂·ν = g·(ν/s)
-                let mut r = self.r;
-                let mut l = self.l;
-                let mut lp = self.lp;
-                let nu = v - (h1 * r + h2 * l + h3 * lp);
-                let mut p11 = self.p11;
-                let mut p12 = self.p12;
-                let mut p13 = self.p13;
-                let mut p22 = self.p22;
-                let mut p23 = self.p23;
-                let mut p33 = self.p33;
-                let m = nu * w;
-                // a non-finite sample is a missing measurement: prediction only
-                let used = m.is_finite();
-                if used {
-                    let k1 = g1 * w;
-                    let k2 = g2 * w;
-                    let k3 = g3 * w;
-                    r += g1 * m;
-                    l += g2 * m;
-                    lp += g3 * m;
-                    // line 10: Σ_{k/k} = (I − K̂ H) Σ = B = Σ − K̂ gᵀ (symmetric: upper triangle);
-                    // the l block as the equal Joseph form B − d K̂ᵀ, d = B Hᵀ − σ_v² K̂, which is 0 up
-                    // to rounding: it undoes the cancellation in the nearly singular l block
-                    // (with B alone Σ turns indefinite in f32)
-                    let b11 = p11 - k1 * g1;
-                    let b12 = p12 - k1 * g2;
-                    let b13 = p13 - k1 * g3;
-                    let b22 = p22 - k2 * g2;
-                    let b23 = p23 - k2 * g3;
-                    let b33 = p33 - k3 * g3;
-                    let d2 = b12 * h1 + b22 * h2 + b23 * h3 - SEMERA_VOLTAGE_VARIANCE * k2;
-                    let d3 = b13 * h1 + b23 * h2 + b33 * h3 - SEMERA_VOLTAGE_VARIANCE * k3;
-                    p11 = b11;
-                    p12 = b12;
-                    p13 = b13;
-                    p22 = b22 - d2 * k2;
-                    p23 = b23 - d2 * k3;
-                    p33 = b33 - d3 * k3;
-                }
-                // lines 11–12: x̂_{k+1/k} = F x̂_{k/k}, Σ_{k+1/k} = F Σ Fᵀ + G Q Gᵀ (21)–(24)
-                self.r = r;
-                self.l = 2.0 * l - lp;
-                self.lp = l;
-                self.p11 = p11 + SEMERA_PROCESS_R;
-                self.p12 = 2.0 * p12 - p13;
-                self.p13 = p12;
-                self.p22 = 4.0 * (p22 - p23) + p33 + SEMERA_PROCESS_L;
-                self.p23 = 2.0 * p22 - p23;
-                self.p33 = p22;
-                // lines 13–15: the CI detector and the expert rule
-                let valid = used && Real::abs(i) > SEMERA_CI
-                    && Real::abs(self.i_prev) > SEMERA_CI;
-                let (r_hat, l_hat) = if valid {
-                    (r, l)
-                } else {
-                    (self.r_hat, SEMERA_INITIAL_INDUCTANCE)
-                };
-                self.r_hat = r_hat;
-                self.i_prev = i;
-                // line 16 and §II-C: λ = l·ι, φ = λ/N, R = N²/l
-                let lambda = l_hat * i;
-                Estimate {
-                    r: r_hat,
-                    l: l_hat,
-                    lambda,
-                    phi: lambda * INV_TURNS,
-                    reluctance: TURNS_SQ / l_hat,
-                    valid,
-                }
-            }
-        }
-
-        impl Default for Semera {
-            fn default() -> Self {
-                Self::new()
-            }
-        }
-
-        /// The integral estimator (semera Algorithm 2): λ̂ = λ₀ + Δ·(S_u − r̄·S_ι) (46),
-        /// l̂ = λ̂/ι (48) under the CI detector (else l̄₀), and at the start of each
-        /// energizing operation (the voltage rising above `INTEGRAL_ENERGIZE_THRESHOLD`
-        /// between two samples: the operation started at the earlier one) the resistance
-        /// update r̄ = S_u/S_ι (47) — used when S_ι exceeds its noise interval — and the
-        /// reset S_u = S_ι = 0. Non-finite samples are skipped (nothing summed).
-        #[derive(Clone, Debug, PartialEq)]
-        pub struct Integral {
-            /// r̄
-            r_bar: f32,
-            /// S_u
-            sum_u: f32,
-            /// S_ι
-            sum_i: f32,
-            /// m, the samples in the sums
-            count: f32,
-            /// ι_{k−1}
-            i_prev: f32,
-            /// The last finite voltage sample.
-            v_prev: f32,
-        }
-
-        impl Integral {
-            /// At rest (Algorithm 2, lines 1–2): r̄ = r̄₀, S_u = S_ι = 0, ι₀ = 0.
-            #[must_use]
-            pub const fn new() -> Self {
-                Integral {
-                    r_bar: INTEGRAL_INITIAL_RESISTANCE,
-                    sum_u: 0.0,
-                    sum_i: 0.0,
-                    count: 0.0,
-                    i_prev: 0.0,
-                    v_prev: 0.0,
-                }
-            }
-
-            /// One sample k: the coil voltage u_k = `v` [V] and current ι_k = `i` [A],
-            /// taken every Δ.
-            #[must_use]
-            pub fn step(&mut self, v: f32, i: f32) -> Estimate {
-                // lines 10–11 of sample k − 1 (the voltage rose since): (47) and the reset
-                if v > INTEGRAL_ENERGIZE_THRESHOLD
-                    && self.v_prev <= INTEGRAL_ENERGIZE_THRESHOLD
-                {
-                    // (47) only when S_ι is more than noise: |S_ι| > n_σ·σ_i·√m
-                    if self.sum_i > 0.0
-                        && self.sum_i * self.sum_i > INTEGRAL_CI_SQ * self.count
-                    {
-                        let r = self.sum_u / self.sum_i;
-                        if r > 0.0 && r.is_finite() {
-                            self.r_bar = r;
-                        }
-                    }
-                    self.sum_u = 0.0;
-                    self.sum_i = 0.0;
-                    self.count = 0.0;
-                }
-                // line 5 (a non-finite sample is missing: nothing is summed)
-                if v.is_finite() && i.is_finite() {
-                    self.sum_u += v;
-                    self.sum_i += i;
-                    self.count += 1.0;
-                    self.v_prev = v;
-                }
-                // line 6: (46)
-                let lambda = INTEGRAL_INITIAL_FLUX_LINKAGE
-                    + SAMPLE_PERIOD * (self.sum_u - self.r_bar * self.sum_i);
-                // lines 7–9: the CI detector, (48) or the expert rule
-                let valid = Real::abs(i) > INTEGRAL_CI
-                    && Real::abs(self.i_prev) > INTEGRAL_CI;
-                let l = if valid { lambda / i } else { INTEGRAL_INITIAL_INDUCTANCE };
-                self.i_prev = i;
-                // line 12: r̂_k = r̄
-                Estimate {
-                    r: self.r_bar,
-                    l,
-                    lambda,
-                    phi: lambda * INV_TURNS,
-                    reluctance: TURNS_SQ / l,
-                    valid,
-                }
-            }
-
-            /// r̄, the resistance in use [Ω].
-            #[must_use]
-            pub const fn resistance(&self) -> f32 {
-                self.r_bar
-            }
-        }
-
-        impl Default for Integral {
-            fn default() -> Self {
-                Self::new()
-            }
-        }
+        /// The integral estimator (Algorithm 2): `Integral::new(&INTEGRAL)`, then `step(v, i)` every Δ.
+        pub type Integral = integral::Integral<f32>;
     }
 
     /// The model-free estimators of `semera_valve` in f64 (semera-electromagnetic-estimation §II).
     pub mod f64 {
-        use reldesign_runtime::math::Real;
+        use reldesign_runtime::{integral, semera};
 
-        /// Δ [s]: call `step` once per sample, every Δ.
-        pub const SAMPLE_PERIOD: f64 = 5e-5;
+        params!(f64);
+        settings!(f64);
 
-        /// σ_v [V]: standard deviation of the voltage measurement noise (43).
-        pub const VOLTAGE_NOISE: f64 = 0.015;
+        /// The estimate of one sample: r̂, l̂, λ̂, φ̂ = λ̂/N, R̂ = N²/l̂ and the CI detector's `valid`.
+        pub type Estimate = semera::Estimate<f64>;
 
-        /// σ_i [A]: standard deviation of the current measurement noise (the CI detector).
-        pub const CURRENT_NOISE: f64 = 0.001;
+        /// SEMERA (Algorithm 1): `Semera::new(&SEMERA)`, then `step(v, i)` every Δ.
+        pub type Semera = semera::Semera<f64>;
 
-        /// N, the coil's turns: φ = λ/N, R = N²/l (§II-C).
-        pub const TURNS: f64 = 1200.0;
-
-        /// 1/N.
-        pub const INV_TURNS: f64 = 1.0 / TURNS;
-
-        /// N².
-        pub const TURNS_SQ: f64 = TURNS * TURNS;
-
-        /// r̄₀ [Ω]: expected initial resistance (25).
-        pub const SEMERA_INITIAL_RESISTANCE: f64 = 77.5;
-
-        /// σ_r0 [Ω] (26).
-        pub const SEMERA_INITIAL_RESISTANCE_STD: f64 = 1.0;
-
-        /// l̄₀ [H]: inductance at rest (25); the expert rule's l̂.
-        pub const SEMERA_INITIAL_INDUCTANCE: f64 = 0.05;
-
-        /// σ_l0 [H] (26).
-        pub const SEMERA_INITIAL_INDUCTANCE_STD: f64 = 0.005;
-
-        /// σ_ṙ [Ω/s] (24).
-        pub const SEMERA_RESISTANCE_RATE_STD: f64 = 1.0;
-
-        /// σ_l̈ [H/s²] (24).
-        pub const SEMERA_INDUCTANCE_ACCEL_STD: f64 = 100000000.0;
-
-        /// n_σ: half-width of the current's noise interval in σ_i.
-        pub const SEMERA_CI_SIGMAS: f64 = 3.29;
-
-        /// 1/Δ (11).
-        pub const SEMERA_INV_SAMPLE_PERIOD: f64 = 1.0 / SAMPLE_PERIOD;
-
-        /// σ_v² (43).
-        pub const SEMERA_VOLTAGE_VARIANCE: f64 = VOLTAGE_NOISE * VOLTAGE_NOISE;
-
-        /// (σ_ṙ·Δ)²: G Q Gᵀ (1, 1), (23)–(24).
-        pub const SEMERA_PROCESS_R: f64 = (SEMERA_RESISTANCE_RATE_STD * SAMPLE_PERIOD)
-            * (SEMERA_RESISTANCE_RATE_STD * SAMPLE_PERIOD);
-
-        /// (σ_l̈·Δ²)²: G Q Gᵀ (2, 2), (23)–(24).
-        pub const SEMERA_PROCESS_L: f64 = (SEMERA_INDUCTANCE_ACCEL_STD * SAMPLE_PERIOD
-            * SAMPLE_PERIOD) * (SEMERA_INDUCTANCE_ACCEL_STD * SAMPLE_PERIOD * SAMPLE_PERIOD);
-
-        /// n_σ·σ_i [A]: the CI detector's bound.
-        pub const SEMERA_CI: f64 = SEMERA_CI_SIGMAS * CURRENT_NOISE;
-
-        /// σ²_r0: P₀ (1, 1) of (26) (ERRATA: the text prints σ_r0).
-        pub const SEMERA_VAR_R0: f64 = SEMERA_INITIAL_RESISTANCE_STD
-            * SEMERA_INITIAL_RESISTANCE_STD;
-
-        /// σ²_l0: the l block of P₀ (26) is [[σ²_l0, σ²_l0], [σ²_l0, σ²_l0]] (l₋₁ = l₀).
-        pub const SEMERA_VAR_L0: f64 = SEMERA_INITIAL_INDUCTANCE_STD
-            * SEMERA_INITIAL_INDUCTANCE_STD;
-
-        /// r̄₀ [Ω]: the resistance until the first update (47).
-        pub const INTEGRAL_INITIAL_RESISTANCE: f64 = 77.5;
-
-        /// l̄₀ [H]: the expert rule's l̂.
-        pub const INTEGRAL_INITIAL_INDUCTANCE: f64 = 0.05;
-
-        /// λ₀ [Wb]: the flux linkage at each reset (46).
-        pub const INTEGRAL_INITIAL_FLUX_LINKAGE: f64 = 0.0;
-
-        /// n_σ: half-width of the current's noise interval in σ_i.
-        pub const INTEGRAL_CI_SIGMAS: f64 = 3.29;
-
-        /// [V]: the voltage rising above it starts an energizing operation.
-        pub const INTEGRAL_ENERGIZE_THRESHOLD: f64 = 15.0;
-
-        /// n_σ·σ_i [A]: the CI detector's bound.
-        pub const INTEGRAL_CI: f64 = INTEGRAL_CI_SIGMAS * CURRENT_NOISE;
-
-        /// (n_σ·σ_i)²: (47) is used when S_ι² > (n_σ·σ_i)²·m (the sum is more than noise).
-        pub const INTEGRAL_CI_SQ: f64 = INTEGRAL_CI * INTEGRAL_CI;
-
-        /// The estimate of one sample.
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Estimate {
-            /// r̂ [Ω], the coil resistance.
-            pub r: f64,
-            /// l̂ [H], the apparent inductance (l̄₀ under the expert rule).
-            pub l: f64,
-            /// λ̂ [Wb], the flux linkage.
-            pub lambda: f64,
-            /// φ̂ = λ̂/N [Wb], the magnetic flux.
-            pub phi: f64,
-            /// R̂ = N²/l̂ [H⁻¹], the reluctance.
-            pub reluctance: f64,
-            /// The confidence-interval detector: |ι_k| and |ι_{k−1}| both exceed n_σ·σ_i
-            /// (and the sample was usable), so r̂ and l̂ come from the estimator; false
-            /// under the expert rule (r̂ held, l̂ = l̄₀).
-            pub valid: bool,
-        }
-
-        /// SEMERA (semera Algorithm 1): Kalman estimation of x = [r, l, l₋₁] (10) from the
-        /// observation u_k = H_k x_k + v_k (8)–(12), H_k = [ι_k, ι_k/Δ, −ι_{k−1}/Δ], with
-        /// F of (21) (r constant, l linear in time), Q of (24) and the gain (43)
-        /// K̂ = Σ Hᵀ (H Σ Hᵀ + σ_v²)⁻¹. r̂ and l̂ are the a posteriori estimates when the
-        /// CI detector finds |ι_k| and |ι_{k−1}| above n_σ·σ_i; otherwise the expert rule
-        /// r̂_k = r̂_{k−1}, l̂_k = l̄₀. λ̂ = l̂·ι, φ̂ = λ̂/N, R̂ = N²/l̂.
-        ///
-        /// A sample whose update is not finite (NaN or infinite v or i) is a missing
-        /// measurement: prediction only, and the expert rule.
-        #[derive(Clone, Debug, PartialEq)]
-        pub struct Semera {
-            /// x̂_{k+1/k} = [r, l, l₋₁]
-            r: f64,
-            l: f64,
-            lp: f64,
-            /// Σ_{k+1/k}, symmetric
-            p11: f64,
-            p12: f64,
-            p13: f64,
-            p22: f64,
-            p23: f64,
-            p33: f64,
-            /// ι_{k−1}
-            i_prev: f64,
-            /// r̂_{k−1}
-            r_hat: f64,
-        }
-
-        impl Semera {
-            /// At rest (Algorithm 1, lines 1–3): x̂_{1/0} = [r̄₀, l̄₀, l̄₀] (25),
-            /// Σ_{1/0} = P₀ (26), ι₀ = 0.
-            #[must_use]
-            pub const fn new() -> Self {
-                Semera {
-                    r: SEMERA_INITIAL_RESISTANCE,
-                    l: SEMERA_INITIAL_INDUCTANCE,
-                    lp: SEMERA_INITIAL_INDUCTANCE,
-                    p11: SEMERA_VAR_R0,
-                    p12: 0.0,
-                    p13: 0.0,
-                    p22: SEMERA_VAR_L0,
-                    p23: SEMERA_VAR_L0,
-                    p33: SEMERA_VAR_L0,
-                    i_prev: 0.0,
-                    r_hat: SEMERA_INITIAL_RESISTANCE,
-                }
-            }
-
-            /// One sample k (Algorithm 1, lines 5–16): the coil voltage u_k = `v` [V] and
-            /// current ι_k = `i` [A], taken every Δ.
-            #[must_use]
-            pub fn step(&mut self, v: f64, i: f64) -> Estimate {
-                // line 7: H_k (11)
-                let h1 = i;
-                let h2 = i * SEMERA_INV_SAMPLE_PERIOD;
-                let h3 = -(self.i_prev * SEMERA_INV_SAMPLE_PERIOD);
-                // line 8: K̂ (43) = g/s with g = Σ Hᵀ, s = H Σ Hᵀ + σ_v²
-                let g1 = self.p11 * h1 + self.p12 * h2 + self.p13 * h3;
-                let g2 = self.p12 * h1 + self.p22 * h2 + self.p23 * h3;
-                let g3 = self.p13 * h1 + self.p23 * h2 + self.p33 * h3;
-                let s = h1 * g1 + h2 * g2 + h3 * g3 + SEMERA_VOLTAGE_VARIANCE;
-                let w = 1.0 / s;
-                // line 9: x̂_{k/k} = x̂_{k/k−1} + K̂·(z_k − H_k x̂_{k/k−1}), K̂·ν = g·(ν/s)
-                let mut r = self.r;
-                let mut l = self.l;
-                let mut lp = self.lp;
-                let nu = v - (h1 * r + h2 * l + h3 * lp);
-                let mut p11 = self.p11;
-                let mut p12 = self.p12;
-                let mut p13 = self.p13;
-                let mut p22 = self.p22;
-                let mut p23 = self.p23;
-                let mut p33 = self.p33;
-                let m = nu * w;
-                // a non-finite sample is a missing measurement: prediction only
-                let used = m.is_finite();
-                if used {
-                    let k1 = g1 * w;
-                    let k2 = g2 * w;
-                    let k3 = g3 * w;
-                    r += g1 * m;
-                    l += g2 * m;
-                    lp += g3 * m;
-                    // line 10: Σ_{k/k} = (I − K̂ H) Σ = B = Σ − K̂ gᵀ (symmetric: upper triangle);
-                    // the l block as the equal Joseph form B − d K̂ᵀ, d = B Hᵀ − σ_v² K̂, which is 0 up
-                    // to rounding: it undoes the cancellation in the nearly singular l block
-                    // (with B alone Σ turns indefinite in f32)
-                    let b11 = p11 - k1 * g1;
-                    let b12 = p12 - k1 * g2;
-                    let b13 = p13 - k1 * g3;
-                    let b22 = p22 - k2 * g2;
-                    let b23 = p23 - k2 * g3;
-                    let b33 = p33 - k3 * g3;
-                    let d2 = b12 * h1 + b22 * h2 + b23 * h3 - SEMERA_VOLTAGE_VARIANCE * k2;
-                    let d3 = b13 * h1 + b23 * h2 + b33 * h3 - SEMERA_VOLTAGE_VARIANCE * k3;
-                    p11 = b11;
-                    p12 = b12;
-                    p13 = b13;
-                    p22 = b22 - d2 * k2;
-                    p23 = b23 - d2 * k3;
-                    p33 = b33 - d3 * k3;
-                }
-                // lines 11–12: x̂_{k+1/k} = F x̂_{k/k}, Σ_{k+1/k} = F Σ Fᵀ + G Q Gᵀ (21)–(24)
-                self.r = r;
-                self.l = 2.0 * l - lp;
-                self.lp = l;
-                self.p11 = p11 + SEMERA_PROCESS_R;
-                self.p12 = 2.0 * p12 - p13;
-                self.p13 = p12;
-                self.p22 = 4.0 * (p22 - p23) + p33 + SEMERA_PROCESS_L;
-                self.p23 = 2.0 * p22 - p23;
-                self.p33 = p22;
-                // lines 13–15: the CI detector and the expert rule
-                let valid = used && Real::abs(i) > SEMERA_CI
-                    && Real::abs(self.i_prev) > SEMERA_CI;
-                let (r_hat, l_hat) = if valid {
-                    (r, l)
-                } else {
-                    (self.r_hat, SEMERA_INITIAL_INDUCTANCE)
-                };
-                self.r_hat = r_hat;
-                self.i_prev = i;
-                // line 16 and §II-C: λ = l·ι, φ = λ/N, R = N²/l
-                let lambda = l_hat * i;
-                Estimate {
-                    r: r_hat,
-                    l: l_hat,
-                    lambda,
-                    phi: lambda * INV_TURNS,
-                    reluctance: TURNS_SQ / l_hat,
-                    valid,
-                }
-            }
-        }
-
-        impl Default for Semera {
-            fn default() -> Self {
-                Self::new()
-            }
-        }
-
-        /// The integral estimator (semera Algorithm 2): λ̂ = λ₀ + Δ·(S_u − r̄·S_ι) (46),
-        /// l̂ = λ̂/ι (48) under the CI detector (else l̄₀), and at the start of each
-        /// energizing operation (the voltage rising above `INTEGRAL_ENERGIZE_THRESHOLD`
-        /// between two samples: the operation started at the earlier one) the resistance
-        /// update r̄ = S_u/S_ι (47) — used when S_ι exceeds its noise interval — and the
-        /// reset S_u = S_ι = 0. Non-finite samples are skipped (nothing summed).
-        #[derive(Clone, Debug, PartialEq)]
-        pub struct Integral {
-            /// r̄
-            r_bar: f64,
-            /// S_u
-            sum_u: f64,
-            /// S_ι
-            sum_i: f64,
-            /// m, the samples in the sums
-            count: f64,
-            /// ι_{k−1}
-            i_prev: f64,
-            /// The last finite voltage sample.
-            v_prev: f64,
-        }
-
-        impl Integral {
-            /// At rest (Algorithm 2, lines 1–2): r̄ = r̄₀, S_u = S_ι = 0, ι₀ = 0.
-            #[must_use]
-            pub const fn new() -> Self {
-                Integral {
-                    r_bar: INTEGRAL_INITIAL_RESISTANCE,
-                    sum_u: 0.0,
-                    sum_i: 0.0,
-                    count: 0.0,
-                    i_prev: 0.0,
-                    v_prev: 0.0,
-                }
-            }
-
-            /// One sample k: the coil voltage u_k = `v` [V] and current ι_k = `i` [A],
-            /// taken every Δ.
-            #[must_use]
-            pub fn step(&mut self, v: f64, i: f64) -> Estimate {
-                // lines 10–11 of sample k − 1 (the voltage rose since): (47) and the reset
-                if v > INTEGRAL_ENERGIZE_THRESHOLD
-                    && self.v_prev <= INTEGRAL_ENERGIZE_THRESHOLD
-                {
-                    // (47) only when S_ι is more than noise: |S_ι| > n_σ·σ_i·√m
-                    if self.sum_i > 0.0
-                        && self.sum_i * self.sum_i > INTEGRAL_CI_SQ * self.count
-                    {
-                        let r = self.sum_u / self.sum_i;
-                        if r > 0.0 && r.is_finite() {
-                            self.r_bar = r;
-                        }
-                    }
-                    self.sum_u = 0.0;
-                    self.sum_i = 0.0;
-                    self.count = 0.0;
-                }
-                // line 5 (a non-finite sample is missing: nothing is summed)
-                if v.is_finite() && i.is_finite() {
-                    self.sum_u += v;
-                    self.sum_i += i;
-                    self.count += 1.0;
-                    self.v_prev = v;
-                }
-                // line 6: (46)
-                let lambda = INTEGRAL_INITIAL_FLUX_LINKAGE
-                    + SAMPLE_PERIOD * (self.sum_u - self.r_bar * self.sum_i);
-                // lines 7–9: the CI detector, (48) or the expert rule
-                let valid = Real::abs(i) > INTEGRAL_CI
-                    && Real::abs(self.i_prev) > INTEGRAL_CI;
-                let l = if valid { lambda / i } else { INTEGRAL_INITIAL_INDUCTANCE };
-                self.i_prev = i;
-                // line 12: r̂_k = r̄
-                Estimate {
-                    r: self.r_bar,
-                    l,
-                    lambda,
-                    phi: lambda * INV_TURNS,
-                    reluctance: TURNS_SQ / l,
-                    valid,
-                }
-            }
-
-            /// r̄, the resistance in use [Ω].
-            #[must_use]
-            pub const fn resistance(&self) -> f64 {
-                self.r_bar
-            }
-        }
-
-        impl Default for Integral {
-            fn default() -> Self {
-                Self::new()
-            }
-        }
+        /// The integral estimator (Algorithm 2): `Integral::new(&INTEGRAL)`, then `step(v, i)` every Δ.
+        pub type Integral = integral::Integral<f64>;
     }
 }

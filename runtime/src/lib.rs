@@ -6,8 +6,10 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod integral;
 pub mod linalg;
 mod ln;
+pub mod semera;
 
 /// Scalar math for generated code, through `libm` (no `std`).
 ///

@@ -3,8 +3,8 @@
 //!     semera-step-bench KIND N REPS    N calls of KIND, REPS times; prints
 //!                                      `best_ns_per_call=<f> checksum=<f>`
 //!
-//! KIND: semera64 semera32 integral64 integral32 (`step` of the generated
-//! estimator on the samples of `record.csv`, cycling), base64 base32 (the
+//! KIND: semera64 semera32 integral64 integral32 (`step` of the runtime's
+//! estimator, with the generated settings, on the samples of `record.csv`, cycling), base64 base32 (the
 //! same loop without the call: loop overhead). The record (801 samples of a
 //! noisy two-cycle square-wave experiment, see build.rs) is parsed at start
 //! up, identically in every run, so callgrind's N vs 2N difference removes it.
@@ -17,7 +17,7 @@ mod semera {
     include!(concat!(env!("OUT_DIR"), "/semera.rs"));
 }
 
-use semera::{f32 as s32, f64 as s64};
+use semera::estimators::{f32 as s32, f64 as s64};
 
 fn record() -> Vec<[f64; 2]> {
     include_str!(concat!(env!("OUT_DIR"), "/record.csv"))
@@ -49,10 +49,10 @@ macro_rules! step_loop {
     };
 }
 
-step_loop!(semera64, f64, s64::Semera::new());
-step_loop!(semera32, f32, s32::Semera::new());
-step_loop!(integral64, f64, s64::Integral::new());
-step_loop!(integral32, f32, s32::Integral::new());
+step_loop!(semera64, f64, s64::Semera::new(&s64::SEMERA));
+step_loop!(semera32, f32, s32::Semera::new(&s32::SEMERA));
+step_loop!(integral64, f64, s64::Integral::new(&s64::INTEGRAL));
+step_loop!(integral32, f32, s32::Integral::new(&s32::INTEGRAL));
 
 /// The loop without the estimator: the sample's current is "the estimate".
 struct Base;
