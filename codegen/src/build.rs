@@ -20,7 +20,10 @@ use designer::observe::discrete::{DiscreteModel, KalmanSettings, ResistanceSetti
 
 use crate::controller::{emit_controller, gains, ControllerError, ControllerInput, OperationTable};
 use crate::header::Header;
-use crate::observer::{emit_ekf, emit_ukf, wrap_module, ObserverError, ObserverInput};
+use crate::observer::{
+    emit_ekf, emit_kalman_macro, emit_observer_params, emit_ukf, wrap_module, ObserverError,
+    ObserverInput,
+};
 use crate::semera::{emit_semera, SemeraError, SemeraInput};
 use crate::Float;
 
@@ -397,6 +400,18 @@ impl Design {
                 discrete,
                 floats,
             };
+            let macro_error = |e: ObserverError| BuildError::Observer {
+                file: file(),
+                estimator: "ekf/ukf",
+                message: e.to_string(),
+            };
+            // the filters' `params!` (the controller's when there is one) and `kalman!`
+            if self.controller.is_none() {
+                out.push('\n');
+                out.push_str(&emit_observer_params(&input).map_err(macro_error)?);
+            }
+            out.push('\n');
+            out.push_str(&emit_kalman_macro(&input).map_err(macro_error)?);
             type Emitter = fn(&ObserverInput) -> Result<String, ObserverError>;
             let kinds: [(Estimator, &str, &str, Emitter); 2] = [
                 (Estimator::Ekf, "ekf", "The extended Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).", emit_ekf),
@@ -437,10 +452,15 @@ impl Design {
                 file: d.source.file_name.clone(),
             });
         };
+        // the stops join the parameters of `params!` (the observers read them there)
+        let mut graph = self.model.graph.clone();
+        let mut params = self.model.params.clone();
+        params.add(&mut graph, "z_min", d.mechanics.z_min);
+        params.add(&mut graph, "z_max", d.mechanics.z_max);
         let input = ControllerInput {
             name: &d.name,
-            graph: &self.model.graph,
-            params: self.model.params.iter().collect(),
+            graph: &graph,
+            params: params.iter().collect(),
             states: [
                 self.model.states[0],
                 self.model.states[1],
