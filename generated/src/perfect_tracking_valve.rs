@@ -2039,7 +2039,8 @@ macro_rules! kalman {
         /// the initial σ (at rest: v = 0 is known), each with q_z² added so that P₀ is positive
         /// definite. The unscented transform's weights W₀ᵐ = λ/(n + λ), W₀ᶜ = W₀ᵐ + 1 − α² + β,
         /// Wᵢ = 1/(2·(n + λ)); γ = √(n + λ) and chol P₀ are evaluated when generated (they
-        /// change with α, κ and the initial σ).
+        /// change with α, κ and the initial σ; in f32 the f64 text rounds to the nearest f32).
+        #[allow(clippy::excessive_precision)]
         pub const SETTINGS: reldesign_runtime::observe::Settings<$f, 3> = reldesign_runtime::observe::Settings {
             sample_period: T_S,
             z_min: Z_MIN,
