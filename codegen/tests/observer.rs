@@ -563,3 +563,37 @@ fn emitted_filters_compile_pass_clippy_and_match_the_designer() {
     }
     assert!(lines.next().is_none());
 }
+
+/// Through the build (`codegen::Design`): a file declares `params!` (with
+/// the stops) and `kalman!` once, with a controller (whose emitter writes
+/// `params!`) and without one (the observers' own).
+#[test]
+fn the_build_declares_params_and_kalman_once() {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/perfect-tracking-valve.toml");
+    let text = std::fs::read_to_string(p).unwrap();
+    let physics = &text[..text.find("\n[trajectory]").unwrap()];
+    let observers = &text[text.find("\n[observer]").unwrap()..];
+    for (name, toml) in [
+        ("with a controller", text.clone()),
+        ("observers only", format!("{physics}\n{observers}")),
+    ] {
+        let d = parse_str(&toml, "valve.toml").unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(d.controller.is_some(), name == "with a controller");
+        let code = codegen::Design::new(&d).unwrap().emit().unwrap();
+        for (needle, count) in [
+            ("macro_rules! params {", 1),
+            ("macro_rules! kalman {", 1),
+            ("pub const Z_MIN: $f = 0.0;", 1),
+            ("pub const Z_MAX: $f = 0.001;", 1),
+            (
+                "params!(f32);",
+                if name == "observers only" { 2 } else { 3 },
+            ),
+            ("kalman!(f64);", 2),
+            ("pub mod ekf {", 1),
+            ("pub mod ukf {", 1),
+        ] {
+            assert_eq!(code.matches(needle).count(), count, "{name}: {needle}");
+        }
+    }
+}

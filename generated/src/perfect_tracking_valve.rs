@@ -2340,6 +2340,7 @@ pub mod ekf {
         }
 
         impl observe::DiscreteModel<f32, 3> for Model {
+            #[inline]
             fn acceleration(&mut self, x: &[f32; 3], u: f32, _t: f32) -> f32 {
                 let [z, z_prev, phi] = *x;
                 acceleration(z, z_prev, phi, u).accel
@@ -2347,6 +2348,7 @@ pub mod ekf {
         }
 
         impl observe::Linearised<f32, 3> for Model {
+            #[inline]
             fn transition(
                 &mut self,
                 x: &[f32; 3],
@@ -2370,6 +2372,7 @@ pub mod ekf {
                 }
             }
 
+            #[inline]
             fn measurement(
                 &mut self,
                 x: &[f32; 3],
@@ -2649,6 +2652,7 @@ pub mod ekf {
         }
 
         impl observe::DiscreteModel<f64, 3> for Model {
+            #[inline]
             fn acceleration(&mut self, x: &[f64; 3], u: f64, _t: f64) -> f64 {
                 let [z, z_prev, phi] = *x;
                 acceleration(z, z_prev, phi, u).accel
@@ -2656,6 +2660,7 @@ pub mod ekf {
         }
 
         impl observe::Linearised<f64, 3> for Model {
+            #[inline]
             fn transition(
                 &mut self,
                 x: &[f64; 3],
@@ -2679,6 +2684,7 @@ pub mod ekf {
                 }
             }
 
+            #[inline]
             fn measurement(
                 &mut self,
                 x: &[f64; 3],
@@ -2864,6 +2870,7 @@ pub mod ukf {
         }
 
         impl observe::DiscreteModel<f32, 3> for Model {
+            #[inline]
             fn acceleration(&mut self, x: &[f32; 3], u: f32, _t: f32) -> f32 {
                 let [z, z_prev, phi] = *x;
                 acceleration(z, z_prev, phi, u).accel
@@ -2871,6 +2878,7 @@ pub mod ukf {
         }
 
         impl observe::Sampled<f32, 3> for Model {
+            #[inline]
             fn transition(&mut self, x: &[f32; 3], u: f32, _t: f32) -> Prediction<f32, 3> {
                 let [z, z_prev, phi] = *x;
                 let o = transition(z, z_prev, phi, u);
@@ -2880,12 +2888,14 @@ pub mod ukf {
                 }
             }
 
+            #[inline]
             fn measurement(&mut self, x: &[f32; 3], u: f32, _t: f32) -> Reading<f32> {
                 let [z, z_prev, phi] = *x;
                 let m = measurement(z, z_prev, phi, u);
                 Reading { y: m.i, dy_du: m.di_du }
             }
 
+            #[inline]
             fn input_gain(&mut self, x: &[f32; 3], u: f32, _t: f32) -> [f32; 3] {
                 let [z, z_prev, phi] = *x;
                 let g = input_gain(z, z_prev, phi, u);
@@ -3064,6 +3074,7 @@ pub mod ukf {
         }
 
         impl observe::DiscreteModel<f64, 3> for Model {
+            #[inline]
             fn acceleration(&mut self, x: &[f64; 3], u: f64, _t: f64) -> f64 {
                 let [z, z_prev, phi] = *x;
                 acceleration(z, z_prev, phi, u).accel
@@ -3071,6 +3082,7 @@ pub mod ukf {
         }
 
         impl observe::Sampled<f64, 3> for Model {
+            #[inline]
             fn transition(&mut self, x: &[f64; 3], u: f64, _t: f64) -> Prediction<f64, 3> {
                 let [z, z_prev, phi] = *x;
                 let o = transition(z, z_prev, phi, u);
@@ -3080,12 +3092,14 @@ pub mod ukf {
                 }
             }
 
+            #[inline]
             fn measurement(&mut self, x: &[f64; 3], u: f64, _t: f64) -> Reading<f64> {
                 let [z, z_prev, phi] = *x;
                 let m = measurement(z, z_prev, phi, u);
                 Reading { y: m.i, dy_du: m.di_du }
             }
 
+            #[inline]
             fn input_gain(&mut self, x: &[f64; 3], u: f64, _t: f64) -> [f64; 3] {
                 let [z, z_prev, phi] = *x;
                 let g = input_gain(z, z_prev, phi, u);

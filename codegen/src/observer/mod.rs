@@ -284,14 +284,14 @@ fn model_impl(
                 quote!(observe::Ekf<Model, #ty, #dim>),
                 quote! {
                     impl observe::Linearised<#ty, #dim> for Model {
-                        fn transition(#args) -> Linearisation<#ty, #dim> {
+                        #[inline] fn transition(#args) -> Linearisation<#ty, #dim> {
                             #states
                             let o = transition(#call);
                             let prediction = #prediction;
                             Linearisation { prediction, f_x: [#(#rows),*], g: #g }
                         }
 
-                        fn measurement(#args) -> (Reading<#ty>, [#ty; #dim]) {
+                        #[inline] fn measurement(#args) -> (Reading<#ty>, [#ty; #dim]) {
                             #states
                             let m = measurement(#call);
                             (#reading, #h)
@@ -305,7 +305,7 @@ fn model_impl(
             let g = vector_tokens(&layout.gain, &g_out, float)?;
             let input_gain = match &layout.input_gain {
                 Some(_) => quote! {
-                    fn input_gain(#args) -> [#ty; #dim] {
+                    #[inline] fn input_gain(#args) -> [#ty; #dim] {
                         #states
                         let g = input_gain(#call);
                         #g
@@ -323,13 +323,13 @@ fn model_impl(
                 quote!(observe::Ukf<Model, #ty, #dim, #points>),
                 quote! {
                     impl observe::Sampled<#ty, #dim> for Model {
-                        fn transition(#args) -> Prediction<#ty, #dim> {
+                        #[inline] fn transition(#args) -> Prediction<#ty, #dim> {
                             #states
                             let o = transition(#call);
                             #prediction
                         }
 
-                        fn measurement(#args) -> Reading<#ty> {
+                        #[inline] fn measurement(#args) -> Reading<#ty> {
                             #states
                             let m = measurement(#call);
                             #reading
@@ -362,7 +362,7 @@ fn model_impl(
         }
 
         impl observe::DiscreteModel<#ty, #dim> for Model {
-            fn acceleration(#args) -> #ty {
+            #[inline] fn acceleration(#args) -> #ty {
                 #states
                 acceleration(#call).accel
             }
