@@ -89,12 +89,12 @@ impl<M: Linearised<T, N>, T: Scalar, const N: usize> Ekf<M, T, N> {
         let held = self.post.hold(u, &s);
         let u = held.u;
 
-        // (84) from the last posterior: x = F(x, u), P = F_x·P·F_xᵀ + Q
+        // [JA 84] from the last posterior: x = F(x, u), P = F_x·P·F_xᵀ + Q
         let mut lin = self.model.transition(&self.post.x, u, held.t);
         let pred = &mut lin.prediction;
         let mode = mode_of(first(&self.post.x), &s);
         if let Some(stop) = resting_stop(mode, pred.accel, first(&pred.next), &s) {
-            // on a stop, or reaching it: the prediction keeps z = the stop
+            // [JA 86] on a stop, or reaching it: the prediction keeps z = the stop
             if let (Some(zn), Some(row)) = (pred.next.first_mut(), lin.f_x.first_mut()) {
                 *zn = stop;
                 *row = [T::ZERO; N];

@@ -184,6 +184,7 @@ impl<T: Scalar, const N: usize> Posterior<T, N> {
             [z, z_prev, phi, ..] => [*z, *z_prev, *phi],
             _ => [T::ZERO; 3],
         };
+        // [JA 86] the mode, [JA 87] a = f_v in mode 2, [JA 85] v below
         let mode = mode_of(z, s);
         let a = if mode == 2 {
             model.acceleration(&x, u, self.now)

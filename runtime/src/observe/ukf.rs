@@ -124,6 +124,7 @@ impl<M: Sampled<T, N>, T: Jitter, const N: usize, const P: usize> Ukf<M, T, N, P
         let pts: [[T; N]; P] = self.sigma_points(s);
         let mut next = pts;
         let (mut accel, mut z_next) = (T::ZERO, T::ZERO);
+        // [JA 84] every sigma point through F
         for (k, (nk, pt)) in next.iter_mut().zip(&pts).enumerate() {
             let o = self.model.transition(pt, u, t);
             *nk = o.next;
@@ -135,7 +136,7 @@ impl<M: Sampled<T, N>, T: Jitter, const N: usize, const P: usize> Ukf<M, T, N, P
         }
         let z = first(&self.post.x);
         if let Some(stop) = resting_stop(mode_of(z, s), accel, z_next, s) {
-            // on a stop, or reaching it: every point keeps z = the stop
+            // [JA 86] on a stop, or reaching it: every point keeps z = the stop
             for z in next.iter_mut().filter_map(|nk| nk.first_mut()) {
                 *z = stop;
             }

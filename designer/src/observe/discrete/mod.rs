@@ -82,6 +82,13 @@
 //! not at all, and the mean of the truncated spread hovers ≈ γ·σ_z off the
 //! stop in mode 2 with a spurious velocity towards it. Only q_z then remains
 //! of the position's uncertainty.
+//!
+//! | file | concept |
+//! | --- | --- |
+//! | `mod.rs` | the model (84)–(87) in the symbolic core, its Jacobians, the runtime filters' settings |
+//! | `settings.rs` | `[observer.kalman]`: [`KalmanSettings`], [`ResistanceSettings`], [`KalmanError`] |
+//! | `tapes.rs` | the model on tapes, and [`TapeModel`]: the runtime's model traits for the reference filters |
+//! | `estimate.rs` | the designer's [`Estimate`] |
 
 mod estimate;
 mod settings;
