@@ -235,6 +235,56 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
     Ok(text)
 }
 
+/// The pieces every trait method of the emitted `Model` is written with.
+struct Method {
+    ty: Ident,
+    dim: Literal,
+    /// `&mut self, x: &[f32; 3], u: f32, t: f32` (`_t` when the model does
+    /// not read t).
+    args: TokenStream,
+    /// `let [z, z_prev, phi] = *x;`
+    states: TokenStream,
+    /// The model function's arguments: `z, z_prev, phi, u(, t)`.
+    call: TokenStream,
+    /// `Prediction { … }` from the transition's outputs `o`.
+    prediction: TokenStream,
+    /// `Reading { … }` from the measurement's outputs `m`.
+    reading: TokenStream,
+}
+
+impl Method {
+    fn new(dm: &DiscreteModel, layout: &Layout, float: Float) -> Method {
+        let ty = float.ty();
+        let dim = Literal::usize_unsuffixed(layout.n);
+        let names: Vec<Ident> = state_names(dm)
+            .iter()
+            .map(|s| format_ident!("{}", s.name))
+            .collect();
+        let (t, t_arg) = if dm.uses_time {
+            (format_ident!("t"), quote!(, t))
+        } else {
+            (format_ident!("_t"), quote!())
+        };
+        let next = state_names(dm).into_iter().map(|s| {
+            let f = format_ident!("{}_next", s.short);
+            quote!(o.#f)
+        });
+        let (y, dy_du) = (
+            format_ident!("{}", layout.y),
+            format_ident!("d{}_du", layout.y),
+        );
+        Method {
+            args: quote!(&mut self, x: &[#ty; #dim], u: #ty, #t: #ty),
+            states: quote!(let [#(#names),*] = *x;),
+            call: quote!(#(#names),*, u #t_arg),
+            prediction: quote!(Prediction { next: [#(#next),*], accel: o.accel }),
+            reading: quote!(Reading { y: m.#y, dy_du: m.#dy_du }),
+            ty,
+            dim,
+        }
+    }
+}
+
 /// The zero-sized `Model` implementing the runtime's traits with the model
 /// functions, and the `Filter` and `Estimate` types.
 fn model_impl(
@@ -243,114 +293,33 @@ fn model_impl(
     kind: Kind,
     float: Float,
 ) -> Result<TokenStream, ObserverError> {
-    let ty = float.ty();
-    let n = layout.n;
-    let dim = Literal::usize_unsuffixed(n);
-    let names: Vec<Ident> = state_names(dm)
-        .iter()
-        .map(|s| format_ident!("{}", s.name))
-        .collect();
-    let (t, t_arg) = if dm.uses_time {
-        (format_ident!("t"), quote!(, t))
-    } else {
-        (format_ident!("_t"), quote!())
-    };
-    // `x: &[f32; 3], u: f32, t: f32`, x's entries and the call's arguments
-    let args = quote!(&mut self, x: &[#ty; #dim], u: #ty, #t: #ty);
-    let states = quote!(let [#(#names),*] = *x;);
-    let call = quote!(#(#names),*, u #t_arg);
-    let (o, m) = (format_ident!("o"), format_ident!("m"));
-    let next: Vec<TokenStream> = state_names(dm)
-        .iter()
-        .map(|s| {
-            let f = format_ident!("{}_next", s.short);
-            quote!(o.#f)
-        })
-        .collect();
-    let prediction = quote!(Prediction { next: [#(#next),*], accel: o.accel });
-    let y = format_ident!("{}", layout.y);
-    let dy_du = format_ident!("d{}_du", layout.y);
-    let reading = quote!(Reading { y: m.#y, dy_du: m.#dy_du });
-    let (filter, model_trait) = match kind {
-        Kind::Ekf => {
-            let rows = layout
-                .jacobian
-                .iter()
-                .map(|row| vector_tokens(row, &o, float))
-                .collect::<Result<Vec<_>, _>>()?;
-            let g = vector_tokens(&layout.gain, &o, float)?;
-            let h = vector_tokens(&layout.h_row, &m, float)?;
-            (
-                quote!(observe::Ekf<Model, #ty, #dim>),
-                quote! {
-                    impl observe::Linearised<#ty, #dim> for Model {
-                        #[inline] fn transition(#args) -> Linearisation<#ty, #dim> {
-                            #states
-                            let o = transition(#call);
-                            let prediction = #prediction;
-                            Linearisation { prediction, f_x: [#(#rows),*], g: #g }
-                        }
-
-                        #[inline] fn measurement(#args) -> (Reading<#ty>, [#ty; #dim]) {
-                            #states
-                            let m = measurement(#call);
-                            (#reading, #h)
-                        }
-                    }
-                },
-            )
-        }
+    let f = Method::new(dm, layout, float);
+    let (ty, dim) = (&f.ty, &f.dim);
+    let (filter, model_trait, what) = match kind {
+        Kind::Ekf => (
+            quote!(observe::Ekf<Model, #ty, #dim>),
+            linearised_impl(&f, layout, float)?,
+            "extended",
+        ),
         Kind::Ukf => {
-            let g_out = format_ident!("g");
-            let g = vector_tokens(&layout.gain, &g_out, float)?;
-            let input_gain = match &layout.input_gain {
-                Some(_) => quote! {
-                    #[inline] fn input_gain(#args) -> [#ty; #dim] {
-                        #states
-                        let g = input_gain(#call);
-                        #g
-                    }
-                },
-                // every entry constant
-                None => quote! {
-                    fn input_gain(&mut self, _: &[#ty; #dim], _: #ty, _: #ty) -> [#ty; #dim] {
-                        #g
-                    }
-                },
-            };
-            let points = Literal::usize_unsuffixed(2 * n + 1);
+            let points = Literal::usize_unsuffixed(2 * layout.n + 1);
             (
                 quote!(observe::Ukf<Model, #ty, #dim, #points>),
-                quote! {
-                    impl observe::Sampled<#ty, #dim> for Model {
-                        #[inline] fn transition(#args) -> Prediction<#ty, #dim> {
-                            #states
-                            let o = transition(#call);
-                            #prediction
-                        }
-
-                        #[inline] fn measurement(#args) -> Reading<#ty> {
-                            #states
-                            let m = measurement(#call);
-                            #reading
-                        }
-
-                        #input_gain
-                    }
-                },
+                sampled_impl(&f, layout, float)?,
+                "unscented",
             )
         }
     };
-    let kind_doc = match kind {
-        Kind::Ekf => " The extended Kalman filter on [`Model`] (see the module docs).",
-        Kind::Ukf => " The unscented Kalman filter on [`Model`] (see the module docs).",
-    };
+    let kind_doc = format!(" The {what} Kalman filter on [`Model`] (see the module docs).");
     let y_doc = if dm.drive == Drive::Voltage {
         " the measured coil voltage held over the last sample, y = i the coil current now."
     } else {
         " the measured coil current held over the last sample, y = u_coil the coil voltage now."
     };
     let step_doc = format!(" `Filter::step(u, y)`: u is{y_doc}");
+    let Method {
+        args, states, call, ..
+    } = &f;
     Ok(quote! {
         /// The discretised model: the functions above, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
@@ -376,5 +345,93 @@ fn model_impl(
 
         /// What [`Filter`] reports at each sample.
         pub type Estimate = observe::Estimate<#ty>;
+    })
+}
+
+/// The EKF's model: F with ∂F/∂x and g, h with ∂h/∂x (constant entries as
+/// literals).
+fn linearised_impl(
+    f: &Method,
+    layout: &Layout,
+    float: Float,
+) -> Result<TokenStream, ObserverError> {
+    let (o, m) = (format_ident!("o"), format_ident!("m"));
+    let rows = layout
+        .jacobian
+        .iter()
+        .map(|row| vector_tokens(row, &o, float))
+        .collect::<Result<Vec<_>, _>>()?;
+    let g = vector_tokens(&layout.gain, &o, float)?;
+    let h = vector_tokens(&layout.h_row, &m, float)?;
+    let Method {
+        ty,
+        dim,
+        args,
+        states,
+        call,
+        prediction,
+        reading,
+    } = f;
+    Ok(quote! {
+        impl observe::Linearised<#ty, #dim> for Model {
+            #[inline] fn transition(#args) -> Linearisation<#ty, #dim> {
+                #states
+                let o = transition(#call);
+                let prediction = #prediction;
+                Linearisation { prediction, f_x: [#(#rows),*], g: #g }
+            }
+
+            #[inline] fn measurement(#args) -> (Reading<#ty>, [#ty; #dim]) {
+                #states
+                let m = measurement(#call);
+                (#reading, #h)
+            }
+        }
+    })
+}
+
+/// The UKF's model: F, h and g (a constant g without a function).
+fn sampled_impl(f: &Method, layout: &Layout, float: Float) -> Result<TokenStream, ObserverError> {
+    let g = vector_tokens(&layout.gain, &format_ident!("g"), float)?;
+    let Method {
+        ty,
+        dim,
+        args,
+        states,
+        call,
+        prediction,
+        reading,
+    } = f;
+    let input_gain = match &layout.input_gain {
+        Some(_) => quote! {
+            #[inline] fn input_gain(#args) -> [#ty; #dim] {
+                #states
+                let g = input_gain(#call);
+                #g
+            }
+        },
+        // every entry constant
+        None => quote! {
+            fn input_gain(&mut self, _: &[#ty; #dim], _: #ty, _: #ty) -> [#ty; #dim] {
+                #g
+            }
+        },
+    };
+    Ok(quote! {
+        impl observe::Sampled<#ty, #dim> for Model {
+            #[inline] fn transition(#args) -> Prediction<#ty, #dim> {
+                #states
+                let o = transition(#call);
+                #prediction
+            }
+
+            #[inline] fn measurement(#args) -> Reading<#ty> {
+                #states
+                let m = measurement(#call);
+                #reading
+            }
+
+            #input_gain
+        }
     })
 }

@@ -41,12 +41,9 @@ pub(super) const KALMAN_CONSTS: &[&str] = &[
 /// The placeholder of the float type while the items are formatted.
 const FLOAT: &str = "MacroFloatType";
 
-/// `macro_rules! kalman` for `input` (the model's dimension and settings):
-/// invoked as `kalman!(f64)` / `kalman!(f32)` in every EKF and UKF module.
-pub fn emit_kalman_macro(input: &ObserverInput) -> Result<String, ObserverError> {
-    let dm = input.discrete;
+/// The settings as (const name, value, doc), in the order of the macro.
+fn named_settings(dm: &DiscreteModel) -> Vec<(&'static str, f64, &'static str)> {
     let s = &dm.settings;
-    let f = Ident::new(FLOAT, Span::call_site());
     let mut settings: Vec<(&str, f64, &str)> = vec![
         ("T_S", s.sample_period, "T_s [s]: the sample period."),
         (
@@ -103,8 +100,16 @@ pub fn emit_kalman_macro(input: &ObserverInput) -> Result<String, ObserverError>
         ),
         ("UKF_KAPPA", s.ukf_kappa, "κ of the unscented transform."),
     ]);
+    settings
+}
+
+/// `macro_rules! kalman` for `input` (the model's dimension and settings):
+/// invoked as `kalman!(f64)` / `kalman!(f32)` in every EKF and UKF module.
+pub fn emit_kalman_macro(input: &ObserverInput) -> Result<String, ObserverError> {
+    let dm = input.discrete;
+    let f = Ident::new(FLOAT, Span::call_site());
     let mut items = TokenStream::new();
-    for (name, value, doc) in settings {
+    for (name, value, doc) in named_settings(dm) {
         let id = Ident::new(name, Span::call_site());
         let v = lit(Float::F64, name, value)?;
         let docs = doc_attrs(doc);
