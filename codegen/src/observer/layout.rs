@@ -131,145 +131,145 @@ pub(super) struct Layout {
     pub(super) h_row: Vec<Entry>,
 }
 
+/// `(84a)`… : the doc of F's output for a state.
+fn next_doc(k: StateKind) -> &'static str {
+    match k {
+        StateKind::Position => "(84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)",
+        StateKind::PreviousPosition => "(84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)",
+        StateKind::Flux => "(84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)",
+        StateKind::CoreField => "(84d) H_c,{k+1} = H_c + T_s·f_Hc(z, φ, H_c, u)",
+        StateKind::Resistance => "R_{k+1} = R (random walk)",
+    }
+}
+
+const ACCEL_DOC: &str = "(87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)";
+
+/// `transition` (with ∂F/∂x and g for the EKF), the entries of ∂F/∂x (EKF)
+/// and of g, and the UKF's `input_gain` (none when g is constant).
+fn transition(
+    dm: &DiscreteModel,
+    kind: Kind,
+) -> (Function, Vec<Vec<Entry>>, Vec<Entry>, Option<Function>) {
+    let g = &dm.graph;
+    let names = state_names(dm);
+    let mut outputs: Vec<(String, Id, String)> = names
+        .iter()
+        .zip(&dm.transition)
+        .zip(&dm.kinds)
+        .map(|((s, &id), &k)| (format!("{}_next", s.short), id, next_doc(k).to_owned()))
+        .collect();
+    outputs.push(("accel".to_owned(), dm.acceleration, ACCEL_DOC.to_owned()));
+    let mut jacobian = Vec::new();
+    if kind == Kind::Ekf {
+        for (si, row_ids) in names.iter().zip(&dm.transition_jacobian) {
+            let row = names
+                .iter()
+                .zip(row_ids)
+                .map(|(sj, &id)| {
+                    let name = format!("d{}_d{}", si.short, sj.short);
+                    let doc = format!("∂{}_{{k+1}}/∂{}", si.doc, sj.doc);
+                    entry(g, &mut outputs, name, id, doc)
+                })
+                .collect();
+            jacobian.push(row);
+        }
+    }
+    // g: outputs of `transition` (EKF) or of `input_gain` (UKF)
+    let mut gain_outputs = Vec::new();
+    let target = match kind {
+        Kind::Ekf => &mut outputs,
+        Kind::Ukf => &mut gain_outputs,
+    };
+    let gain = names
+        .iter()
+        .zip(&dm.input_gain)
+        .map(|(s, &id)| {
+            let doc = format!("g = ∂{}_{{k+1}}/∂u (maps the input's noise into Q)", s.doc);
+            entry(g, target, format!("d{}_du", s.short), id, doc)
+        })
+        .collect();
+    let input_gain = (kind == Kind::Ukf && !gain_outputs.is_empty()).then(|| Function {
+        name: "input_gain",
+        doc: "g = ∂F/∂u of the transition (84): the input's noise σ_u enters the process\n\
+              noise as σ_u²·g·gᵀ. Entries not listed are constant."
+            .to_owned(),
+        outputs: gain_outputs,
+    });
+    let doc = match kind {
+        Kind::Ekf => {
+            "The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held\n\
+             over the sample, the acceleration f_v of (87), and the symbolic Jacobians\n\
+             ∂F/∂x and g = ∂F/∂u (entries not listed are constant)."
+        }
+        Kind::Ukf => {
+            "The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held\n\
+             over the sample, and the acceleration f_v of (87)."
+        }
+    };
+    let function = Function {
+        name: "transition",
+        doc: doc.to_owned(),
+        outputs,
+    };
+    (function, jacobian, gain, input_gain)
+}
+
+/// `measurement` (y, ∂y/∂u, and ∂y/∂x for the EKF) and the entries of ∂h/∂x.
+fn measurement(dm: &DiscreteModel, kind: Kind, y: &str) -> (Function, Vec<Entry>) {
+    let y_doc = if dm.drive == Drive::Voltage {
+        "i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))"
+    } else {
+        "u_coil = R·u + N·f_φ, the coil voltage (eq. 1)"
+    };
+    let mut outputs = vec![
+        (y.to_owned(), dm.measurement, y_doc.to_owned()),
+        (
+            format!("d{y}_du"),
+            dm.measurement_input_gain,
+            format!("∂{y}/∂u (the input's noise in the measurement variance)"),
+        ),
+    ];
+    let mut h_row = Vec::new();
+    if kind == Kind::Ekf {
+        for (s, &id) in state_names(dm).iter().zip(&dm.measurement_jacobian) {
+            let (name, doc) = (format!("d{y}_d{}", s.short), format!("H = ∂{y}/∂{}", s.doc));
+            h_row.push(entry(&dm.graph, &mut outputs, name, id, doc));
+        }
+    }
+    let doc = match kind {
+        Kind::Ekf => {
+            "The measured quantity y = h(x, u) on the model's domain and its derivatives\n\
+             (entries of ∂h/∂x not listed are constant)."
+        }
+        Kind::Ukf => "The measured quantity y = h(x, u) on the model's domain and ∂h/∂u.",
+    };
+    let function = Function {
+        name: "measurement",
+        doc: doc.to_owned(),
+        outputs,
+    };
+    (function, h_row)
+}
+
 impl Layout {
     pub(super) fn new(dm: &DiscreteModel, kind: Kind) -> Layout {
-        let g = &dm.graph;
-        let n = dm.dim();
-        let voltage_drive = dm.drive == Drive::Voltage;
-        let y = if voltage_drive { "i" } else { "u_coil" }.to_owned();
-        let names = state_names(dm);
-        let next_doc = |k: StateKind| {
-            match k {
-            StateKind::Position => "(84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)",
-            StateKind::PreviousPosition => "(84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)",
-            StateKind::Flux => "(84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)",
-            StateKind::CoreField => "(84d) H_c,{k+1} = H_c + T_s·f_Hc(z, φ, H_c, u)",
-            StateKind::Resistance => "R_{k+1} = R (random walk)",
-        }
-        };
-        let mut outputs = Vec::new();
-        for i in 0..n {
-            outputs.push((
-                format!("{}_next", names[i].short),
-                dm.transition[i],
-                next_doc(dm.kinds[i]).to_owned(),
-            ));
-        }
-        outputs.push((
-            "accel".to_owned(),
-            dm.acceleration,
-            "(87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)".to_owned(),
-        ));
-        let mut jacobian = Vec::new();
-        let mut gain = Vec::new();
-        let mut input_gain = None;
-        if kind == Kind::Ekf {
-            for i in 0..n {
-                let mut row = Vec::new();
-                for j in 0..n {
-                    row.push(entry(
-                        g,
-                        &mut outputs,
-                        format!("d{}_d{}", names[i].short, names[j].short),
-                        dm.transition_jacobian[i][j],
-                        format!("∂{}_{{k+1}}/∂{}", names[i].doc, names[j].doc),
-                    ));
-                }
-                jacobian.push(row);
-            }
-        }
-        let mut gain_outputs = Vec::new();
-        {
-            let target = if kind == Kind::Ekf {
-                &mut outputs
-            } else {
-                &mut gain_outputs
-            };
-            for i in 0..n {
-                gain.push(entry(
-                    g,
-                    target,
-                    format!("d{}_du", names[i].short),
-                    dm.input_gain[i],
-                    format!(
-                        "g = ∂{}_{{k+1}}/∂u (maps the input's noise into Q)",
-                        names[i].doc
-                    ),
-                ));
-            }
-        }
-        if kind == Kind::Ukf && !gain_outputs.is_empty() {
-            input_gain = Some(Function {
-                name: "input_gain",
-                doc: "g = ∂F/∂u of the transition (84): the input's noise σ_u enters the process\n\
-                      noise as σ_u²·g·gᵀ. Entries not listed are constant."
-                    .to_owned(),
-                outputs: gain_outputs,
-            });
-        }
-        let transition = Function {
-            name: "transition",
-            doc: if kind == Kind::Ekf {
-                "The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held\n\
-                 over the sample, the acceleration f_v of (87), and the symbolic Jacobians\n\
-                 ∂F/∂x and g = ∂F/∂u (entries not listed are constant)."
-            } else {
-                "The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held\n\
-                 over the sample, and the acceleration f_v of (87)."
-            }
-            .to_owned(),
-            outputs,
-        };
-
-        let y_doc = if voltage_drive {
-            "i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))"
+        let y = if dm.drive == Drive::Voltage {
+            "i"
         } else {
-            "u_coil = R·u + N·f_φ, the coil voltage (eq. 1)"
-        };
-        let mut m_outputs = vec![
-            (y.clone(), dm.measurement, y_doc.to_owned()),
-            (
-                format!("d{y}_du"),
-                dm.measurement_input_gain,
-                format!("∂{y}/∂u (the input's noise in the measurement variance)"),
-            ),
-        ];
-        let mut h_row = Vec::new();
-        if kind == Kind::Ekf {
-            for j in 0..n {
-                h_row.push(entry(
-                    g,
-                    &mut m_outputs,
-                    format!("d{y}_d{}", names[j].short),
-                    dm.measurement_jacobian[j],
-                    format!("H = ∂{y}/∂{}", names[j].doc),
-                ));
-            }
+            "u_coil"
         }
-        let measurement = Function {
-            name: "measurement",
-            doc: if kind == Kind::Ekf {
-                "The measured quantity y = h(x, u) on the model's domain and its derivatives\n\
-                 (entries of ∂h/∂x not listed are constant)."
-            } else {
-                "The measured quantity y = h(x, u) on the model's domain and ∂h/∂u."
-            }
-            .to_owned(),
-            outputs: m_outputs,
-        };
+        .to_owned();
+        let (transition, jacobian, gain, input_gain) = transition(dm, kind);
+        let (measurement, h_row) = measurement(dm, kind, &y);
         let acceleration = Function {
             name: "acceleration",
             doc: "The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the\n\
                   estimate's a, at the posterior."
                 .to_owned(),
-            outputs: vec![(
-                "accel".to_owned(),
-                dm.acceleration,
-                "(87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)".to_owned(),
-            )],
+            outputs: vec![("accel".to_owned(), dm.acceleration, ACCEL_DOC.to_owned())],
         };
         Layout {
-            n,
+            n: dm.dim(),
             y,
             transition,
             measurement,
