@@ -4,7 +4,7 @@
 //! the designer's [`Estimate`] and 4-arrays.
 
 use reldesign_runtime::linalg::Matrix;
-use reldesign_runtime::observe::{self as rt, Jitter};
+use reldesign_runtime::observe as rt;
 
 use crate::model::Model;
 
@@ -22,10 +22,7 @@ pub trait Runtime<const N: usize>: Sized {
 
 macro_rules! runtime_impl {
     ($filter:ty, $($points:ident)?) => {
-        impl<const N: usize $(, const $points: usize)?> Runtime<N> for $filter
-        where
-            f64: Jitter,
-        {
+        impl<const N: usize $(, const $points: usize)?> Runtime<N> for $filter {
             fn build(model: TapeModel<N>) -> Self {
                 let settings = rt::Configured::settings(&model);
                 <$filter>::with_model(model, &settings)
