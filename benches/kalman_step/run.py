@@ -5,7 +5,8 @@ Usage: bash benches/kalman_step.sh [--n N] [--time-n N] [--runs R] [--reps R]
 
 The driver (benches/kalman_step/rust, its own workspace, cargo --release, target dir
 target/kalman_step) generates its filters in build.rs with codegen::emit_ekf and
-codegen::emit_ukf from examples/perfect-tracking-valve.toml (T_s = 50 µs, σ_v = 15 mV,
+codegen::emit_ukf (the runtime's reldesign_runtime::observe::{Ekf, Ukf} on the emitted
+model functions) from examples/perfect-tracking-valve.toml (T_s = 50 µs, σ_v = 15 mV,
 σ_i = 1 mA, the process noise of the observer tests) and a 400-sample noisy record of
 the valve driven open loop (closing with 24 V, opening with 0 V and a −24 V pulse,
 rest), simulated by the designer. Each kind runs `Filter::step` over the record,
@@ -87,7 +88,9 @@ def check():
 def instructions(kind, n, work):
     """(Ir per step, {function: self Ir per step}) from the 2N − N difference."""
     per_call, files = callgrind.difference(lambda calls: [BIN, kind, str(calls), "1"], n, work, kind)
-    return per_call, callgrind.self_costs_per_call(files, n, r"^kalman_step_bench::")
+    # the bench's and the runtime's paths left out of the names
+    strip = r"kalman_step_bench::valve::|reldesign_runtime::observe::|reldesign_runtime::"
+    return per_call, callgrind.self_costs_per_call(files, n, strip)
 
 
 def nanoseconds(n, runs, reps):

@@ -22,7 +22,10 @@ use crate::controller::{
     emit_controller, gains, params_macro, ControllerError, ControllerInput, OperationTable,
 };
 use crate::header::Header;
-use crate::observer::{emit_ekf, emit_ukf, wrap_module, ObserverError, ObserverInput};
+use crate::observer::{
+    emit_ekf, emit_kalman_macro, emit_observer_params, emit_ukf, wrap_module, ObserverError,
+    ObserverInput,
+};
 use crate::semera::{emit_semera, SemeraError, SemeraInput};
 use crate::Float;
 
@@ -375,8 +378,10 @@ impl Design {
             Some(c) => self.emit_controller(c)?,
             None => self.header(),
         };
-        // the estimators take N from `params!` (the controller's file has it already)
-        if self.controller.is_none() && SemeraInput::from_description(d).is_some() {
+        // the estimators take N from `params!` (the controller's file has it
+        // already, and the filters' `params!` below when there are filters)
+        let filters = d.observer.as_ref().is_some_and(|o| o.kalman.is_some());
+        if self.controller.is_none() && !filters && SemeraInput::from_description(d).is_some() {
             let params: Vec<_> = self.model.params.iter().collect();
             let text = params_macro(&d.name, &params).map_err(|source| BuildError::Emit {
                 file: file(),
@@ -409,6 +414,18 @@ impl Design {
                 discrete,
                 floats,
             };
+            let macro_error = |e: ObserverError| BuildError::Observer {
+                file: file(),
+                estimator: "ekf/ukf",
+                message: e.to_string(),
+            };
+            // the filters' `params!` (the controller's when there is one) and `kalman!`
+            if self.controller.is_none() {
+                out.push('\n');
+                out.push_str(&emit_observer_params(&input).map_err(macro_error)?);
+            }
+            out.push('\n');
+            out.push_str(&emit_kalman_macro(&input).map_err(macro_error)?);
             type Emitter = fn(&ObserverInput) -> Result<String, ObserverError>;
             let kinds: [(Estimator, &str, &str, Emitter); 2] = [
                 (Estimator::Ekf, "ekf", "The extended Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).", emit_ekf),
@@ -449,10 +466,15 @@ impl Design {
                 file: d.source.file_name.clone(),
             });
         };
+        // the stops join the parameters of `params!` (the observers read them there)
+        let mut graph = self.model.graph.clone();
+        let mut params = self.model.params.clone();
+        params.add(&mut graph, "z_min", d.mechanics.z_min);
+        params.add(&mut graph, "z_max", d.mechanics.z_max);
         let input = ControllerInput {
             name: &d.name,
-            graph: &self.model.graph,
-            params: self.model.params.iter().collect(),
+            graph: &graph,
+            params: params.iter().collect(),
             states: [
                 self.model.states[0],
                 self.model.states[1],

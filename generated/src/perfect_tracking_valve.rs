@@ -26,6 +26,10 @@ macro_rules! params {
         /// `c`
         pub const C: $f = 0.1;
         pub const F0: $f = -0.75;
+        /// `z_min`
+        pub const Z_MIN: $f = 0.0;
+        /// `z_max`
+        pub const Z_MAX: $f = 0.001;
     };
 }
 
@@ -1999,115 +2003,94 @@ pub mod f64 {
     }
 }
 
+/// The Kalman filters' settings of `perfect_tracking_valve` (`[observer]`, `[observer.kalman]`), one per
+/// line, and the filters' `Settings` derived from them; declared in each filter module
+/// as `kalman!(f64)` / `kalman!(f32)`.
+macro_rules! kalman {
+    ($f:ty) => {
+        /// T_s [s]: the sample period.
+        pub const T_S: $f = 1e-5;
+        /// σ_v [V]: standard deviation of the measured coil voltage's noise.
+        pub const VOLTAGE_NOISE: $f = 0.015;
+        /// σ_i [A]: standard deviation of the measured coil current's noise.
+        pub const CURRENT_NOISE: $f = 0.001;
+        /// σ of w_z [m] per sample (84a).
+        pub const PROCESS_Z: $f = 1e-9;
+        /// σ of w_φ [Wb] per sample (84c).
+        pub const PROCESS_PHI: $f = 3e-9;
+        /// Initial σ of z [m] (shared by z_prev: the filter starts at rest).
+        pub const INITIAL_Z_STD: $f = 1e-5;
+        /// Initial σ of φ [Wb].
+        pub const INITIAL_PHI_STD: $f = 1e-7;
+        /// α of the unscented transform (spread).
+        pub const UKF_ALPHA: $f = 1.0;
+        /// β of the unscented transform (prior knowledge; 2 for Gaussian).
+        pub const UKF_BETA: $f = 2.0;
+        /// κ of the unscented transform.
+        pub const UKF_KAPPA: $f = 0.0;
+        /// λ = α²·(n + κ) − n of the unscented transform, n = 3 states.
+        pub const UKF_LAMBDA: $f = UKF_ALPHA * UKF_ALPHA * (3.0 + UKF_KAPPA) - 3.0;
+        /// φ_lim [Wb]: the filters evaluate the saturating core at |φ| ≤ φ_lim (R_core is
+        /// infinite at φ_sat).
+        pub const PHI_LIM: $f = (1.0 - 0.001) * PHI_SAT;
+        /// The filters' settings. Mode band of (86): 3·q_z. Q = diag(q_z², 0, q_φ²(, q_Hc²)) +
+        /// σ_u²·g·gᵀ (g = ∂F/∂u: the measured input's noise), measurement variance
+        /// σ_y² + σ_u²·(∂h/∂u)². x₀: at rest at z_max, φ = 0(, H_c = 0). P₀: z and z_prev share
+        /// the initial σ (at rest: v = 0 is known), each with q_z² added so that P₀ is positive
+        /// definite. The unscented transform's weights W₀ᵐ = λ/(n + λ), W₀ᶜ = W₀ᵐ + 1 − α² + β,
+        /// Wᵢ = 1/(2·(n + λ)); γ = √(n + λ) and chol P₀ are evaluated when generated (they
+        /// change with α, κ and the initial σ; in f32 the f64 text rounds to the nearest f32).
+        #[allow(clippy::excessive_precision)]
+        pub const SETTINGS: reldesign_runtime::observe::Settings<$f, 3> = reldesign_runtime::observe::Settings {
+            sample_period: T_S,
+            z_min: Z_MIN,
+            z_max: Z_MAX,
+            mode_band: 3.0 * PROCESS_Z,
+            input_variance: VOLTAGE_NOISE * VOLTAGE_NOISE,
+            measurement_variance: CURRENT_NOISE * CURRENT_NOISE,
+            process_variance: [PROCESS_Z * PROCESS_Z, 0.0, PROCESS_PHI * PROCESS_PHI],
+            initial_state: [Z_MAX, Z_MAX, 0.0],
+            initial_covariance: [
+                [
+                    INITIAL_Z_STD * INITIAL_Z_STD + PROCESS_Z * PROCESS_Z,
+                    INITIAL_Z_STD * INITIAL_Z_STD,
+                    0.0,
+                ],
+                [
+                    INITIAL_Z_STD * INITIAL_Z_STD,
+                    INITIAL_Z_STD * INITIAL_Z_STD + PROCESS_Z * PROCESS_Z,
+                    0.0,
+                ],
+                [0.0, 0.0, INITIAL_PHI_STD * INITIAL_PHI_STD],
+            ],
+            field: None,
+            resistance: None,
+            unscented: reldesign_runtime::observe::Weights {
+                gamma: 1.7320508075688772,
+                mean0: UKF_LAMBDA / (3.0 + UKF_LAMBDA),
+                cov0: UKF_LAMBDA / (3.0 + UKF_LAMBDA) + (1.0 - UKF_ALPHA * UKF_ALPHA + UKF_BETA),
+                other: 0.5 / (3.0 + UKF_LAMBDA),
+            },
+            initial_factor: [
+                [1.000000005e-5, 0.0, 0.0],
+                [9.999999950000002e-6, 1.4142135536421423e-9, 0.0],
+                [0.0, 0.0, 1e-7],
+            ],
+        };
+    };
+}
+
 /// The extended Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).
 pub mod ekf {
     /// The extended Kalman filter of `perfect_tracking_valve` in f32, on the discretised model of
-    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ].
-    /// Update with the symbolic ∂h/∂x in Joseph form, prediction with the symbolic ∂F/∂x.
-    /// Process noise Q = diag(q_z², 0, q_φ²(, q_Hc²)) + σ_u²·g·gᵀ (g = ∂F/∂u: the
-    /// measured input's noise), measurement variance σ_y² + σ_u²·(∂h/∂u)². The model is
-    /// evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
+    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
+    /// below in `reldesign_runtime::observe::Ekf` (update with the symbolic ∂h/∂x in Joseph form,
+    /// prediction with the symbolic ∂F/∂x).
+    /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
     pub mod f32 {
-        use reldesign_runtime::linalg;
-
-        /// `A_gap`
-        pub const A_GAP: f32 = 2e-5;
-
-        /// `l_w`
-        pub const L_W: f32 = 0.015;
-
-        /// `R_core0`
-        pub const R_CORE0: f32 = 3000000.0;
-
-        /// `phi_sat`
-        pub const PHI_SAT: f32 = 2.5e-5;
-
-        pub const N: f32 = 1200.0;
-
-        pub const R: f32 = 75.0;
-
-        /// `k_e`
-        pub const K_E: f32 = 1500.0;
-
-        /// `m`
-        pub const M: f32 = 0.002;
-
-        /// `k_s`
-        pub const K_S: f32 = 50.0;
-
-        /// `c`
-        pub const C: f32 = 0.1;
-
-        pub const F0: f32 = -0.75;
-
-        /// `T_s`
-        pub const T_S: f32 = 1e-5;
-
-        /// `z_min`
-        pub const Z_MIN: f32 = 0.0;
-
-        /// `z_max`
-        pub const Z_MAX: f32 = 0.001;
-
-        /// `phi_lim`
-        pub const PHI_LIM: f32 = 2.4975e-5;
-
-        /// σ_v [V]: standard deviation of the measured coil voltage's noise.
-        pub const VOLTAGE_NOISE: f32 = 0.015;
-
-        /// σ_i [A]: standard deviation of the measured coil current's noise.
-        pub const CURRENT_NOISE: f32 = 0.001;
-
-        /// σ of w_z [m] per sample (84a).
-        pub const PROCESS_Z: f32 = 1e-9;
-
-        /// σ of w_φ [Wb] per sample (84c).
-        pub const PROCESS_PHI: f32 = 3e-9;
-
-        /// Initial σ of z [m] (shared by z_prev: the filter starts at rest).
-        pub const INITIAL_Z_STD: f32 = 1e-5;
-
-        /// Initial σ of φ [Wb].
-        pub const INITIAL_PHI_STD: f32 = 1e-7;
-
-        /// Number of states: x = [z, z_prev, φ].
-        pub const DIM: usize = 3;
-
-        /// σ_u²: variance of the measured input's noise.
-        pub const INPUT_VARIANCE: f32 = VOLTAGE_NOISE * VOLTAGE_NOISE;
-
-        /// σ_y²: variance of the measured output's noise.
-        pub const MEASUREMENT_VARIANCE: f32 = CURRENT_NOISE * CURRENT_NOISE;
-
-        /// diag(q_z², 0, q_φ²(, q_Hc²)): the part of the process noise Q that does not come
-        /// from the input (which adds σ_u²·g·gᵀ, g = ∂F/∂u).
-        pub const PROCESS_VARIANCE: [f32; 3] = [
-            PROCESS_Z * PROCESS_Z,
-            0.0,
-            PROCESS_PHI * PROCESS_PHI,
-        ];
-
-        /// x₀: at rest at z_max, φ = 0(, H_c = 0).
-        pub const INITIAL_STATE: [f32; 3] = [Z_MAX, Z_MAX, 0.0];
-
-        /// P₀: z and z_prev share the initial σ (at rest: v = 0 is known), each with q_z²
-        /// added so that P₀ is positive definite.
-        pub const INITIAL_COVARIANCE: [[f32; 3]; 3] = [
-            [
-                INITIAL_Z_STD * INITIAL_Z_STD + PROCESS_Z * PROCESS_Z,
-                INITIAL_Z_STD * INITIAL_Z_STD,
-                0.0,
-            ],
-            [
-                INITIAL_Z_STD * INITIAL_Z_STD,
-                INITIAL_Z_STD * INITIAL_Z_STD + PROCESS_Z * PROCESS_Z,
-                0.0,
-            ],
-            [0.0, 0.0, INITIAL_PHI_STD * INITIAL_PHI_STD],
-        ];
-
-        /// (86): the estimate rests on a stop when within this distance [m] of it.
-        pub const MODE_BAND: f32 = 3.0 * PROCESS_Z;
+        use reldesign_runtime::observe::{self, Linearisation, Prediction, Reading};
+        params!(f32);
+        kalman!(f32);
 
         /// Outputs of [`transition`].
         #[derive(Clone, Copy, Debug, PartialEq)]
@@ -2347,303 +2330,78 @@ pub mod ekf {
             AccelerationOutput { accel }
         }
 
-        /// The estimate at one sample: what the controllers consume.
+        /// The discretised model: the functions above, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Estimate {
-            /// z [m], in [z_min, z_max]
-            pub z: f32,
-            /// v [m/s] = (z − z_prev)/T_s (85)
-            pub v: f32,
-            /// a [m/s²] (87): f_v(z, v, φ) in mode 2, else 0
-            pub a: f32,
-            /// φ [Wb]
-            pub phi: f32,
-            /// q of (86): 1 at z_min, 2 moving, 3 at z_max (within `MODE_BAND` of a stop)
-            pub mode: u8,
+        pub struct Model;
+
+        impl observe::Stateless<f32, 3> for Model {
+            const MODEL: Self = Model;
+            const SETTINGS: observe::Settings<f32, 3> = SETTINGS;
         }
 
-        /// z projected onto [z_min, z_max] (a NaN stays NaN). Not `clamp`, which has a
-        /// panic path (for bounds out of order).
-        #[allow(clippy::manual_clamp)]
-        fn project(z: f32) -> f32 {
-            if z < Z_MIN { Z_MIN } else if z > Z_MAX { Z_MAX } else { z }
-        }
-
-        /// (86) with the band: 1 within `MODE_BAND` of z_min, 3 within it of z_max, else 2
-        /// (also for a NaN z).
-        fn mode_of(z: f32) -> u8 {
-            if z <= Z_MIN + MODE_BAND { 1 } else if z >= Z_MAX - MODE_BAND { 3 } else { 2 }
-        }
-
-        /// The stop the estimate stays on over the next sample: the free acceleration points
-        /// into a stop (the automaton's lift-off guard does not fire) and the estimate is on
-        /// it by its mode (86), or reaches it within the sample (its own prediction (84a)
-        /// `z_next` saturates there); the prediction then keeps z = the stop. A NaN
-        /// acceleration stays nowhere.
-        fn resting_stop(mode: u8, accel: f32, z_next: f32) -> Option<f32> {
-            if accel <= 0.0 && (mode == 1 || z_next == Z_MIN) {
-                Some(Z_MIN)
-            } else if accel >= 0.0 && (mode == 3 || z_next == Z_MAX) {
-                Some(Z_MAX)
-            } else {
-                None
+        impl observe::DiscreteModel<f32, 3> for Model {
+            #[inline]
+            fn acceleration(&mut self, x: &[f32; 3], u: f32, _t: f32) -> f32 {
+                let [z, z_prev, phi] = *x;
+                acceleration(z, z_prev, phi, u).accel
             }
         }
 
-        /// The extended Kalman filter (see the module docs). Allocation- and panic-free.
-        #[derive(Clone, Debug, PartialEq)]
-        pub struct Filter {
-            /// Posterior mean x_{k|k} of the last sample (x₀ before the first).
-            x: [f32; 3],
-            /// Its covariance.
-            p: [[f32; 3]; 3],
-            /// The last finite input.
-            u_last: f32,
-            skipped: u32,
-            repairs: u32,
-        }
-
-        impl Default for Filter {
-            fn default() -> Self {
-                Self::new()
-            }
-        }
-
-        impl Filter {
-            /// A filter at rest at z_max with φ = 0 (and H_c = 0): x₀, P₀.
-            #[must_use]
-            pub const fn new() -> Self {
-                Filter {
-                    x: INITIAL_STATE,
-                    p: INITIAL_COVARIANCE,
-                    u_last: 0.0,
-                    skipped: 0,
-                    repairs: 0,
-                }
-            }
-
-            /// One sample k: `u` is the measured coil voltage [V] held over the last sample (u_{k−1}, what
-            /// was applied since the previous call), `i` is the measured coil current [A] at t_k. Predicts
-            /// the prior from the last posterior with u, updates it with the measurement and
-            /// returns the posterior estimate, so that the controller acts on an estimate
-            /// without lag and the prediction uses the input actually applied. A non-finite
-            /// `u` is replaced by the last finite one and its update skipped; a non-finite
-            /// measurement skips the update.
-            pub fn step(&mut self, u: f32, i: f32) -> Estimate {
-                let u_ok = u.is_finite();
-                if u_ok {
-                    self.u_last = u;
-                }
-                // a non-finite input is replaced by the last finite one (and its update skipped)
-                let u = self.u_last;
-                let [z, z_prev, phi] = self.x;
-                // prediction (84) from the last posterior with u held over the last sample:
-                // x = F(x, u), P = F_x·P·F_xᵀ + Q
+        impl observe::Linearised<f32, 3> for Model {
+            #[inline]
+            fn transition(
+                &mut self,
+                x: &[f32; 3],
+                u: f32,
+                _t: f32,
+            ) -> Linearisation<f32, 3> {
+                let [z, z_prev, phi] = *x;
                 let o = transition(z, z_prev, phi, u);
-                // on a stop, or reaching it (f_v into it): the prediction keeps z = the stop
-                let resting = resting_stop(mode_of(z), o.accel, o.z_next);
-                let (next, f) = match resting {
-                    Some(stop) => {
-                        (
-                            [stop, o.zp_next, o.phi_next],
-                            [[0.0; 3], [o.dzp_dz, 0.0, 0.0], [o.dphi_dz, 0.0, o.dphi_dphi]],
-                        )
-                    }
-                    None => {
-                        (
-                            [o.z_next, o.zp_next, o.phi_next],
-                            [
-                                [o.dz_dz, o.dz_dzp, o.dz_dphi],
-                                [o.dzp_dz, 0.0, 0.0],
-                                [o.dphi_dz, 0.0, o.dphi_dphi],
-                            ],
-                        )
-                    }
+                let prediction = Prediction {
+                    next: [o.z_next, o.zp_next, o.phi_next],
+                    accel: o.accel,
                 };
-                let mut p = linalg::sandwich(&f, &self.p);
-                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
-                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, o.dphi_du]);
-                if linalg::all_finite(&next) && linalg::all_finite_matrix(&p) {
-                    self.x = next;
-                    self.p = p;
-                } else {
-                    // a non-finite prediction: restart from x₀, P₀ (counted)
-                    self.x = INITIAL_STATE;
-                    self.p = INITIAL_COVARIANCE;
-                    self.repairs = self.repairs.saturating_add(1);
-                }
-                // Measurement update, Joseph form (symmetric and positive semi-definite for any
-                // rounding of the gain). Skipped when u, the measurement, the innovation
-                // variance or the innovation is not finite: a NaN or ∞ never enters the state
-                // (where it would stay forever).
-                let mut updated = false;
-                if u_ok && i.is_finite() {
-                    let [z, z_prev, phi] = self.x;
-                    let m = measurement(z, z_prev, phi, u);
-                    let h = [m.di_dz, 0.0, m.di_dphi];
-                    let r = MEASUREMENT_VARIANCE + INPUT_VARIANCE * (m.di_du * m.di_du);
-                    let ph = linalg::mat_vec(&self.p, &h);
-                    let s = linalg::dot(&h, &ph) + r;
-                    let innovation = i - m.i;
-                    if innovation.is_finite() && s.is_finite() && s > 0.0 {
-                        let k = ph.map(|x| x / s);
-                        linalg::axpy(&mut self.x, innovation, &k);
-                        self.p = linalg::joseph_update(&self.p, &k, &h, r);
-                        updated = true;
-                    }
-                }
-                if !updated {
-                    self.skipped = self.skipped.saturating_add(1);
-                }
-                let [z, z_prev, phi] = self.x;
-                // the posterior: z and z_prev projected onto [z_min, z_max], mode (86)
-                let (z, z_prev) = (project(z), project(z_prev));
-                self.x = [z, z_prev, phi];
-                let mode = mode_of(z);
-                // the estimate (85)–(87) at the posterior; f_v of (87) only in mode 2
-                let a = if mode == 2 { acceleration(z, z_prev, phi, u).accel } else { 0.0 };
-                Estimate {
-                    z,
-                    v: (z - z_prev) / T_S,
-                    a,
-                    phi,
-                    mode,
+                Linearisation {
+                    prediction,
+                    f_x: [
+                        [o.dz_dz, o.dz_dzp, o.dz_dphi],
+                        [o.dzp_dz, 0.0, 0.0],
+                        [o.dphi_dz, 0.0, o.dphi_dphi],
+                    ],
+                    g: [0.0, 0.0, o.dphi_du],
                 }
             }
 
-            /// The posterior mean x_{k|k} (after the last `step`).
-            #[must_use]
-            pub const fn state(&self) -> [f32; 3] {
-                self.x
-            }
-
-            /// The posterior covariance.
-            #[must_use]
-            pub const fn covariance(&self) -> [[f32; 3]; 3] {
-                self.p
-            }
-
-            /// Samples whose measurement update was skipped (non-finite data).
-            #[must_use]
-            pub const fn skipped(&self) -> u32 {
-                self.skipped
-            }
-
-            /// Restarts after a non-finite prediction.
-            #[must_use]
-            pub const fn repairs(&self) -> u32 {
-                self.repairs
+            #[inline]
+            fn measurement(
+                &mut self,
+                x: &[f32; 3],
+                u: f32,
+                _t: f32,
+            ) -> (Reading<f32>, [f32; 3]) {
+                let [z, z_prev, phi] = *x;
+                let m = measurement(z, z_prev, phi, u);
+                (Reading { y: m.i, dy_du: m.di_du }, [m.di_dz, 0.0, m.di_dphi])
             }
         }
+
+        /// The extended Kalman filter on [`Model`] (see the module docs).
+        /// `Filter::step(u, y)`: u is the measured coil voltage held over the last sample, y = i the coil current now.
+        pub type Filter = observe::Ekf<Model, f32, 3>;
+
+        /// What [`Filter`] reports at each sample.
+        pub type Estimate = observe::Estimate<f32>;
     }
 
     /// The extended Kalman filter of `perfect_tracking_valve` in f64, on the discretised model of
-    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ].
-    /// Update with the symbolic ∂h/∂x in Joseph form, prediction with the symbolic ∂F/∂x.
-    /// Process noise Q = diag(q_z², 0, q_φ²(, q_Hc²)) + σ_u²·g·gᵀ (g = ∂F/∂u: the
-    /// measured input's noise), measurement variance σ_y² + σ_u²·(∂h/∂u)². The model is
-    /// evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
+    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
+    /// below in `reldesign_runtime::observe::Ekf` (update with the symbolic ∂h/∂x in Joseph form,
+    /// prediction with the symbolic ∂F/∂x).
+    /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
     pub mod f64 {
-        use reldesign_runtime::linalg;
-
-        /// `A_gap`
-        pub const A_GAP: f64 = 2e-5;
-
-        /// `l_w`
-        pub const L_W: f64 = 0.015;
-
-        /// `R_core0`
-        pub const R_CORE0: f64 = 3000000.0;
-
-        /// `phi_sat`
-        pub const PHI_SAT: f64 = 2.5e-5;
-
-        pub const N: f64 = 1200.0;
-
-        pub const R: f64 = 75.0;
-
-        /// `k_e`
-        pub const K_E: f64 = 1500.0;
-
-        /// `m`
-        pub const M: f64 = 0.002;
-
-        /// `k_s`
-        pub const K_S: f64 = 50.0;
-
-        /// `c`
-        pub const C: f64 = 0.1;
-
-        pub const F0: f64 = -0.75;
-
-        /// `T_s`
-        pub const T_S: f64 = 1e-5;
-
-        /// `z_min`
-        pub const Z_MIN: f64 = 0.0;
-
-        /// `z_max`
-        pub const Z_MAX: f64 = 0.001;
-
-        /// `phi_lim`
-        pub const PHI_LIM: f64 = 2.4975e-5;
-
-        /// σ_v [V]: standard deviation of the measured coil voltage's noise.
-        pub const VOLTAGE_NOISE: f64 = 0.015;
-
-        /// σ_i [A]: standard deviation of the measured coil current's noise.
-        pub const CURRENT_NOISE: f64 = 0.001;
-
-        /// σ of w_z [m] per sample (84a).
-        pub const PROCESS_Z: f64 = 1e-9;
-
-        /// σ of w_φ [Wb] per sample (84c).
-        pub const PROCESS_PHI: f64 = 3e-9;
-
-        /// Initial σ of z [m] (shared by z_prev: the filter starts at rest).
-        pub const INITIAL_Z_STD: f64 = 1e-5;
-
-        /// Initial σ of φ [Wb].
-        pub const INITIAL_PHI_STD: f64 = 1e-7;
-
-        /// Number of states: x = [z, z_prev, φ].
-        pub const DIM: usize = 3;
-
-        /// σ_u²: variance of the measured input's noise.
-        pub const INPUT_VARIANCE: f64 = VOLTAGE_NOISE * VOLTAGE_NOISE;
-
-        /// σ_y²: variance of the measured output's noise.
-        pub const MEASUREMENT_VARIANCE: f64 = CURRENT_NOISE * CURRENT_NOISE;
-
-        /// diag(q_z², 0, q_φ²(, q_Hc²)): the part of the process noise Q that does not come
-        /// from the input (which adds σ_u²·g·gᵀ, g = ∂F/∂u).
-        pub const PROCESS_VARIANCE: [f64; 3] = [
-            PROCESS_Z * PROCESS_Z,
-            0.0,
-            PROCESS_PHI * PROCESS_PHI,
-        ];
-
-        /// x₀: at rest at z_max, φ = 0(, H_c = 0).
-        pub const INITIAL_STATE: [f64; 3] = [Z_MAX, Z_MAX, 0.0];
-
-        /// P₀: z and z_prev share the initial σ (at rest: v = 0 is known), each with q_z²
-        /// added so that P₀ is positive definite.
-        pub const INITIAL_COVARIANCE: [[f64; 3]; 3] = [
-            [
-                INITIAL_Z_STD * INITIAL_Z_STD + PROCESS_Z * PROCESS_Z,
-                INITIAL_Z_STD * INITIAL_Z_STD,
-                0.0,
-            ],
-            [
-                INITIAL_Z_STD * INITIAL_Z_STD,
-                INITIAL_Z_STD * INITIAL_Z_STD + PROCESS_Z * PROCESS_Z,
-                0.0,
-            ],
-            [0.0, 0.0, INITIAL_PHI_STD * INITIAL_PHI_STD],
-        ];
-
-        /// (86): the estimate rests on a stop when within this distance [m] of it.
-        pub const MODE_BAND: f64 = 3.0 * PROCESS_Z;
+        use reldesign_runtime::observe::{self, Linearisation, Prediction, Reading};
+        params!(f64);
+        kalman!(f64);
 
         /// Outputs of [`transition`].
         #[derive(Clone, Copy, Debug, PartialEq)]
@@ -2884,341 +2642,81 @@ pub mod ekf {
             AccelerationOutput { accel }
         }
 
-        /// The estimate at one sample: what the controllers consume.
+        /// The discretised model: the functions above, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Estimate {
-            /// z [m], in [z_min, z_max]
-            pub z: f64,
-            /// v [m/s] = (z − z_prev)/T_s (85)
-            pub v: f64,
-            /// a [m/s²] (87): f_v(z, v, φ) in mode 2, else 0
-            pub a: f64,
-            /// φ [Wb]
-            pub phi: f64,
-            /// q of (86): 1 at z_min, 2 moving, 3 at z_max (within `MODE_BAND` of a stop)
-            pub mode: u8,
+        pub struct Model;
+
+        impl observe::Stateless<f64, 3> for Model {
+            const MODEL: Self = Model;
+            const SETTINGS: observe::Settings<f64, 3> = SETTINGS;
         }
 
-        /// z projected onto [z_min, z_max] (a NaN stays NaN). Not `clamp`, which has a
-        /// panic path (for bounds out of order).
-        #[allow(clippy::manual_clamp)]
-        fn project(z: f64) -> f64 {
-            if z < Z_MIN { Z_MIN } else if z > Z_MAX { Z_MAX } else { z }
-        }
-
-        /// (86) with the band: 1 within `MODE_BAND` of z_min, 3 within it of z_max, else 2
-        /// (also for a NaN z).
-        fn mode_of(z: f64) -> u8 {
-            if z <= Z_MIN + MODE_BAND { 1 } else if z >= Z_MAX - MODE_BAND { 3 } else { 2 }
-        }
-
-        /// The stop the estimate stays on over the next sample: the free acceleration points
-        /// into a stop (the automaton's lift-off guard does not fire) and the estimate is on
-        /// it by its mode (86), or reaches it within the sample (its own prediction (84a)
-        /// `z_next` saturates there); the prediction then keeps z = the stop. A NaN
-        /// acceleration stays nowhere.
-        fn resting_stop(mode: u8, accel: f64, z_next: f64) -> Option<f64> {
-            if accel <= 0.0 && (mode == 1 || z_next == Z_MIN) {
-                Some(Z_MIN)
-            } else if accel >= 0.0 && (mode == 3 || z_next == Z_MAX) {
-                Some(Z_MAX)
-            } else {
-                None
+        impl observe::DiscreteModel<f64, 3> for Model {
+            #[inline]
+            fn acceleration(&mut self, x: &[f64; 3], u: f64, _t: f64) -> f64 {
+                let [z, z_prev, phi] = *x;
+                acceleration(z, z_prev, phi, u).accel
             }
         }
 
-        /// The extended Kalman filter (see the module docs). Allocation- and panic-free.
-        #[derive(Clone, Debug, PartialEq)]
-        pub struct Filter {
-            /// Posterior mean x_{k|k} of the last sample (x₀ before the first).
-            x: [f64; 3],
-            /// Its covariance.
-            p: [[f64; 3]; 3],
-            /// The last finite input.
-            u_last: f64,
-            skipped: u32,
-            repairs: u32,
-        }
-
-        impl Default for Filter {
-            fn default() -> Self {
-                Self::new()
-            }
-        }
-
-        impl Filter {
-            /// A filter at rest at z_max with φ = 0 (and H_c = 0): x₀, P₀.
-            #[must_use]
-            pub const fn new() -> Self {
-                Filter {
-                    x: INITIAL_STATE,
-                    p: INITIAL_COVARIANCE,
-                    u_last: 0.0,
-                    skipped: 0,
-                    repairs: 0,
-                }
-            }
-
-            /// One sample k: `u` is the measured coil voltage [V] held over the last sample (u_{k−1}, what
-            /// was applied since the previous call), `i` is the measured coil current [A] at t_k. Predicts
-            /// the prior from the last posterior with u, updates it with the measurement and
-            /// returns the posterior estimate, so that the controller acts on an estimate
-            /// without lag and the prediction uses the input actually applied. A non-finite
-            /// `u` is replaced by the last finite one and its update skipped; a non-finite
-            /// measurement skips the update.
-            pub fn step(&mut self, u: f64, i: f64) -> Estimate {
-                let u_ok = u.is_finite();
-                if u_ok {
-                    self.u_last = u;
-                }
-                // a non-finite input is replaced by the last finite one (and its update skipped)
-                let u = self.u_last;
-                let [z, z_prev, phi] = self.x;
-                // prediction (84) from the last posterior with u held over the last sample:
-                // x = F(x, u), P = F_x·P·F_xᵀ + Q
+        impl observe::Linearised<f64, 3> for Model {
+            #[inline]
+            fn transition(
+                &mut self,
+                x: &[f64; 3],
+                u: f64,
+                _t: f64,
+            ) -> Linearisation<f64, 3> {
+                let [z, z_prev, phi] = *x;
                 let o = transition(z, z_prev, phi, u);
-                // on a stop, or reaching it (f_v into it): the prediction keeps z = the stop
-                let resting = resting_stop(mode_of(z), o.accel, o.z_next);
-                let (next, f) = match resting {
-                    Some(stop) => {
-                        (
-                            [stop, o.zp_next, o.phi_next],
-                            [[0.0; 3], [o.dzp_dz, 0.0, 0.0], [o.dphi_dz, 0.0, o.dphi_dphi]],
-                        )
-                    }
-                    None => {
-                        (
-                            [o.z_next, o.zp_next, o.phi_next],
-                            [
-                                [o.dz_dz, o.dz_dzp, o.dz_dphi],
-                                [o.dzp_dz, 0.0, 0.0],
-                                [o.dphi_dz, 0.0, o.dphi_dphi],
-                            ],
-                        )
-                    }
+                let prediction = Prediction {
+                    next: [o.z_next, o.zp_next, o.phi_next],
+                    accel: o.accel,
                 };
-                let mut p = linalg::sandwich(&f, &self.p);
-                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
-                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, o.dphi_du]);
-                if linalg::all_finite(&next) && linalg::all_finite_matrix(&p) {
-                    self.x = next;
-                    self.p = p;
-                } else {
-                    // a non-finite prediction: restart from x₀, P₀ (counted)
-                    self.x = INITIAL_STATE;
-                    self.p = INITIAL_COVARIANCE;
-                    self.repairs = self.repairs.saturating_add(1);
-                }
-                // Measurement update, Joseph form (symmetric and positive semi-definite for any
-                // rounding of the gain). Skipped when u, the measurement, the innovation
-                // variance or the innovation is not finite: a NaN or ∞ never enters the state
-                // (where it would stay forever).
-                let mut updated = false;
-                if u_ok && i.is_finite() {
-                    let [z, z_prev, phi] = self.x;
-                    let m = measurement(z, z_prev, phi, u);
-                    let h = [m.di_dz, 0.0, m.di_dphi];
-                    let r = MEASUREMENT_VARIANCE + INPUT_VARIANCE * (m.di_du * m.di_du);
-                    let ph = linalg::mat_vec(&self.p, &h);
-                    let s = linalg::dot(&h, &ph) + r;
-                    let innovation = i - m.i;
-                    if innovation.is_finite() && s.is_finite() && s > 0.0 {
-                        let k = ph.map(|x| x / s);
-                        linalg::axpy(&mut self.x, innovation, &k);
-                        self.p = linalg::joseph_update(&self.p, &k, &h, r);
-                        updated = true;
-                    }
-                }
-                if !updated {
-                    self.skipped = self.skipped.saturating_add(1);
-                }
-                let [z, z_prev, phi] = self.x;
-                // the posterior: z and z_prev projected onto [z_min, z_max], mode (86)
-                let (z, z_prev) = (project(z), project(z_prev));
-                self.x = [z, z_prev, phi];
-                let mode = mode_of(z);
-                // the estimate (85)–(87) at the posterior; f_v of (87) only in mode 2
-                let a = if mode == 2 { acceleration(z, z_prev, phi, u).accel } else { 0.0 };
-                Estimate {
-                    z,
-                    v: (z - z_prev) / T_S,
-                    a,
-                    phi,
-                    mode,
+                Linearisation {
+                    prediction,
+                    f_x: [
+                        [o.dz_dz, o.dz_dzp, o.dz_dphi],
+                        [o.dzp_dz, 0.0, 0.0],
+                        [o.dphi_dz, 0.0, o.dphi_dphi],
+                    ],
+                    g: [0.0, 0.0, o.dphi_du],
                 }
             }
 
-            /// The posterior mean x_{k|k} (after the last `step`).
-            #[must_use]
-            pub const fn state(&self) -> [f64; 3] {
-                self.x
-            }
-
-            /// The posterior covariance.
-            #[must_use]
-            pub const fn covariance(&self) -> [[f64; 3]; 3] {
-                self.p
-            }
-
-            /// Samples whose measurement update was skipped (non-finite data).
-            #[must_use]
-            pub const fn skipped(&self) -> u32 {
-                self.skipped
-            }
-
-            /// Restarts after a non-finite prediction.
-            #[must_use]
-            pub const fn repairs(&self) -> u32 {
-                self.repairs
+            #[inline]
+            fn measurement(
+                &mut self,
+                x: &[f64; 3],
+                u: f64,
+                _t: f64,
+            ) -> (Reading<f64>, [f64; 3]) {
+                let [z, z_prev, phi] = *x;
+                let m = measurement(z, z_prev, phi, u);
+                (Reading { y: m.i, dy_du: m.di_du }, [m.di_dz, 0.0, m.di_dphi])
             }
         }
+
+        /// The extended Kalman filter on [`Model`] (see the module docs).
+        /// `Filter::step(u, y)`: u is the measured coil voltage held over the last sample, y = i the coil current now.
+        pub type Filter = observe::Ekf<Model, f64, 3>;
+
+        /// What [`Filter`] reports at each sample.
+        pub type Estimate = observe::Estimate<f64>;
     }
 }
 
 /// The unscented Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).
 pub mod ukf {
     /// The unscented Kalman filter of `perfect_tracking_valve` in f32, on the discretised model of
-    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ].
-    /// Sigma points x̄ ± γ·(columns of chol P) through h and F; Cholesky failures
-    /// are repaired and counted.
-    /// Process noise Q = diag(q_z², 0, q_φ²(, q_Hc²)) + σ_u²·g·gᵀ (g = ∂F/∂u: the
-    /// measured input's noise), measurement variance σ_y² + σ_u²·(∂h/∂u)². The model is
-    /// evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
+    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
+    /// below in `reldesign_runtime::observe::Ukf` (sigma points x̄ ± γ·(columns of chol P) through h
+    /// and F; failed factorisations are repaired and counted).
+    /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
     pub mod f32 {
-        use reldesign_runtime::linalg;
-
-        /// `A_gap`
-        pub const A_GAP: f32 = 2e-5;
-
-        /// `l_w`
-        pub const L_W: f32 = 0.015;
-
-        /// `R_core0`
-        pub const R_CORE0: f32 = 3000000.0;
-
-        /// `phi_sat`
-        pub const PHI_SAT: f32 = 2.5e-5;
-
-        pub const N: f32 = 1200.0;
-
-        pub const R: f32 = 75.0;
-
-        /// `k_e`
-        pub const K_E: f32 = 1500.0;
-
-        /// `m`
-        pub const M: f32 = 0.002;
-
-        /// `k_s`
-        pub const K_S: f32 = 50.0;
-
-        /// `c`
-        pub const C: f32 = 0.1;
-
-        pub const F0: f32 = -0.75;
-
-        /// `T_s`
-        pub const T_S: f32 = 1e-5;
-
-        /// `z_min`
-        pub const Z_MIN: f32 = 0.0;
-
-        /// `z_max`
-        pub const Z_MAX: f32 = 0.001;
-
-        /// `phi_lim`
-        pub const PHI_LIM: f32 = 2.4975e-5;
-
-        /// σ_v [V]: standard deviation of the measured coil voltage's noise.
-        pub const VOLTAGE_NOISE: f32 = 0.015;
-
-        /// σ_i [A]: standard deviation of the measured coil current's noise.
-        pub const CURRENT_NOISE: f32 = 0.001;
-
-        /// σ of w_z [m] per sample (84a).
-        pub const PROCESS_Z: f32 = 1e-9;
-
-        /// σ of w_φ [Wb] per sample (84c).
-        pub const PROCESS_PHI: f32 = 3e-9;
-
-        /// Initial σ of z [m] (shared by z_prev: the filter starts at rest).
-        pub const INITIAL_Z_STD: f32 = 1e-5;
-
-        /// Initial σ of φ [Wb].
-        pub const INITIAL_PHI_STD: f32 = 1e-7;
-
-        /// α of the unscented transform (spread).
-        pub const UKF_ALPHA: f32 = 1.0;
-
-        /// β of the unscented transform (prior knowledge; 2 for Gaussian).
-        pub const UKF_BETA: f32 = 2.0;
-
-        /// κ of the unscented transform.
-        pub const UKF_KAPPA: f32 = 0.0;
-
-        /// Number of states: x = [z, z_prev, φ].
-        pub const DIM: usize = 3;
-
-        /// σ_u²: variance of the measured input's noise.
-        pub const INPUT_VARIANCE: f32 = VOLTAGE_NOISE * VOLTAGE_NOISE;
-
-        /// σ_y²: variance of the measured output's noise.
-        pub const MEASUREMENT_VARIANCE: f32 = CURRENT_NOISE * CURRENT_NOISE;
-
-        /// diag(q_z², 0, q_φ²(, q_Hc²)): the part of the process noise Q that does not come
-        /// from the input (which adds σ_u²·g·gᵀ, g = ∂F/∂u).
-        pub const PROCESS_VARIANCE: [f32; 3] = [
-            PROCESS_Z * PROCESS_Z,
-            0.0,
-            PROCESS_PHI * PROCESS_PHI,
-        ];
-
-        /// x₀: at rest at z_max, φ = 0(, H_c = 0).
-        pub const INITIAL_STATE: [f32; 3] = [Z_MAX, Z_MAX, 0.0];
-
-        /// P₀: z and z_prev share the initial σ (at rest: v = 0 is known), each with q_z²
-        /// added so that P₀ is positive definite.
-        pub const INITIAL_COVARIANCE: [[f32; 3]; 3] = [
-            [
-                INITIAL_Z_STD * INITIAL_Z_STD + PROCESS_Z * PROCESS_Z,
-                INITIAL_Z_STD * INITIAL_Z_STD,
-                0.0,
-            ],
-            [
-                INITIAL_Z_STD * INITIAL_Z_STD,
-                INITIAL_Z_STD * INITIAL_Z_STD + PROCESS_Z * PROCESS_Z,
-                0.0,
-            ],
-            [0.0, 0.0, INITIAL_PHI_STD * INITIAL_PHI_STD],
-        ];
-
-        /// (86): the estimate rests on a stop when within this distance [m] of it.
-        pub const MODE_BAND: f32 = 3.0 * PROCESS_Z;
-
-        /// γ = √(n + λ), λ = α²·(n + κ) − n: sigma points x̄ ± γ·(columns of chol P).
-        pub const GAMMA: f32 = 1.7320508;
-
-        /// W₀ᵐ = λ/(n + λ): weight of the centre point in means.
-        pub const WEIGHT_MEAN0: f32 = 0.0;
-
-        /// W₀ᶜ = W₀ᵐ + 1 − α² + β: weight of the centre point in covariances.
-        pub const WEIGHT_COV0: f32 = 2.0;
-
-        /// Wᵢ = 1/(2·(n + λ)): weight of the other points.
-        pub const WEIGHT: f32 = 0.16666667;
-
-        /// Relative diagonal jitter of the first repair of a failed Cholesky factorisation.
-        pub const REPAIR_JITTER: f32 = 1e-5;
-
-        /// Number of sigma points, 2n + 1.
-        pub const POINTS: usize = 7;
-
-        /// chol P₀, the factor a reset of the covariance starts from.
-        pub const INITIAL_FACTOR: [[f32; 3]; 3] = [
-            [1e-5, 0.0, 0.0],
-            [1e-5, 1.4142135e-9, 0.0],
-            [0.0, 0.0, 1e-7],
-        ];
+        use reldesign_runtime::observe::{self, Prediction, Reading};
+        params!(f32);
+        kalman!(f32);
 
         /// Outputs of [`transition`].
         #[derive(Clone, Copy, Debug, PartialEq)]
@@ -3362,400 +2860,66 @@ pub mod ukf {
             InputGainOutput { dphi_du }
         }
 
-        /// The estimate at one sample: what the controllers consume.
+        /// The discretised model: the functions above, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Estimate {
-            /// z [m], in [z_min, z_max]
-            pub z: f32,
-            /// v [m/s] = (z − z_prev)/T_s (85)
-            pub v: f32,
-            /// a [m/s²] (87): f_v(z, v, φ) in mode 2, else 0
-            pub a: f32,
-            /// φ [Wb]
-            pub phi: f32,
-            /// q of (86): 1 at z_min, 2 moving, 3 at z_max (within `MODE_BAND` of a stop)
-            pub mode: u8,
+        pub struct Model;
+
+        impl observe::Stateless<f32, 3> for Model {
+            const MODEL: Self = Model;
+            const SETTINGS: observe::Settings<f32, 3> = SETTINGS;
         }
 
-        /// z projected onto [z_min, z_max] (a NaN stays NaN). Not `clamp`, which has a
-        /// panic path (for bounds out of order).
-        #[allow(clippy::manual_clamp)]
-        fn project(z: f32) -> f32 {
-            if z < Z_MIN { Z_MIN } else if z > Z_MAX { Z_MAX } else { z }
-        }
-
-        /// (86) with the band: 1 within `MODE_BAND` of z_min, 3 within it of z_max, else 2
-        /// (also for a NaN z).
-        fn mode_of(z: f32) -> u8 {
-            if z <= Z_MIN + MODE_BAND { 1 } else if z >= Z_MAX - MODE_BAND { 3 } else { 2 }
-        }
-
-        /// The stop the estimate stays on over the next sample: the free acceleration points
-        /// into a stop (the automaton's lift-off guard does not fire) and the estimate is on
-        /// it by its mode (86), or reaches it within the sample (its own prediction (84a)
-        /// `z_next` saturates there); the prediction then keeps z = the stop. A NaN
-        /// acceleration stays nowhere.
-        fn resting_stop(mode: u8, accel: f32, z_next: f32) -> Option<f32> {
-            if accel <= 0.0 && (mode == 1 || z_next == Z_MIN) {
-                Some(Z_MIN)
-            } else if accel >= 0.0 && (mode == 3 || z_next == Z_MAX) {
-                Some(Z_MAX)
-            } else {
-                None
+        impl observe::DiscreteModel<f32, 3> for Model {
+            #[inline]
+            fn acceleration(&mut self, x: &[f32; 3], u: f32, _t: f32) -> f32 {
+                let [z, z_prev, phi] = *x;
+                acceleration(z, z_prev, phi, u).accel
             }
         }
 
-        /// The unscented Kalman filter (see the module docs). Allocation- and panic-free.
-        #[derive(Clone, Debug, PartialEq)]
-        pub struct Filter {
-            /// Posterior mean x_{k|k} of the last sample (x₀ before the first).
-            x: [f32; 3],
-            /// Its covariance.
-            p: [[f32; 3]; 3],
-            /// The last finite input.
-            u_last: f32,
-            skipped: u32,
-            repairs: u32,
-        }
+        impl observe::Sampled<f32, 3> for Model {
+            #[inline]
+            fn transition(&mut self, x: &[f32; 3], u: f32, _t: f32) -> Prediction<f32, 3> {
+                let [z, z_prev, phi] = *x;
+                let o = transition(z, z_prev, phi, u);
+                Prediction {
+                    next: [o.z_next, o.zp_next, o.phi_next],
+                    accel: o.accel,
+                }
+            }
 
-        impl Default for Filter {
-            fn default() -> Self {
-                Self::new()
+            #[inline]
+            fn measurement(&mut self, x: &[f32; 3], u: f32, _t: f32) -> Reading<f32> {
+                let [z, z_prev, phi] = *x;
+                let m = measurement(z, z_prev, phi, u);
+                Reading { y: m.i, dy_du: m.di_du }
+            }
+
+            #[inline]
+            fn input_gain(&mut self, x: &[f32; 3], u: f32, _t: f32) -> [f32; 3] {
+                let [z, z_prev, phi] = *x;
+                let g = input_gain(z, z_prev, phi, u);
+                [0.0, 0.0, g.dphi_du]
             }
         }
 
-        /// Weight of sigma point `k` in means.
-        fn weight_mean(k: usize) -> f32 {
-            if k == 0 { WEIGHT_MEAN0 } else { WEIGHT }
-        }
+        /// The unscented Kalman filter on [`Model`] (see the module docs).
+        /// `Filter::step(u, y)`: u is the measured coil voltage held over the last sample, y = i the coil current now.
+        pub type Filter = observe::Ukf<Model, f32, 3, 7>;
 
-        /// Weight of sigma point `k` in covariances.
-        fn weight_cov(k: usize) -> f32 {
-            if k == 0 { WEIGHT_COV0 } else { WEIGHT }
-        }
-
-        impl Filter {
-            /// A filter at rest at z_max with φ = 0 (and H_c = 0): x₀, P₀.
-            #[must_use]
-            pub const fn new() -> Self {
-                Filter {
-                    x: INITIAL_STATE,
-                    p: INITIAL_COVARIANCE,
-                    u_last: 0.0,
-                    skipped: 0,
-                    repairs: 0,
-                }
-            }
-
-            /// The lower Cholesky factor of P. If the factorisation fails (P not
-            /// numerically positive definite) P is repaired and the repair counted:
-            /// first jitter on the diagonal, Pᵢᵢ += REPAIR_JITTER·(|Pᵢᵢ| + P₀ᵢᵢ), then,
-            /// if that fails too, P = P₀.
-            fn factor(&mut self) -> [[f32; 3]; 3] {
-                if let Some(l) = linalg::cholesky(&self.p) {
-                    return l;
-                }
-                self.repairs = self.repairs.saturating_add(1);
-                let d = linalg::diag_of(&self.p);
-                let d0 = linalg::diag_of(&INITIAL_COVARIANCE);
-                let mut jitter = [0.0; 3];
-                for ((j, &pi), &p0) in jitter.iter_mut().zip(&d).zip(&d0) {
-                    *j = REPAIR_JITTER * (reldesign_runtime::math::Real::abs(pi) + p0);
-                }
-                let q = linalg::add(&self.p, &linalg::diagonal(&jitter));
-                if let Some(l) = linalg::cholesky(&q) {
-                    self.p = q;
-                    return l;
-                }
-                self.p = INITIAL_COVARIANCE;
-                INITIAL_FACTOR
-            }
-
-            /// One sample k: `u` is the measured coil voltage [V] held over the last sample (u_{k−1}, what
-            /// was applied since the previous call), `i` is the measured coil current [A] at t_k. Predicts
-            /// the prior from the last posterior with u, updates it with the measurement and
-            /// returns the posterior estimate, so that the controller acts on an estimate
-            /// without lag and the prediction uses the input actually applied. A non-finite
-            /// `u` is replaced by the last finite one and its update skipped; a non-finite
-            /// measurement skips the update.
-            pub fn step(&mut self, u: f32, i: f32) -> Estimate {
-                let u_ok = u.is_finite();
-                if u_ok {
-                    self.u_last = u;
-                }
-                // a non-finite input is replaced by the last finite one (and its update skipped)
-                let u = self.u_last;
-                let l = self.factor();
-                let pts: [[f32; 3]; 7] = linalg::sigma_points(&self.x, &l, GAMMA);
-                // prediction: the last posterior's sigma points through (84), u held over the
-                // last sample
-                let mut next = pts;
-                let mut accel = 0.0;
-                let mut z_next = 0.0;
-                for (k, (nk, pt)) in next.iter_mut().zip(&pts).enumerate() {
-                    let [z, z_prev, phi] = *pt;
-                    let o = transition(z, z_prev, phi, u);
-                    *nk = [o.z_next, o.zp_next, o.phi_next];
-                    if k == 0 {
-                        accel = o.accel;
-                        z_next = o.z_next;
-                    }
-                }
-                let [z_post, ..] = self.x;
-                // on a stop, or reaching it (f_v into it): every point keeps z = the stop
-                if let Some(stop) = resting_stop(mode_of(z_post), accel, z_next) {
-                    for nk in next.iter_mut() {
-                        let [_, zp, phi] = *nk;
-                        *nk = [stop, zp, phi];
-                    }
-                }
-                let mean = linalg::weighted_mean(&next, WEIGHT_MEAN0, WEIGHT);
-                let mut p = linalg::weighted_covariance(&next, &mean, WEIGHT_COV0, WEIGHT);
-                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
-                let [z, z_prev, phi] = self.x;
-                let gain_out = input_gain(z, z_prev, phi, u);
-                // the input's noise: Q += σ_u²·g·gᵀ, g = ∂F/∂u at the posterior mean
-                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, gain_out.dphi_du]);
-                if linalg::all_finite(&mean) && linalg::all_finite_matrix(&p) {
-                    self.x = mean;
-                    self.p = p;
-                } else {
-                    // a non-finite prediction: restart from x₀, P₀ (counted)
-                    self.x = INITIAL_STATE;
-                    self.p = INITIAL_COVARIANCE;
-                    self.repairs = self.repairs.saturating_add(1);
-                }
-                // Measurement update through the sigma points. Skipped when u, the measurement,
-                // the innovation variance or the innovation is not finite: a NaN or ∞ never
-                // enters the state (where it would stay forever).
-                let mut updated = false;
-                if u_ok && i.is_finite() {
-                    let l = self.factor();
-                    let pts: [[f32; 3]; 7] = linalg::sigma_points(&self.x, &l, GAMMA);
-                    let mut ys = [0.0; 7];
-                    let mut dy_du = 0.0;
-                    for (k, (yk, pt)) in ys.iter_mut().zip(&pts).enumerate() {
-                        let [z, z_prev, phi] = *pt;
-                        let m = measurement(z, z_prev, phi, u);
-                        *yk = m.i;
-                        if k == 0 {
-                            dy_du = m.di_du;
-                        }
-                    }
-                    let mut y_mean = 0.0;
-                    for (k, &yk) in ys.iter().enumerate() {
-                        y_mean += weight_mean(k) * yk;
-                    }
-                    let mut s = 0.0;
-                    for (k, &yk) in ys.iter().enumerate() {
-                        let d = yk - y_mean;
-                        s += weight_cov(k) * (d * d);
-                    }
-                    let r = MEASUREMENT_VARIANCE + INPUT_VARIANCE * (dy_du * dy_du);
-                    let s = s + r;
-                    let pxy = linalg::weighted_cross(
-                        &pts,
-                        &self.x,
-                        &ys,
-                        y_mean,
-                        WEIGHT_COV0,
-                        WEIGHT,
-                    );
-                    let innovation = i - y_mean;
-                    if innovation.is_finite() && s.is_finite() && s > 0.0 {
-                        let k = pxy.map(|x| x / s);
-                        linalg::axpy(&mut self.x, innovation, &k);
-                        linalg::rank1_update(&mut self.p, -s, &k);
-                        updated = true;
-                    }
-                }
-                if !updated {
-                    self.skipped = self.skipped.saturating_add(1);
-                }
-                let [z, z_prev, phi] = self.x;
-                // the posterior: z and z_prev projected onto [z_min, z_max], mode (86)
-                let (z, z_prev) = (project(z), project(z_prev));
-                self.x = [z, z_prev, phi];
-                let mode = mode_of(z);
-                // the estimate (85)–(87) at the posterior; f_v of (87) only in mode 2
-                let a = if mode == 2 { acceleration(z, z_prev, phi, u).accel } else { 0.0 };
-                Estimate {
-                    z,
-                    v: (z - z_prev) / T_S,
-                    a,
-                    phi,
-                    mode,
-                }
-            }
-
-            /// The posterior mean x_{k|k} (after the last `step`).
-            #[must_use]
-            pub const fn state(&self) -> [f32; 3] {
-                self.x
-            }
-
-            /// The posterior covariance.
-            #[must_use]
-            pub const fn covariance(&self) -> [[f32; 3]; 3] {
-                self.p
-            }
-
-            /// Samples whose measurement update was skipped (non-finite data).
-            #[must_use]
-            pub const fn skipped(&self) -> u32 {
-                self.skipped
-            }
-
-            /// Repaired factorisations and restarts after a non-finite prediction.
-            #[must_use]
-            pub const fn repairs(&self) -> u32 {
-                self.repairs
-            }
-        }
+        /// What [`Filter`] reports at each sample.
+        pub type Estimate = observe::Estimate<f32>;
     }
 
     /// The unscented Kalman filter of `perfect_tracking_valve` in f64, on the discretised model of
-    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ].
-    /// Sigma points x̄ ± γ·(columns of chol P) through h and F; Cholesky failures
-    /// are repaired and counted.
-    /// Process noise Q = diag(q_z², 0, q_φ²(, q_Hc²)) + σ_u²·g·gᵀ (g = ∂F/∂u: the
-    /// measured input's noise), measurement variance σ_y² + σ_u²·(∂h/∂u)². The model is
-    /// evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
+    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
+    /// below in `reldesign_runtime::observe::Ukf` (sigma points x̄ ± γ·(columns of chol P) through h
+    /// and F; failed factorisations are repaired and counted).
+    /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
     pub mod f64 {
-        use reldesign_runtime::linalg;
-
-        /// `A_gap`
-        pub const A_GAP: f64 = 2e-5;
-
-        /// `l_w`
-        pub const L_W: f64 = 0.015;
-
-        /// `R_core0`
-        pub const R_CORE0: f64 = 3000000.0;
-
-        /// `phi_sat`
-        pub const PHI_SAT: f64 = 2.5e-5;
-
-        pub const N: f64 = 1200.0;
-
-        pub const R: f64 = 75.0;
-
-        /// `k_e`
-        pub const K_E: f64 = 1500.0;
-
-        /// `m`
-        pub const M: f64 = 0.002;
-
-        /// `k_s`
-        pub const K_S: f64 = 50.0;
-
-        /// `c`
-        pub const C: f64 = 0.1;
-
-        pub const F0: f64 = -0.75;
-
-        /// `T_s`
-        pub const T_S: f64 = 1e-5;
-
-        /// `z_min`
-        pub const Z_MIN: f64 = 0.0;
-
-        /// `z_max`
-        pub const Z_MAX: f64 = 0.001;
-
-        /// `phi_lim`
-        pub const PHI_LIM: f64 = 2.4975e-5;
-
-        /// σ_v [V]: standard deviation of the measured coil voltage's noise.
-        pub const VOLTAGE_NOISE: f64 = 0.015;
-
-        /// σ_i [A]: standard deviation of the measured coil current's noise.
-        pub const CURRENT_NOISE: f64 = 0.001;
-
-        /// σ of w_z [m] per sample (84a).
-        pub const PROCESS_Z: f64 = 1e-9;
-
-        /// σ of w_φ [Wb] per sample (84c).
-        pub const PROCESS_PHI: f64 = 3e-9;
-
-        /// Initial σ of z [m] (shared by z_prev: the filter starts at rest).
-        pub const INITIAL_Z_STD: f64 = 1e-5;
-
-        /// Initial σ of φ [Wb].
-        pub const INITIAL_PHI_STD: f64 = 1e-7;
-
-        /// α of the unscented transform (spread).
-        pub const UKF_ALPHA: f64 = 1.0;
-
-        /// β of the unscented transform (prior knowledge; 2 for Gaussian).
-        pub const UKF_BETA: f64 = 2.0;
-
-        /// κ of the unscented transform.
-        pub const UKF_KAPPA: f64 = 0.0;
-
-        /// Number of states: x = [z, z_prev, φ].
-        pub const DIM: usize = 3;
-
-        /// σ_u²: variance of the measured input's noise.
-        pub const INPUT_VARIANCE: f64 = VOLTAGE_NOISE * VOLTAGE_NOISE;
-
-        /// σ_y²: variance of the measured output's noise.
-        pub const MEASUREMENT_VARIANCE: f64 = CURRENT_NOISE * CURRENT_NOISE;
-
-        /// diag(q_z², 0, q_φ²(, q_Hc²)): the part of the process noise Q that does not come
-        /// from the input (which adds σ_u²·g·gᵀ, g = ∂F/∂u).
-        pub const PROCESS_VARIANCE: [f64; 3] = [
-            PROCESS_Z * PROCESS_Z,
-            0.0,
-            PROCESS_PHI * PROCESS_PHI,
-        ];
-
-        /// x₀: at rest at z_max, φ = 0(, H_c = 0).
-        pub const INITIAL_STATE: [f64; 3] = [Z_MAX, Z_MAX, 0.0];
-
-        /// P₀: z and z_prev share the initial σ (at rest: v = 0 is known), each with q_z²
-        /// added so that P₀ is positive definite.
-        pub const INITIAL_COVARIANCE: [[f64; 3]; 3] = [
-            [
-                INITIAL_Z_STD * INITIAL_Z_STD + PROCESS_Z * PROCESS_Z,
-                INITIAL_Z_STD * INITIAL_Z_STD,
-                0.0,
-            ],
-            [
-                INITIAL_Z_STD * INITIAL_Z_STD,
-                INITIAL_Z_STD * INITIAL_Z_STD + PROCESS_Z * PROCESS_Z,
-                0.0,
-            ],
-            [0.0, 0.0, INITIAL_PHI_STD * INITIAL_PHI_STD],
-        ];
-
-        /// (86): the estimate rests on a stop when within this distance [m] of it.
-        pub const MODE_BAND: f64 = 3.0 * PROCESS_Z;
-
-        /// γ = √(n + λ), λ = α²·(n + κ) − n: sigma points x̄ ± γ·(columns of chol P).
-        pub const GAMMA: f64 = 1.7320508075688772;
-
-        /// W₀ᵐ = λ/(n + λ): weight of the centre point in means.
-        pub const WEIGHT_MEAN0: f64 = 0.0;
-
-        /// W₀ᶜ = W₀ᵐ + 1 − α² + β: weight of the centre point in covariances.
-        pub const WEIGHT_COV0: f64 = 2.0;
-
-        /// Wᵢ = 1/(2·(n + λ)): weight of the other points.
-        pub const WEIGHT: f64 = 0.16666666666666666;
-
-        /// Relative diagonal jitter of the first repair of a failed Cholesky factorisation.
-        pub const REPAIR_JITTER: f64 = 1e-9;
-
-        /// Number of sigma points, 2n + 1.
-        pub const POINTS: usize = 7;
-
-        /// chol P₀, the factor a reset of the covariance starts from.
-        pub const INITIAL_FACTOR: [[f64; 3]; 3] = [
-            [1.000000005e-5, 0.0, 0.0],
-            [9.999999950000002e-6, 1.4142135536421423e-9, 0.0],
-            [0.0, 0.0, 1e-7],
-        ];
+        use reldesign_runtime::observe::{self, Prediction, Reading};
+        params!(f64);
+        kalman!(f64);
 
         /// Outputs of [`transition`].
         #[derive(Clone, Copy, Debug, PartialEq)]
@@ -3900,255 +3064,54 @@ pub mod ukf {
             InputGainOutput { dphi_du }
         }
 
-        /// The estimate at one sample: what the controllers consume.
+        /// The discretised model: the functions above, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Estimate {
-            /// z [m], in [z_min, z_max]
-            pub z: f64,
-            /// v [m/s] = (z − z_prev)/T_s (85)
-            pub v: f64,
-            /// a [m/s²] (87): f_v(z, v, φ) in mode 2, else 0
-            pub a: f64,
-            /// φ [Wb]
-            pub phi: f64,
-            /// q of (86): 1 at z_min, 2 moving, 3 at z_max (within `MODE_BAND` of a stop)
-            pub mode: u8,
+        pub struct Model;
+
+        impl observe::Stateless<f64, 3> for Model {
+            const MODEL: Self = Model;
+            const SETTINGS: observe::Settings<f64, 3> = SETTINGS;
         }
 
-        /// z projected onto [z_min, z_max] (a NaN stays NaN). Not `clamp`, which has a
-        /// panic path (for bounds out of order).
-        #[allow(clippy::manual_clamp)]
-        fn project(z: f64) -> f64 {
-            if z < Z_MIN { Z_MIN } else if z > Z_MAX { Z_MAX } else { z }
-        }
-
-        /// (86) with the band: 1 within `MODE_BAND` of z_min, 3 within it of z_max, else 2
-        /// (also for a NaN z).
-        fn mode_of(z: f64) -> u8 {
-            if z <= Z_MIN + MODE_BAND { 1 } else if z >= Z_MAX - MODE_BAND { 3 } else { 2 }
-        }
-
-        /// The stop the estimate stays on over the next sample: the free acceleration points
-        /// into a stop (the automaton's lift-off guard does not fire) and the estimate is on
-        /// it by its mode (86), or reaches it within the sample (its own prediction (84a)
-        /// `z_next` saturates there); the prediction then keeps z = the stop. A NaN
-        /// acceleration stays nowhere.
-        fn resting_stop(mode: u8, accel: f64, z_next: f64) -> Option<f64> {
-            if accel <= 0.0 && (mode == 1 || z_next == Z_MIN) {
-                Some(Z_MIN)
-            } else if accel >= 0.0 && (mode == 3 || z_next == Z_MAX) {
-                Some(Z_MAX)
-            } else {
-                None
+        impl observe::DiscreteModel<f64, 3> for Model {
+            #[inline]
+            fn acceleration(&mut self, x: &[f64; 3], u: f64, _t: f64) -> f64 {
+                let [z, z_prev, phi] = *x;
+                acceleration(z, z_prev, phi, u).accel
             }
         }
 
-        /// The unscented Kalman filter (see the module docs). Allocation- and panic-free.
-        #[derive(Clone, Debug, PartialEq)]
-        pub struct Filter {
-            /// Posterior mean x_{k|k} of the last sample (x₀ before the first).
-            x: [f64; 3],
-            /// Its covariance.
-            p: [[f64; 3]; 3],
-            /// The last finite input.
-            u_last: f64,
-            skipped: u32,
-            repairs: u32,
-        }
+        impl observe::Sampled<f64, 3> for Model {
+            #[inline]
+            fn transition(&mut self, x: &[f64; 3], u: f64, _t: f64) -> Prediction<f64, 3> {
+                let [z, z_prev, phi] = *x;
+                let o = transition(z, z_prev, phi, u);
+                Prediction {
+                    next: [o.z_next, o.zp_next, o.phi_next],
+                    accel: o.accel,
+                }
+            }
 
-        impl Default for Filter {
-            fn default() -> Self {
-                Self::new()
+            #[inline]
+            fn measurement(&mut self, x: &[f64; 3], u: f64, _t: f64) -> Reading<f64> {
+                let [z, z_prev, phi] = *x;
+                let m = measurement(z, z_prev, phi, u);
+                Reading { y: m.i, dy_du: m.di_du }
+            }
+
+            #[inline]
+            fn input_gain(&mut self, x: &[f64; 3], u: f64, _t: f64) -> [f64; 3] {
+                let [z, z_prev, phi] = *x;
+                let g = input_gain(z, z_prev, phi, u);
+                [0.0, 0.0, g.dphi_du]
             }
         }
 
-        /// Weight of sigma point `k` in means.
-        fn weight_mean(k: usize) -> f64 {
-            if k == 0 { WEIGHT_MEAN0 } else { WEIGHT }
-        }
+        /// The unscented Kalman filter on [`Model`] (see the module docs).
+        /// `Filter::step(u, y)`: u is the measured coil voltage held over the last sample, y = i the coil current now.
+        pub type Filter = observe::Ukf<Model, f64, 3, 7>;
 
-        /// Weight of sigma point `k` in covariances.
-        fn weight_cov(k: usize) -> f64 {
-            if k == 0 { WEIGHT_COV0 } else { WEIGHT }
-        }
-
-        impl Filter {
-            /// A filter at rest at z_max with φ = 0 (and H_c = 0): x₀, P₀.
-            #[must_use]
-            pub const fn new() -> Self {
-                Filter {
-                    x: INITIAL_STATE,
-                    p: INITIAL_COVARIANCE,
-                    u_last: 0.0,
-                    skipped: 0,
-                    repairs: 0,
-                }
-            }
-
-            /// The lower Cholesky factor of P. If the factorisation fails (P not
-            /// numerically positive definite) P is repaired and the repair counted:
-            /// first jitter on the diagonal, Pᵢᵢ += REPAIR_JITTER·(|Pᵢᵢ| + P₀ᵢᵢ), then,
-            /// if that fails too, P = P₀.
-            fn factor(&mut self) -> [[f64; 3]; 3] {
-                if let Some(l) = linalg::cholesky(&self.p) {
-                    return l;
-                }
-                self.repairs = self.repairs.saturating_add(1);
-                let d = linalg::diag_of(&self.p);
-                let d0 = linalg::diag_of(&INITIAL_COVARIANCE);
-                let mut jitter = [0.0; 3];
-                for ((j, &pi), &p0) in jitter.iter_mut().zip(&d).zip(&d0) {
-                    *j = REPAIR_JITTER * (reldesign_runtime::math::Real::abs(pi) + p0);
-                }
-                let q = linalg::add(&self.p, &linalg::diagonal(&jitter));
-                if let Some(l) = linalg::cholesky(&q) {
-                    self.p = q;
-                    return l;
-                }
-                self.p = INITIAL_COVARIANCE;
-                INITIAL_FACTOR
-            }
-
-            /// One sample k: `u` is the measured coil voltage [V] held over the last sample (u_{k−1}, what
-            /// was applied since the previous call), `i` is the measured coil current [A] at t_k. Predicts
-            /// the prior from the last posterior with u, updates it with the measurement and
-            /// returns the posterior estimate, so that the controller acts on an estimate
-            /// without lag and the prediction uses the input actually applied. A non-finite
-            /// `u` is replaced by the last finite one and its update skipped; a non-finite
-            /// measurement skips the update.
-            pub fn step(&mut self, u: f64, i: f64) -> Estimate {
-                let u_ok = u.is_finite();
-                if u_ok {
-                    self.u_last = u;
-                }
-                // a non-finite input is replaced by the last finite one (and its update skipped)
-                let u = self.u_last;
-                let l = self.factor();
-                let pts: [[f64; 3]; 7] = linalg::sigma_points(&self.x, &l, GAMMA);
-                // prediction: the last posterior's sigma points through (84), u held over the
-                // last sample
-                let mut next = pts;
-                let mut accel = 0.0;
-                let mut z_next = 0.0;
-                for (k, (nk, pt)) in next.iter_mut().zip(&pts).enumerate() {
-                    let [z, z_prev, phi] = *pt;
-                    let o = transition(z, z_prev, phi, u);
-                    *nk = [o.z_next, o.zp_next, o.phi_next];
-                    if k == 0 {
-                        accel = o.accel;
-                        z_next = o.z_next;
-                    }
-                }
-                let [z_post, ..] = self.x;
-                // on a stop, or reaching it (f_v into it): every point keeps z = the stop
-                if let Some(stop) = resting_stop(mode_of(z_post), accel, z_next) {
-                    for nk in next.iter_mut() {
-                        let [_, zp, phi] = *nk;
-                        *nk = [stop, zp, phi];
-                    }
-                }
-                let mean = linalg::weighted_mean(&next, WEIGHT_MEAN0, WEIGHT);
-                let mut p = linalg::weighted_covariance(&next, &mean, WEIGHT_COV0, WEIGHT);
-                p = linalg::add(&p, &linalg::diagonal(&PROCESS_VARIANCE));
-                let [z, z_prev, phi] = self.x;
-                let gain_out = input_gain(z, z_prev, phi, u);
-                // the input's noise: Q += σ_u²·g·gᵀ, g = ∂F/∂u at the posterior mean
-                linalg::rank1_update(&mut p, INPUT_VARIANCE, &[0.0, 0.0, gain_out.dphi_du]);
-                if linalg::all_finite(&mean) && linalg::all_finite_matrix(&p) {
-                    self.x = mean;
-                    self.p = p;
-                } else {
-                    // a non-finite prediction: restart from x₀, P₀ (counted)
-                    self.x = INITIAL_STATE;
-                    self.p = INITIAL_COVARIANCE;
-                    self.repairs = self.repairs.saturating_add(1);
-                }
-                // Measurement update through the sigma points. Skipped when u, the measurement,
-                // the innovation variance or the innovation is not finite: a NaN or ∞ never
-                // enters the state (where it would stay forever).
-                let mut updated = false;
-                if u_ok && i.is_finite() {
-                    let l = self.factor();
-                    let pts: [[f64; 3]; 7] = linalg::sigma_points(&self.x, &l, GAMMA);
-                    let mut ys = [0.0; 7];
-                    let mut dy_du = 0.0;
-                    for (k, (yk, pt)) in ys.iter_mut().zip(&pts).enumerate() {
-                        let [z, z_prev, phi] = *pt;
-                        let m = measurement(z, z_prev, phi, u);
-                        *yk = m.i;
-                        if k == 0 {
-                            dy_du = m.di_du;
-                        }
-                    }
-                    let mut y_mean = 0.0;
-                    for (k, &yk) in ys.iter().enumerate() {
-                        y_mean += weight_mean(k) * yk;
-                    }
-                    let mut s = 0.0;
-                    for (k, &yk) in ys.iter().enumerate() {
-                        let d = yk - y_mean;
-                        s += weight_cov(k) * (d * d);
-                    }
-                    let r = MEASUREMENT_VARIANCE + INPUT_VARIANCE * (dy_du * dy_du);
-                    let s = s + r;
-                    let pxy = linalg::weighted_cross(
-                        &pts,
-                        &self.x,
-                        &ys,
-                        y_mean,
-                        WEIGHT_COV0,
-                        WEIGHT,
-                    );
-                    let innovation = i - y_mean;
-                    if innovation.is_finite() && s.is_finite() && s > 0.0 {
-                        let k = pxy.map(|x| x / s);
-                        linalg::axpy(&mut self.x, innovation, &k);
-                        linalg::rank1_update(&mut self.p, -s, &k);
-                        updated = true;
-                    }
-                }
-                if !updated {
-                    self.skipped = self.skipped.saturating_add(1);
-                }
-                let [z, z_prev, phi] = self.x;
-                // the posterior: z and z_prev projected onto [z_min, z_max], mode (86)
-                let (z, z_prev) = (project(z), project(z_prev));
-                self.x = [z, z_prev, phi];
-                let mode = mode_of(z);
-                // the estimate (85)–(87) at the posterior; f_v of (87) only in mode 2
-                let a = if mode == 2 { acceleration(z, z_prev, phi, u).accel } else { 0.0 };
-                Estimate {
-                    z,
-                    v: (z - z_prev) / T_S,
-                    a,
-                    phi,
-                    mode,
-                }
-            }
-
-            /// The posterior mean x_{k|k} (after the last `step`).
-            #[must_use]
-            pub const fn state(&self) -> [f64; 3] {
-                self.x
-            }
-
-            /// The posterior covariance.
-            #[must_use]
-            pub const fn covariance(&self) -> [[f64; 3]; 3] {
-                self.p
-            }
-
-            /// Samples whose measurement update was skipped (non-finite data).
-            #[must_use]
-            pub const fn skipped(&self) -> u32 {
-                self.skipped
-            }
-
-            /// Repaired factorisations and restarts after a non-finite prediction.
-            #[must_use]
-            pub const fn repairs(&self) -> u32 {
-                self.repairs
-            }
-        }
+        /// What [`Filter`] reports at each sample.
+        pub type Estimate = observe::Estimate<f64>;
     }
 }

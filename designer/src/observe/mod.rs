@@ -6,14 +6,14 @@
 //! | `semera.rs` | SEMERA: model-free Kalman estimation of r, l, λ (semera Algorithm 1) |
 //! | `integral.rs` | the integral estimator with resistance update (semera Algorithm 2, (47)) |
 //! | `observability.rs` | the observability determinant (32) over a recorded current |
-//! | `discrete.rs` | the discretised model of jiles-atherton-actuator-model (84)–(87) |
-//! | `filter.rs` | state and steps the EKF and UKF share (input, projection, Q, restart) |
-//! | `ekf.rs` | extended Kalman filter on the discretised model (symbolic Jacobians) |
-//! | `ukf.rs` | unscented Kalman filter on the discretised model |
+//! | `discrete/` | the discretised model of jiles-atherton-actuator-model (84)–(87), its settings and tapes, the tape-backed model of the runtime's filters, the estimate |
+//! | `filter.rs` | a runtime filter at the model's number of states, with the designer's estimate |
+//! | `ekf.rs` | the reference extended Kalman filter: the runtime's EKF on the tapes |
+//! | `ukf.rs` | the reference unscented Kalman filter: the runtime's UKF on the tapes |
 
 pub mod discrete;
 pub mod ekf;
-mod filter;
+pub mod filter;
 pub mod integral;
 pub mod observability;
 pub mod semera;

@@ -19,13 +19,10 @@ mod record {
 }
 // the generated modules hold more than the driver calls
 #[allow(dead_code)]
-mod ekf {
-    include!(concat!(env!("OUT_DIR"), "/valve_ekf.rs"));
+mod valve {
+    include!(concat!(env!("OUT_DIR"), "/valve_observers.rs"));
 }
-#[allow(dead_code)]
-mod ukf {
-    include!(concat!(env!("OUT_DIR"), "/valve_ukf.rs"));
-}
+use valve::{ekf, ukf};
 
 use record::RECORD;
 
