@@ -440,7 +440,7 @@ impl Design {
         let input = ControllerInput {
             name: &d.name,
             graph: &self.model.graph,
-            params: self.model.params.iter().collect(),
+            params: self.model.params.iter().map(crate::Param::from).collect(),
             states: [
                 self.model.states[0],
                 self.model.states[1],

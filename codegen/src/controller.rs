@@ -50,12 +50,13 @@ use designer::sym::{Graph, Id, Tape};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::emit::{function_tokens_inline, FunctionSpec, Inline, Param};
+use crate::emit::{function_tokens_inline, FunctionSpec, Inline};
 use crate::error::EmitError;
 use crate::float::Float;
 use crate::format::{comment_lets, format_items, space_items};
 use crate::header::Header;
 use crate::names::const_name;
+use crate::param::Param;
 
 /// 5 % settling-time criterion of a triple real pole.
 const SETTLING_FRACTION: f64 = 0.05;
@@ -358,12 +359,12 @@ fn round_down_1sig(x: f64) -> f64 {
 fn smallest_reference_flux(input: &ControllerInput) -> Result<f64, ControllerError> {
     let lin = input.linearization;
     let mut inputs: Vec<Id> = lin.xi.to_vec();
-    inputs.extend(input.params.iter().map(|p| p.1));
+    inputs.extend(input.params.iter().map(|p| p.symbol));
     let tape = Tape::compile(input.graph, &inputs, &[lin.flux_squared])
         .map_err(|e| EmitError::UnboundSymbol(e.0))?;
     let mut scratch = tape.scratch();
     let mut point: Vec<f64> = vec![0.0; 3];
-    point.extend(input.params.iter().map(|p| p.2));
+    point.extend(input.params.iter().map(|p| p.value));
     let mut out = [0.0];
     let mut smallest = f64::INFINITY;
     let mut visit = |xi: [f64; 3]| {
@@ -489,7 +490,7 @@ fn f64_text(v: f64) -> String {
 /// module the literal rounds to the nearest `f32`).
 fn params_macro(input: &ControllerInput) -> Result<String, ControllerError> {
     let mut body = String::new();
-    for &(name, _, value) in &input.params {
+    for &Param { name, value, .. } in &input.params {
         let cname = const_name(name)?;
         if DESIGN_CONSTS.contains(&cname.as_str()) {
             return Err(ControllerError::NameTaken(cname));
@@ -562,7 +563,7 @@ fn float_module(
     let [z, v, phi] = input.states;
     let mut params: Vec<Param> = input.params.clone();
     for (k, (&id, name)) in law.gains.iter().zip(GAIN_SYMBOLS).enumerate() {
-        params.push((name, id, input.gains[k]));
+        params.push(Param::from((name, id, input.gains[k])));
     }
     let spec = FunctionSpec {
         name: "law_terms",

@@ -12,11 +12,8 @@ use crate::fold::{fold, Folded};
 use crate::format::{comment_lets, format_items};
 use crate::lower::Lowerer;
 use crate::names::{camel, const_name, ident, Namer};
+use crate::param::Param;
 use crate::plan::{plan, PlanRequest};
-
-/// One parameter: symbol name, symbol node, value (e.g. from
-/// `model.params.iter()`).
-pub type Param<'a> = (&'a str, Id, f64);
 
 /// What to emit as one function.
 #[derive(Debug, Clone)]
@@ -58,7 +55,7 @@ pub fn params_tokens(
     const_names(graph, params)?;
     let ty = float.ty();
     let mut items = TokenStream::new();
-    for &(name, _, value) in params {
+    for &Param { name, value, .. } in params {
         let cname = ident(&const_name(name)?);
         let lit = float
             .unsuffixed_signed(value)
@@ -80,7 +77,10 @@ pub fn params_tokens(
 fn const_names(graph: &Graph, params: &[Param]) -> Result<HashMap<Id, String>, EmitError> {
     let mut by_id = HashMap::new();
     let mut seen: Vec<String> = Vec::new();
-    for &(name, id, _) in params {
+    for &Param {
+        name, symbol: id, ..
+    } in params
+    {
         if graph.name_of(id).is_none() {
             return Err(EmitError::NotASymbol(name.to_owned()));
         }
@@ -149,11 +149,11 @@ pub(crate) fn function_tokens_inline(
     let (graph, roots, params) = match &folded {
         Some(f) => {
             let mut all = params.to_vec();
-            all.extend(
-                f.derived
-                    .iter()
-                    .map(|d| (d.name.as_str(), d.symbol, d.value)),
-            );
+            all.extend(f.derived.iter().map(|d| Param {
+                name: d.name.as_str(),
+                symbol: d.symbol,
+                value: d.value,
+            }));
             (&f.graph, f.roots.clone(), all)
         }
         None => (graph, roots, params.to_vec()),

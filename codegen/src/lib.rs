@@ -35,6 +35,7 @@ mod header;
 mod lower;
 mod names;
 mod observer;
+mod param;
 mod plan;
 mod semera;
 
@@ -46,11 +47,12 @@ pub use controller::{
     emit_controller, gains, triple_pole_settling_product, ControllerError, ControllerInput,
     OperationTable,
 };
-pub use emit::{emit_function, emit_params, function_tokens, params_tokens, FunctionSpec, Param};
+pub use emit::{emit_function, emit_params, function_tokens, params_tokens, FunctionSpec};
 pub use error::EmitError;
 pub use float::Float;
 pub use format::format_items;
 pub use header::{sha256_hex, Header};
 pub use names::const_name;
 pub use observer::*;
+pub use param::Param;
 pub use semera::*;

@@ -34,11 +34,12 @@ use designer::sym::{Graph, Id};
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::emit::{function_tokens, FunctionSpec, Param};
+use crate::emit::{function_tokens, FunctionSpec};
 use crate::error::EmitError;
 use crate::float::Float;
 use crate::format::{comment_lets, format_items, space_items};
 use crate::names::const_name;
+use crate::param::Param;
 
 /// Everything [`emit_ekf`] and [`emit_ukf`] need.
 #[derive(Clone)]
@@ -516,7 +517,7 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
     let n = layout.n;
     let ty = float.ty();
     let module = format_ident!("{}", float.name());
-    let params: Vec<Param> = dm.param_list();
+    let params: Vec<Param> = dm.param_list().into_iter().map(Param::from).collect();
     let has_field = dm.has_field_state();
     let voltage_drive = dm.drive == Drive::Voltage;
 

@@ -92,7 +92,7 @@ fn emit_ops(v: &Valve, floats: &[Float], both: bool) -> String {
     let input = ControllerInput {
         name: &d.name,
         graph: &v.model.graph,
-        params: v.model.params.iter().collect(),
+        params: v.model.params.iter().map(codegen::Param::from).collect(),
         states: [s[0], s[1], s[2]],
         linearization: &v.lin,
         gains: gains(&Gains::SettlingTime(1e-3)),
