@@ -14,7 +14,6 @@ use crate::emit::params_macro;
 use crate::error::EmitError;
 use crate::header::Header;
 use crate::observer::{emit_ekf, emit_ukf, wrap_module, ObserverError, ObserverInput};
-use crate::param::Param;
 use crate::semera::{emit_semera, SemeraError, SemeraInput};
 use crate::Float;
 
@@ -103,13 +102,9 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
     }
     let mut out = header(design);
     if modules.iter().any(|m| invokes_params(m)) {
-        let m = &d.mechanics;
-        let params: Vec<Param> = design.model.params.iter().map(Param::from).collect();
-        let text = params_macro(&d.name, &params, [m.z_min, m.z_max]).map_err(|source| {
-            BuildError::Params {
-                file: file(),
-                source,
-            }
+        let text = params_macro(&design.model).map_err(|source| BuildError::Params {
+            file: file(),
+            source,
         })?;
         out.push('\n');
         out.push_str(&text);

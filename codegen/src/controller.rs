@@ -3,8 +3,9 @@
 //! `designer::design::ControllerDesign`, one module per float type
 //! (`pub mod f64 { … }` / `pub mod f32 { … }`) holding
 //!
-//! - `params!(f…)`: the model parameters and the stroke limits `Z_MIN`,
-//!   `Z_MAX`, from the file's one `params!` macro (`emit::params_macro`);
+//! - `params!(f…)`: the model parameters, the stroke limits `Z_MIN`,
+//!   `Z_MAX` and the physical constants `MU0`, `Z_EPS`, from the file's one
+//!   `params!` macro (`emit::params_macro`);
 //! - the design constants (gains, supply bounds, timing, guard threshold,
 //!   landed band, press, creep);
 //! - the reference tables, one `[[f; 7]; N]` per operation, one row
@@ -33,6 +34,7 @@ use crate::float::Float;
 use crate::format::{comment_lets, format_items, space_items};
 use crate::names::const_name;
 use crate::param::Param;
+use crate::physical::{in_scope, of_model};
 
 /// Why a controller could not be emitted.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -102,9 +104,11 @@ pub fn emit_controller(input: &ControllerInput) -> Result<String, ControllerErro
     }
     let mut graph = input.model.graph.clone();
     let law = LawSymbols::build(&mut graph, input.design, &input.model.named)?;
+    // MU0, Z_EPS as the file's params! declares them
+    let physical = in_scope(&mut graph, &of_model(input.model));
     let mut modules = Vec::new();
     for float in floats {
-        modules.push(float_module(&graph, input, &law, float)?);
+        modules.push(float_module(&graph, input, &law, &physical, float)?);
     }
     Ok(modules.join("\n"))
 }
@@ -218,10 +222,12 @@ fn law_terms(
     graph: &Graph,
     input: &ControllerInput,
     law: &LawSymbols,
+    physical: &[Param],
     float: Float,
 ) -> Result<(TokenStream, Comments), ControllerError> {
     let model = input.model;
     let mut params: Vec<Param> = model.params.iter().map(Param::from).collect();
+    params.extend_from_slice(physical);
     for ((&id, name), &k) in law.gains.iter().zip(GAIN_SYMBOLS).zip(&input.design.gains) {
         params.push(Param::from((name, id, k)));
     }
@@ -377,12 +383,13 @@ fn float_module(
     graph: &Graph,
     input: &ControllerInput,
     law: &LawSymbols,
+    physical: &[Param],
     float: Float,
 ) -> Result<String, ControllerError> {
     let ty = float.ty();
     let module = format_ident!("{}", float.name());
     let design = input.design;
-    let (law_fn, comments) = law_terms(graph, input, law, float)?;
+    let (law_fn, comments) = law_terms(graph, input, law, physical, float)?;
     let consts = design_consts(design, float)?;
     let mech = &input.model.description.mechanics;
     let position = |name: &str, z: f64| -> Result<TokenStream, ControllerError> {

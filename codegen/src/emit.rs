@@ -2,6 +2,7 @@
 
 use std::collections::{HashMap, HashSet};
 
+use designer::model::Model;
 use designer::sym::{Graph, Id};
 use proc_macro2::TokenStream;
 use quote::quote;
@@ -13,7 +14,7 @@ use crate::format::{comment_lets, format_items};
 use crate::lower::Lowerer;
 use crate::names::{camel, const_name, ident, Namer};
 use crate::param::Param;
-use crate::physical::{name_constants, Named};
+use crate::physical::{self, name_constants, Named};
 use crate::plan::{plan, PlanRequest};
 
 /// What to emit as one function.
@@ -74,27 +75,19 @@ pub fn params_tokens(
     Ok(items)
 }
 
-/// `macro_rules! params`: the file's one declaration of the model
-/// parameters and the stroke limits `Z_MIN`, `Z_MAX` [m], one
-/// `pub const NAME: $f = value;` line each (shortest round-trip f64 text: in
-/// an `f32` module the literal rounds to the nearest `f32`). Every float
-/// module that needs them invokes `params!(f64)` / `params!(f32)`, so one
-/// parameter change is one changed line of the file.
-pub fn params_macro(
-    description: &str,
-    params: &[Param],
-    stroke: [f64; 2],
-) -> Result<String, EmitError> {
-    let [z_min, z_max] = stroke;
-    let limits = [("z_min", z_min), ("z_max", z_max)];
-    let all = params.iter().map(|p| (p.name, p.value)).chain(limits);
-    let mut seen: Vec<String> = Vec::new();
-    let mut body = String::new();
-    for (name, value) in all {
-        let cname = const_name(name)?;
-        if seen.contains(&cname) {
-            return Err(EmitError::DuplicateName(cname));
-        }
+/// `macro_rules! params`: the file's one declaration of `model`'s
+/// parameters, the stroke limits `Z_MIN`, `Z_MAX` [m] and the physical
+/// constants its equations use (`MU0`, `Z_EPS`), one `pub const NAME: $f =
+/// value;` line each (shortest round-trip f64 text: in an `f32` module the
+/// literal rounds to the nearest `f32`). Every float module that needs them
+/// invokes `params!(f64)` / `params!(f32)`, so one parameter change is one
+/// changed line of the file.
+pub fn params_macro(model: &Model) -> Result<String, EmitError> {
+    let d = &model.description;
+    let m = &d.mechanics;
+    let mut lines: Vec<(&str, String, Option<&str>)> = Vec::new();
+    let given = model.params.iter().map(|(name, _, value)| (name, value));
+    for (name, value) in given.chain([("z_min", m.z_min), ("z_max", m.z_max)]) {
         let text = Float::F64
             .literal_text(value)
             .ok_or_else(|| EmitError::NonFinite {
@@ -102,16 +95,31 @@ pub fn params_macro(
                 value: format!("{value:?}"),
                 float: "f64",
             })?;
-        if cname != name {
-            body.push_str(&format!("        /// `{name}`\n"));
+        lines.push((name, text, None));
+    }
+    for c in physical::of_model(model) {
+        lines.push((c.symbol, c.definition.to_owned(), Some(c.doc)));
+    }
+    let mut seen: Vec<String> = Vec::new();
+    let mut body = String::new();
+    for (name, value, doc) in lines {
+        let cname = const_name(name)?;
+        if seen.contains(&cname) {
+            return Err(EmitError::DuplicateName(cname));
         }
-        body.push_str(&format!("        pub const {cname}: $f = {text};\n"));
+        match doc {
+            Some(doc) => body.push_str(&format!("        /// {doc}\n")),
+            None if cname != name => body.push_str(&format!("        /// `{name}`\n")),
+            None => {}
+        }
+        body.push_str(&format!("        pub const {cname}: $f = {value};\n"));
         seen.push(cname);
     }
     Ok(format!(
-        "/// The model parameters of `{description}` (SI units), one per line, declared in\n\
+        "/// The model parameters of `{}` (SI units), one per line, declared in\n\
          /// each float module as `params!(f64)` / `params!(f32)`.\n\
-         macro_rules! params {{\n    ($f:ty) => {{\n{body}    }};\n}}\n"
+         macro_rules! params {{\n    ($f:ident) => {{\n{body}    }};\n}}\n",
+        d.name
     ))
 }
 
@@ -193,7 +201,7 @@ pub(crate) fn function_tokens_inline(
     let mut all_params = params.to_vec();
     let (graph, roots) = match &named_consts {
         Some(n) => {
-            all_params.extend(n.used.iter().map(|(p, _)| *p));
+            all_params.extend(n.local.iter().map(|(p, _)| *p));
             (&n.graph, n.roots.clone())
         }
         None => (graph, roots),
@@ -377,7 +385,7 @@ fn local_consts(
 ) -> Result<TokenStream, EmitError> {
     let reachable: HashSet<Id> = graph.postorder(roots).into_iter().collect();
     let physical = named
-        .map_or(&[][..], |n| &n.used)
+        .map_or(&[][..], |n| &n.local)
         .iter()
         .filter(|(p, _)| reachable.contains(&p.symbol))
         .map(|(p, doc)| (p.name, p.value, (*doc).to_owned()));

@@ -14,7 +14,7 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use codegen::{emit_controller, params_macro, ControllerInput, Float, Header, Param};
+use codegen::{emit_controller, params_macro, ControllerInput, Float, Header};
 use designer::description::{parse_str, Gains, Operation};
 use designer::design::{
     check_feasibility, gains, ControllerDesign, ControllerSpec, DesignedOperation, Flat,
@@ -125,25 +125,22 @@ fn design(v: &Valve, both: bool) -> ControllerDesign {
 /// The emitted file as `reldesign build` composes it: header, `params!`, the
 /// float modules.
 fn emit_ops(v: &Valve, floats: &[Float], both: bool) -> String {
-    let d = &v.model.description;
     let design = design(v, both);
     let input = ControllerInput {
         model: &v.model,
         design: &design,
         floats: floats.to_vec(),
     };
-    let params: Vec<Param> = v.model.params.iter().map(Param::from).collect();
     let header = Header {
         what: "controller",
         generator_version: env!("CARGO_PKG_VERSION"),
         source_file: "perfect-tracking-valve.toml",
         source_text: &v.text,
     };
-    let stroke = [d.mechanics.z_min, d.mechanics.z_max];
     format!(
         "{}\n{}\n{}",
         header.text(),
-        params_macro(&d.name, &params, stroke).unwrap_or_else(|e| panic!("{e}")),
+        params_macro(&v.model).unwrap_or_else(|e| panic!("{e}")),
         emit_controller(&input).unwrap_or_else(|e| panic!("{e}"))
     )
 }
@@ -218,7 +215,7 @@ fn header_and_sections_are_there() {
         "impl control::Law<f32> for Design {",
         "// (50) u = α + β·w",
         // physical constants and the model's subexpressions by name
-        "const MU0: f64 = 1.2566370614359173e-6;",
+        "pub const MU0: $f = 4e-7 * ::core::$f::consts::PI;",
         "let z_reg = z + Z_EPS;",
         "let fringe_den = ",
         "let f_net = f_mag - f_passive;",

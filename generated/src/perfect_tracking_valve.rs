@@ -6,7 +6,7 @@
 /// The model parameters of `perfect_tracking_valve` (SI units), one per line, declared in
 /// each float module as `params!(f64)` / `params!(f32)`.
 macro_rules! params {
-    ($f:ty) => {
+    ($f:ident) => {
         /// `A_gap`
         pub const A_GAP: $f = 2e-5;
         /// `l_w`
@@ -30,6 +30,10 @@ macro_rules! params {
         pub const Z_MIN: $f = 0.0;
         /// `z_max`
         pub const Z_MAX: $f = 0.001;
+        /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+        pub const MU0: $f = 4e-7 * ::core::$f::consts::PI;
+        /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
+        pub const Z_EPS: $f = 1e-9;
     };
 }
 
@@ -201,12 +205,6 @@ pub mod f32 {
         jr: f32,
     ) -> LawTermsOutput {
         use reldesign_runtime::math::Real;
-
-        /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
-        const MU0: f32 = 1.256637e-6;
-
-        /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-        const Z_EPS: f32 = 1e-9;
 
         /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
         const INV_SQRT_A_GAP: f32 = 223.6068;
@@ -514,12 +512,6 @@ pub mod f64 {
     ) -> LawTermsOutput {
         use reldesign_runtime::math::Real;
 
-        /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
-        const MU0: f64 = 1.2566370614359173e-6;
-
-        /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-        const Z_EPS: f64 = 1e-9;
-
         /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
         const INV_SQRT_A_GAP: f64 = 223.60679774997894;
         let inv_m = 1.0_f64 / M;
@@ -802,7 +794,7 @@ pub mod ekf {
         pub fn transition(z: f32, z_prev: f32, phi: f32, u: f32) -> TransitionOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f32 = 1.256637e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -932,7 +924,7 @@ pub mod ekf {
         pub fn measurement(z: f32, _z_prev: f32, phi: f32, u: f32) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f32 = 1.256637e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -999,7 +991,7 @@ pub mod ekf {
         pub fn acceleration(z: f32, z_prev: f32, phi: f32, _u: f32) -> AccelerationOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f32 = 1.256637e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -1358,7 +1350,7 @@ pub mod ekf {
         pub fn transition(z: f64, z_prev: f64, phi: f64, u: f64) -> TransitionOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f64 = 1.2566370614359173e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -1488,7 +1480,7 @@ pub mod ekf {
         pub fn measurement(z: f64, _z_prev: f64, phi: f64, u: f64) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f64 = 1.2566370614359173e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -1555,7 +1547,7 @@ pub mod ekf {
         pub fn acceleration(z: f64, z_prev: f64, phi: f64, _u: f64) -> AccelerationOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f64 = 1.2566370614359173e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -1937,7 +1929,7 @@ pub mod ukf {
         pub fn transition(z: f32, z_prev: f32, phi: f32, u: f32) -> TransitionOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f32 = 1.256637e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -1998,7 +1990,7 @@ pub mod ukf {
         pub fn measurement(z: f32, _z_prev: f32, phi: f32, u: f32) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f32 = 1.256637e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -2036,7 +2028,7 @@ pub mod ukf {
         pub fn acceleration(z: f32, z_prev: f32, phi: f32, _u: f32) -> AccelerationOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f32 = 1.256637e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -2494,7 +2486,7 @@ pub mod ukf {
         pub fn transition(z: f64, z_prev: f64, phi: f64, u: f64) -> TransitionOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f64 = 1.2566370614359173e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -2555,7 +2547,7 @@ pub mod ukf {
         pub fn measurement(z: f64, _z_prev: f64, phi: f64, u: f64) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f64 = 1.2566370614359173e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -2593,7 +2585,7 @@ pub mod ukf {
         pub fn acceleration(z: f64, z_prev: f64, phi: f64, _u: f64) -> AccelerationOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability (the compiler folds it into the coefficients)
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
             const MU0: f64 = 1.2566370614359173e-6;
 
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
