@@ -26,8 +26,9 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), Report> {
     let description = crate::load(&args.model)?;
-    let design = codegen::Design::new(&description).map_err(fail)?;
-    let code = design.emit().map_err(fail)?;
+    let design = designer::design::Design::new(&description)
+        .map_err(|e| fail(format!("{}: {e}", description.source.file_name)))?;
+    let code = codegen::emit(&design).map_err(fail)?;
     if !args.quiet {
         eprintln!(
             "{}: design of `{}`\n{}",
@@ -55,7 +56,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
 }
 
 /// The design figures, for scripts and oracles.
-fn report_json(design: &codegen::Design) -> String {
+fn report_json(design: &designer::design::Design) -> String {
     let no_operations = Vec::new();
     let operations: serde_json::Map<String, serde_json::Value> = design
         .controller
@@ -74,7 +75,7 @@ fn report_json(design: &codegen::Design) -> String {
             if let (Some(opt), Some(map)) = (&o.optimal, entry.as_object_mut()) {
                 map.insert("optimal".into(), opt.summary_json());
             }
-            (codegen::operation_name(o.operation).to_string(), entry)
+            (o.operation.name().to_string(), entry)
         })
         .collect();
     let value = serde_json::json!({ "name": design.description.name, "gains": design.controller.as_ref().map(|c| c.gains), "operations": operations });

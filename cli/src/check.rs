@@ -95,11 +95,7 @@ pub fn statics_text(model: &mut Model) -> String {
 fn design_text(d: &Description) -> String {
     let mut s = String::new();
     if let Some(t) = &d.trajectory {
-        let ops: Vec<&str> = t
-            .operations
-            .iter()
-            .map(|&o| codegen::operation_name(o))
-            .collect();
+        let ops: Vec<&str> = t.operations.iter().map(|&o| o.name()).collect();
         let shape = match t.shape {
             Shape::Polynomial => "5th-degree polynomial",
             Shape::EnergyOptimal => "energy-optimal",

@@ -2,6 +2,7 @@
 
 use std::collections::{HashMap, HashSet};
 
+use designer::model::Model;
 use designer::sym::{Graph, Id};
 use proc_macro2::TokenStream;
 use quote::quote;
@@ -12,11 +13,9 @@ use crate::fold::{fold, Folded};
 use crate::format::{comment_lets, format_items};
 use crate::lower::Lowerer;
 use crate::names::{camel, const_name, ident, Namer};
+use crate::param::Param;
+use crate::physical::{self, name_constants, Named};
 use crate::plan::{plan, PlanRequest};
-
-/// One parameter: symbol name, symbol node, value (e.g. from
-/// `model.params.iter()`).
-pub type Param<'a> = (&'a str, Id, f64);
 
 /// What to emit as one function.
 #[derive(Debug, Clone)]
@@ -58,7 +57,7 @@ pub fn params_tokens(
     const_names(graph, params)?;
     let ty = float.ty();
     let mut items = TokenStream::new();
-    for &(name, _, value) in params {
+    for &Param { name, value, .. } in params {
         let cname = ident(&const_name(name)?);
         let lit = float
             .unsuffixed_signed(value)
@@ -76,11 +75,62 @@ pub fn params_tokens(
     Ok(items)
 }
 
+/// `macro_rules! params`: the file's one declaration of `model`'s
+/// parameters, the stroke limits `Z_MIN`, `Z_MAX` [m] and the physical
+/// constants its equations use (`MU0`, `Z_EPS`), one `pub const NAME: $f =
+/// value;` line each (shortest round-trip f64 text: in an `f32` module the
+/// literal rounds to the nearest `f32`). Every float module that needs them
+/// invokes `params!(f64)` / `params!(f32)`, so one parameter change is one
+/// changed line of the file.
+pub fn params_macro(model: &Model) -> Result<String, EmitError> {
+    let d = &model.description;
+    let m = &d.mechanics;
+    let mut lines: Vec<(&str, String, Option<&str>)> = Vec::new();
+    let given = model.params.iter().map(|(name, _, value)| (name, value));
+    for (name, value) in given.chain([("z_min", m.z_min), ("z_max", m.z_max)]) {
+        let text = Float::F64
+            .literal_text(value)
+            .ok_or_else(|| EmitError::NonFinite {
+                name: name.to_owned(),
+                value: format!("{value:?}"),
+                float: "f64",
+            })?;
+        lines.push((name, text, None));
+    }
+    for c in physical::of_model(model) {
+        lines.push((c.symbol, c.definition.to_owned(), Some(c.doc)));
+    }
+    let mut seen: Vec<String> = Vec::new();
+    let mut body = String::new();
+    for (name, value, doc) in lines {
+        let cname = const_name(name)?;
+        if seen.contains(&cname) {
+            return Err(EmitError::DuplicateName(cname));
+        }
+        match doc {
+            Some(doc) => body.push_str(&format!("        /// {doc}\n")),
+            None if cname != name => body.push_str(&format!("        /// `{name}`\n")),
+            None => {}
+        }
+        body.push_str(&format!("        pub const {cname}: $f = {value};\n"));
+        seen.push(cname);
+    }
+    Ok(format!(
+        "/// The model parameters of `{}` (SI units), one per line, declared in\n\
+         /// each float module as `params!(f64)` / `params!(f32)`.\n\
+         macro_rules! params {{\n    ($f:ident) => {{\n{body}    }};\n}}\n",
+        d.name
+    ))
+}
+
 /// parameter symbol → const name; checks symbols and uniqueness.
 fn const_names(graph: &Graph, params: &[Param]) -> Result<HashMap<Id, String>, EmitError> {
     let mut by_id = HashMap::new();
     let mut seen: Vec<String> = Vec::new();
-    for &(name, id, _) in params {
+    for &Param {
+        name, symbol: id, ..
+    } in params
+    {
         if graph.name_of(id).is_none() {
             return Err(EmitError::NotASymbol(name.to_owned()));
         }
@@ -131,7 +181,9 @@ pub(crate) enum Inline {
     Always,
 }
 
-/// [`function_tokens`] with the given inlining attribute.
+/// [`function_tokens`] with the given inlining attribute: physical
+/// constants named, parameter-only calls folded, then the plan (`plan.rs`),
+/// the lowering (`lower.rs`) and the function's tokens.
 pub(crate) fn function_tokens_inline(
     graph: &Graph,
     spec: &FunctionSpec,
@@ -145,61 +197,30 @@ pub(crate) fn function_tokens_inline(
         .map(|o| o.1)
         .chain(spec.named.iter().map(|n| n.1))
         .collect();
-    let folded = fold(graph, params, &roots)?;
-    let (graph, roots, params) = match &folded {
-        Some(f) => {
-            let mut all = params.to_vec();
-            all.extend(
-                f.derived
-                    .iter()
-                    .map(|d| (d.name.as_str(), d.symbol, d.value)),
-            );
-            (&f.graph, f.roots.clone(), all)
+    let named_consts = name_constants(graph, &roots, params);
+    let mut all_params = params.to_vec();
+    let (graph, roots) = match &named_consts {
+        Some(n) => {
+            all_params.extend(n.local.iter().map(|(p, _)| *p));
+            (&n.graph, n.roots.clone())
         }
-        None => (graph, roots, params.to_vec()),
+        None => (graph, roots),
     };
-    let params = params.as_slice();
-    let const_by_id = const_names(graph, params)?;
-    let mut namer = Namer::default();
-    for &(name, _) in &spec.inputs {
-        namer.reserve(name)?;
-    }
-    for &(name, _, _) in &spec.outputs {
-        namer.reserve(name)?;
-    }
-    for &(name, _) in &spec.named {
-        namer.reserve(name)?;
-    }
-    let inputs: Vec<(String, Id)> = spec
-        .inputs
-        .iter()
-        .map(|&(n, id)| (n.to_owned(), id))
-        .collect();
-    let outputs: Vec<(String, Id)> = spec
-        .outputs
-        .iter()
-        .zip(&roots)
-        .map(|(&(n, _, _), &id)| (n.to_owned(), id))
-        .collect();
-    let named: Vec<(String, Id)> = spec
-        .named
-        .iter()
-        .zip(&roots[spec.outputs.len()..])
-        .map(|(&(n, _), &id)| (n.to_owned(), id))
-        .collect();
-    let output_symbols: Vec<(String, Id)> = spec
-        .output_symbols
-        .iter()
-        .map(|&(n, id)| (n.to_owned(), id))
-        .collect();
-    let request = PlanRequest {
-        inputs: &inputs,
-        params: &const_by_id,
-        outputs: &outputs,
-        named: &named,
-        output_symbols: &output_symbols,
+    let folded = fold(graph, &all_params, &roots)?;
+    let (graph, roots) = match &folded {
+        Some(f) => {
+            all_params.extend(f.derived.iter().map(|d| Param {
+                name: d.name.as_str(),
+                symbol: d.symbol,
+                value: d.value,
+            }));
+            (&f.graph, f.roots.clone())
+        }
+        None => (graph, roots),
     };
-    let plan = plan(graph, &request, &mut namer)?;
+    let const_by_id = const_names(graph, &all_params)?;
+    let request = Request::new(spec, &roots, &const_by_id);
+    let plan = plan(graph, &request.plan(), &mut request.namer()?)?;
 
     let param_ids: HashSet<Id> = const_by_id.keys().copied().collect();
     let mut lower = Lowerer {
@@ -211,14 +232,20 @@ pub(crate) fn function_tokens_inline(
         statics: HashMap::new(),
         defined: HashSet::new(),
     };
-    let mut body = derived_consts(folded.as_ref(), spec.float)?;
+    let mut body = local_consts(
+        graph,
+        &roots,
+        named_consts.as_ref(),
+        folded.as_ref(),
+        spec.float,
+    )?;
     for b in &plan.lets {
         let name = ident(&b.name);
         let rhs = lower.definition(b.id)?;
         lower.defined.insert(b.id);
         body.extend(quote!(let #name = #rhs;));
     }
-    for (name, id) in &outputs {
+    for (name, id) in &request.outputs {
         if plan.bound.get(id) == Some(name) {
             continue; // bound above under the output's own name
         }
@@ -226,34 +253,101 @@ pub(crate) fn function_tokens_inline(
         let name = ident(name);
         body.extend(quote!(let #name = #rhs;));
     }
-    let prelude = if lower.uses_real {
-        quote!(
-            use reldesign_runtime::math::Real;
-        )
-    } else {
-        quote!()
-    };
+    if lower.uses_real {
+        body = quote!(use reldesign_runtime::math::Real; #body);
+    }
+    Ok(assemble(spec, &request, &plan.input_used, body, inline))
+}
 
+/// The names of one function's plan: inputs, outputs (as mapped by the
+/// rewrites), caller-named subexpressions and output symbols.
+struct Request<'a> {
+    spec: &'a FunctionSpec<'a>,
+    const_by_id: &'a HashMap<Id, String>,
+    inputs: Vec<(String, Id)>,
+    outputs: Vec<(String, Id)>,
+    named: Vec<(String, Id)>,
+    output_symbols: Vec<(String, Id)>,
+}
+
+impl<'a> Request<'a> {
+    /// `roots`: the images of the outputs, then of the named subexpressions.
+    fn new(spec: &'a FunctionSpec, roots: &[Id], const_by_id: &'a HashMap<Id, String>) -> Self {
+        let (output_roots, named_roots) = roots.split_at(spec.outputs.len());
+        Request {
+            spec,
+            const_by_id,
+            inputs: owned(spec.inputs.iter().copied()),
+            outputs: owned(
+                spec.outputs
+                    .iter()
+                    .zip(output_roots)
+                    .map(|(o, &id)| (o.0, id)),
+            ),
+            named: owned(spec.named.iter().zip(named_roots).map(|(n, &id)| (n.0, id))),
+            output_symbols: owned(spec.output_symbols.iter().copied()),
+        }
+    }
+
+    fn plan(&self) -> PlanRequest<'_> {
+        PlanRequest {
+            inputs: &self.inputs,
+            params: self.const_by_id,
+            outputs: &self.outputs,
+            named: &self.named,
+            output_symbols: &self.output_symbols,
+        }
+    }
+
+    /// A namer with every caller-given name reserved.
+    fn namer(&self) -> Result<Namer, EmitError> {
+        let mut namer = Namer::default();
+        let given = (self.spec.inputs.iter().map(|i| i.0))
+            .chain(self.spec.outputs.iter().map(|o| o.0))
+            .chain(self.spec.named.iter().map(|n| n.0));
+        for name in given {
+            namer.reserve(name)?;
+        }
+        Ok(namer)
+    }
+}
+
+fn owned<'s>(names: impl Iterator<Item = (&'s str, Id)>) -> Vec<(String, Id)> {
+    names.map(|(n, id)| (n.to_owned(), id)).collect()
+}
+
+/// The output struct and the function around `body`.
+fn assemble(
+    spec: &FunctionSpec,
+    request: &Request,
+    input_used: &[bool],
+    body: TokenStream,
+    inline: Inline,
+) -> TokenStream {
     let ty = spec.float.ty();
     let out_ty = ident(&format!("{}Output", camel(spec.name)));
     let fn_name = ident(spec.name);
-    let args = inputs.iter().zip(&plan.input_used).map(|((n, _), &used)| {
-        let n = if used {
-            ident(n)
-        } else {
-            ident(&format!("_{n}"))
-        };
-        quote!(#n: #ty)
-    });
+    let args = request
+        .inputs
+        .iter()
+        .zip(input_used)
+        .map(|((n, _), &used)| {
+            let n = if used {
+                ident(n)
+            } else {
+                ident(&format!("_{n}"))
+            };
+            quote!(#n: #ty)
+        });
     let fields = spec.outputs.iter().map(|&(n, _, doc)| {
         let n = ident(n);
         let docs = doc_attrs(doc);
         quote!(#docs pub #n: #ty)
     });
-    let field_names = outputs.iter().map(|(n, _)| ident(n));
+    let field_names = request.outputs.iter().map(|(n, _)| ident(n));
     let fn_doc = doc_attrs(spec.doc);
     let struct_doc = format!(" Outputs of [`{}`].", spec.name);
-    let allow = if inputs.len() > 7 {
+    let allow = if request.inputs.len() > 7 {
         quote!(#[allow(clippy::too_many_arguments)])
     } else {
         quote!()
@@ -262,7 +356,7 @@ pub(crate) fn function_tokens_inline(
         Inline::Hint => quote!(#[inline]),
         Inline::Always => quote!(#[inline(always)]),
     };
-    Ok(quote! {
+    quote! {
         #[doc = #struct_doc]
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct #out_ty {
@@ -274,31 +368,46 @@ pub(crate) fn function_tokens_inline(
         #[must_use]
         #allow
         pub fn #fn_name(#(#args),*) -> #out_ty {
-            #prelude
             #body
             #out_ty { #(#field_names),* }
         }
-    })
+    }
 }
 
-/// `const NAME: f32 = value;` per derived const of `folded` (see `fold.rs`),
-/// documented with the expression it stands for.
-fn derived_consts(folded: Option<&Folded>, float: Float) -> Result<TokenStream, EmitError> {
-    let mut items = TokenStream::new();
-    let ty = float.ty();
-    for d in folded.map_or(&[][..], |f| &f.derived) {
-        let cname = const_name(&d.name)?;
-        let lit = float
-            .unsuffixed_signed(d.value)
-            .ok_or_else(|| EmitError::NonFinite {
-                name: cname.clone(),
-                value: format!("{:?}", d.value),
-                float: float.name(),
-            })?;
+/// The function's own consts: the physical constants it uses (`physical.rs`),
+/// then its derived consts (`fold.rs`), each documented.
+fn local_consts(
+    graph: &Graph,
+    roots: &[Id],
+    named: Option<&Named>,
+    folded: Option<&Folded>,
+    float: Float,
+) -> Result<TokenStream, EmitError> {
+    let reachable: HashSet<Id> = graph.postorder(roots).into_iter().collect();
+    let physical = named
+        .map_or(&[][..], |n| &n.local)
+        .iter()
+        .filter(|(p, _)| reachable.contains(&p.symbol))
+        .map(|(p, doc)| (p.name, p.value, (*doc).to_owned()));
+    let derived = folded.map_or(&[][..], |f| &f.derived).iter().map(|d| {
         let doc = format!(
-            " {} (parameters only: evaluated when generated, so it changes with them)",
+            "{} (parameters only: evaluated when generated, so it changes with them)",
             d.formula
         );
+        (d.name.as_str(), d.value, doc)
+    });
+    let mut items = TokenStream::new();
+    let ty = float.ty();
+    for (name, value, doc) in physical.chain(derived) {
+        let cname = const_name(name)?;
+        let lit = float
+            .unsuffixed_signed(value)
+            .ok_or_else(|| EmitError::NonFinite {
+                name: cname.clone(),
+                value: format!("{value:?}"),
+                float: float.name(),
+            })?;
+        let doc = format!(" {doc}");
         let cname = ident(&cname);
         items.extend(quote!(#[doc = #doc] const #cname: #ty = #lit;));
     }

@@ -45,6 +45,16 @@ impl Float {
         v.is_finite().then_some(text)
     }
 
+    /// The text of [`Float::unsuffixed_signed`], `-0.75`.
+    pub(crate) fn literal_text(self, value: f64) -> Option<String> {
+        let magnitude = self.magnitude_text(value)?;
+        Some(if value.is_sign_negative() && value != 0.0 {
+            format!("-{magnitude}")
+        } else {
+            magnitude
+        })
+    }
+
     /// A typed literal `1.5_f64` (non-negative `value`).
     pub(crate) fn suffixed(self, value: f64) -> Option<TokenStream> {
         let text = format!("{}_{}", self.magnitude_text(value)?, self.name());

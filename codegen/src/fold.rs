@@ -18,9 +18,9 @@ use std::collections::{HashMap, HashSet};
 use designer::sym::{Func, Graph, Id, Node};
 use reldesign_runtime::math::Real;
 
-use crate::emit::Param;
 use crate::error::EmitError;
 use crate::names::{const_name, describe};
+use crate::param::Param;
 
 /// One derived const: a parameter-only subexpression replaced by a symbol.
 pub(crate) struct Derived {
@@ -49,15 +49,15 @@ pub(crate) fn fold(
     params: &[Param],
     roots: &[Id],
 ) -> Result<Option<Folded>, EmitError> {
-    let param_ids: HashSet<Id> = params.iter().map(|p| p.1).collect();
+    let param_ids: HashSet<Id> = params.iter().map(|p| p.symbol).collect();
     let sites = fold_sites(graph, &param_ids, roots);
     if sites.is_empty() {
         return Ok(None);
     }
-    let values: HashMap<Id, f64> = params.iter().map(|&(_, id, v)| (id, v)).collect();
+    let values: HashMap<Id, f64> = params.iter().map(|p| (p.symbol, p.value)).collect();
     let mut taken: HashSet<String> = params
         .iter()
-        .map(|p| const_name(p.0))
+        .map(|p| const_name(p.name))
         .collect::<Result<_, _>>()?;
     let mut g = graph.clone();
     let mut derived = Vec::with_capacity(sites.len());
@@ -220,7 +220,7 @@ mod tests {
     fn folds_the_maximal_parameter_only_calls_and_evaluates_them() {
         let mut g = Graph::new();
         let (root, [_, a, b]) = example(&mut g);
-        let params = [("a", a, 4.0), ("b", b, 1.0)];
+        let params = [("a", a, 4.0).into(), ("b", b, 1.0).into()];
         let Ok(Some(f)) = fold(&g, &params, &[root]) else {
             panic!("ln(√a + b) must fold");
         };
@@ -244,7 +244,10 @@ mod tests {
         let ia = g.recip(a);
         let sq = g.powi(a, 2);
         let root = g.product(&[x, ia, sq]);
-        assert!(matches!(fold(&g, &[("a", a, 2.0)], &[root]), Ok(None)));
+        assert!(matches!(
+            fold(&g, &[("a", a, 2.0).into()], &[root]),
+            Ok(None)
+        ));
     }
 
     #[test]
@@ -253,7 +256,7 @@ mod tests {
         let [x, a] = [g.symbol("x"), g.symbol("a")];
         let sa = g.sqrt(a);
         let root = g.mul(x, sa);
-        let err = fold(&g, &[("a", a, -1.0)], &[root]).err();
+        let err = fold(&g, &[("a", a, -1.0).into()], &[root]).err();
         assert!(
             matches!(&err, Some(EmitError::NonFinite { name, .. }) if name == "SQRT_A"),
             "{err:?}"

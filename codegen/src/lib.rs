@@ -3,16 +3,21 @@
 //!
 //! The foundation is the expression emitter: [`emit_params`] writes the
 //! parameters as named consts (one per line, values in shortest round-trip
-//! form), [`emit_function`] writes a set of named outputs as one plain `fn`
-//! over `f32` or `f64` scalars returning a struct. Parameters stay symbolic
-//! (changing one value changes one line), shared subexpressions become `let`s
-//! in the deterministic CSE order, math goes through
+//! form) and [`params_macro`] the file's one `params!` macro of them,
+//! [`emit_function`] writes a set of named outputs as one plain `fn` over
+//! `f32` or `f64` scalars returning a struct. Parameters stay symbolic
+//! (changing one value changes one line), physical constants and the
+//! model's named subexpressions keep their names, shared subexpressions
+//! become `let`s in the deterministic CSE order, math goes through
 //! `reldesign_runtime::math::Real` (libm, no `std`), and nothing emitted
-//! allocates, indexes, unwraps or casts.
+//! allocates, indexes, unwraps or casts. The design is `designer`'s
+//! (`designer::design::Design`); this crate only renders it.
 //!
 //! | module | concept |
 //! | --- | --- |
-//! | `emit.rs` | the public emitters: [`FunctionSpec`], [`emit_params`], [`emit_function`] |
+//! | `emit.rs` | the public emitters: [`FunctionSpec`], [`emit_params`], [`params_macro`], [`emit_function`] |
+//! | `param.rs` | [`Param`]: one parameter (name, symbol, value) |
+//! | `physical.rs` | μ0 and Z_EPS by name instead of folded into coefficients |
 //! | `plan.rs` | which nodes become `let`s, in which order, under which names |
 //! | `lower.rs` | one expression → Rust tokens (subtractions, divisions, powers, `if`) |
 //! | `names.rs` | name validation, parameter const names, readable temporaries |
@@ -20,7 +25,8 @@
 //! | `float.rs` | [`Float`] and shortest round-trip literals |
 //! | `format.rs` | `prettyplease` formatting and `//` comments |
 //! | `error.rs` | [`EmitError`] |
-//! | `controller.rs` | the feedback-linearizing controller module |
+//! | `build.rs` | a description → the emitted file ([`build_file`], [`compile`], [`emit`]) |
+//! | `controller.rs` | the feedback-linearizing controller modules (over `reldesign_runtime::control`) |
 //! | `semera.rs` | the SEMERA and integral estimator modules |
 //! | `observer.rs` | the EKF and UKF modules |
 
@@ -35,22 +41,21 @@ mod header;
 mod lower;
 mod names;
 mod observer;
+mod param;
+mod physical;
 mod plan;
 mod semera;
 
-pub use build::{
-    build_file, compile, operation_name, write_if_changed, BuildError, ControllerDesign, Design,
-    DesignedOperation,
+pub use build::{build_file, compile, emit, write_if_changed, BuildError};
+pub use controller::{emit_controller, ControllerError, ControllerInput};
+pub use emit::{
+    emit_function, emit_params, function_tokens, params_macro, params_tokens, FunctionSpec,
 };
-pub use controller::{
-    emit_controller, gains, triple_pole_settling_product, ControllerError, ControllerInput,
-    OperationTable,
-};
-pub use emit::{emit_function, emit_params, function_tokens, params_tokens, FunctionSpec, Param};
 pub use error::EmitError;
 pub use float::Float;
 pub use format::format_items;
 pub use header::{sha256_hex, Header};
 pub use names::const_name;
 pub use observer::*;
+pub use param::Param;
 pub use semera::*;

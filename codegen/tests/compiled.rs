@@ -36,7 +36,7 @@ impl Case {
     fn params(&self) -> Vec<Param<'_>> {
         self.params
             .iter()
-            .map(|(n, id, v)| (n.as_str(), *id, *v))
+            .map(|(n, id, v)| Param::from((n.as_str(), *id, *v)))
             .collect()
     }
 

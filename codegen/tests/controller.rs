@@ -1,4 +1,4 @@
-//! The emitted controller: gains, determinism, one changed line per changed
+//! The emitted controller: determinism, one changed line per changed
 //! parameter, compilation as a `#![no_std]` crate under clippy's panic lints
 //! (f64 and f32), the law against the designer's tape, and finite saturated
 //! outputs at φ = 0, z = 0 and NaN inputs.
@@ -14,9 +14,12 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use codegen::{emit_controller, gains, ControllerInput, Float, OperationTable};
+use codegen::{emit_controller, params_macro, ControllerInput, Float, Header};
 use designer::description::{parse_str, Gains, Operation};
-use designer::design::{Flat, Linearization, Polynomial, Reference, Segments};
+use designer::design::{
+    check_feasibility, gains, ControllerDesign, ControllerSpec, DesignedOperation, Flat,
+    Linearization, Polynomial, Reference, Segments,
+};
 use designer::model::Model;
 use designer::sym::{Id, Tape};
 
@@ -85,16 +88,28 @@ fn emit(v: &Valve, floats: &[Float]) -> String {
     emit_ops(v, floats, false)
 }
 
-/// The closing controller, with the opening one too if `both`.
-fn emit_ops(v: &Valve, floats: &[Float], both: bool) -> String {
+/// The design of the closing quintic, with the opening one too if `both`.
+fn design(v: &Valve, both: bool) -> ControllerDesign {
+    let mut model = v.model.clone();
     let d = &v.model.description;
-    let s = &v.model.states;
-    let input = ControllerInput {
-        name: &d.name,
-        graph: &v.model.graph,
-        params: v.model.params.iter().collect(),
-        states: [s[0], s[1], s[2]],
-        linearization: &v.lin,
+    let (z_min, z_max) = (d.mechanics.z_min, d.mechanics.z_max);
+    let bounds = (d.supply.u_min, d.supply.u_max);
+    let mut operation = |operation, z0, zf, table: &Segments| {
+        let (reference, _) = quintic_reference(z0, zf);
+        DesignedOperation {
+            operation,
+            z0,
+            zf,
+            feasibility: check_feasibility(&mut model, &v.lin, &reference, bounds, 100),
+            table: table.clone(),
+            optimal: None,
+        }
+    };
+    let mut operations = vec![operation(Operation::Closing, z_max, z_min, &v.segments)];
+    if both {
+        operations.push(operation(Operation::Opening, z_min, z_max, &v.opening));
+    }
+    let spec = ControllerSpec {
         gains: gains(&Gains::SettlingTime(1e-3)),
         sample_period: 1e-5,
         u_min: d.supply.u_min,
@@ -102,41 +117,32 @@ fn emit_ops(v: &Valve, floats: &[Float], both: bool) -> String {
         takeoff: T0,
         landing: TF,
         creep_speed: None,
-        operations: vec![OperationTable {
-            operation: Operation::Closing,
-            z0: d.mechanics.z_max,
-            zf: d.mechanics.z_min,
-            segments: &v.segments,
-        }]
-        .into_iter()
-        .chain(both.then_some(OperationTable {
-            operation: Operation::Opening,
-            z0: d.mechanics.z_min,
-            zf: d.mechanics.z_max,
-            segments: &v.opening,
-        }))
-        .collect(),
-        floats: floats.to_vec(),
-        source_file: "perfect-tracking-valve.toml",
-        source_text: &v.text,
-        generator_version: env!("CARGO_PKG_VERSION"),
     };
-    emit_controller(&input).unwrap_or_else(|e| panic!("{e}"))
+    ControllerDesign::decide(&v.model, v.lin.clone(), &spec, operations)
+        .unwrap_or_else(|e| panic!("{e}"))
 }
 
-#[test]
-fn gains_from_settling_time_and_poles() {
-    // "a 1 ms 5 % settling time of the triple pole is λ ≈ 6296 s⁻¹"
-    let [k1, k2, k3] = gains(&Gains::SettlingTime(1e-3));
-    let lambda = k3 / 3.0;
-    assert!((lambda - 6295.8).abs() < 0.05, "λ = {lambda}");
-    assert!((k2 - 3.0 * lambda * lambda).abs() <= 1e-9 * k2);
-    assert!((k1 - lambda.powi(3)).abs() <= 1e-9 * k1);
-    // the step response of the triple pole is at 95 % at t_s
-    let x: f64 = lambda * 1e-3;
-    assert!(((-x).exp() * (1.0 + x + x * x / 2.0) - 0.05).abs() < 1e-12);
-    // (s + 1)(s + 2)(s + 3) = s³ + 6s² + 11s + 6
-    assert_eq!(gains(&Gains::Poles([-1.0, -2.0, -3.0])), [6.0, 11.0, 6.0]);
+/// The emitted file as `reldesign build` composes it: header, `params!`, the
+/// float modules.
+fn emit_ops(v: &Valve, floats: &[Float], both: bool) -> String {
+    let design = design(v, both);
+    let input = ControllerInput {
+        model: &v.model,
+        design: &design,
+        floats: floats.to_vec(),
+    };
+    let header = Header {
+        what: "controller",
+        generator_version: env!("CARGO_PKG_VERSION"),
+        source_file: "perfect-tracking-valve.toml",
+        source_text: &v.text,
+    };
+    format!(
+        "{}\n{}\n{}",
+        header.text(),
+        params_macro(&v.model).unwrap_or_else(|e| panic!("{e}")),
+        emit_controller(&input).unwrap_or_else(|e| panic!("{e}"))
+    )
 }
 
 #[test]
@@ -205,10 +211,25 @@ fn header_and_sections_are_there() {
         "pub fn guarded_law(",
         "pub const REFERENCE_CLOSING: [[f64; 7]; 1]",
         "pub const REFERENCE_CLOSING: [[f32; 7]; 1]",
-        "pub struct Controller",
+        "pub type Controller = control::SoftLanding<Design, f64>;",
+        "impl control::Law<f32> for Design {",
         "// (50) u = α + β·w",
+        // physical constants and the model's subexpressions by name
+        "pub const MU0: $f = 4e-7 * ::core::$f::consts::PI;",
+        "let z_reg = z + Z_EPS;",
+        "let fringe_den = ",
+        "let f_net = f_mag - f_passive;",
+        // the end stops by name
+        "z0: Z_MAX,",
+        "zf: Z_MIN,",
     ] {
         assert!(code.contains(needle), "missing {needle}");
+    }
+    for folded in ["795774.7", "397887.3", "1e-9_f"] {
+        assert!(
+            !code.contains(folded),
+            "a folded physical constant: {folded}"
+        );
     }
     for forbidden in [
         ".unwrap()",

@@ -6,7 +6,7 @@
 /// The model parameters of `semera_valve` (SI units), one per line, declared in
 /// each float module as `params!(f64)` / `params!(f32)`.
 macro_rules! params {
-    ($f:ty) => {
+    ($f:ident) => {
         /// `k_gap`
         pub const K_GAP: $f = 27000000000.0;
         /// `R_gap0`
@@ -26,6 +26,10 @@ macro_rules! params {
         /// `c`
         pub const C: $f = 0.4;
         pub const F0: $f = -0.8325;
+        /// `z_min`
+        pub const Z_MIN: $f = 0.0;
+        /// `z_max`
+        pub const Z_MAX: $f = 0.0009;
     };
 }
 

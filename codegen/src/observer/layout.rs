@@ -9,7 +9,8 @@ use designer::sym::{Graph, Id};
 use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::emit::{function_tokens, FunctionSpec, Param};
+use crate::emit::{function_tokens, FunctionSpec};
+use crate::param::Param;
 use crate::error::EmitError;
 use crate::float::Float;
 

@@ -33,6 +33,7 @@ use designer::observe::discrete::DiscreteModel;
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
+use crate::param::Param;
 use crate::error::EmitError;
 use crate::float::Float;
 use crate::format::{comment_lets, format_items, space_items};
@@ -168,7 +169,7 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
     let layout = Layout::new(dm, kind);
     let ty = float.ty();
     let module = format_ident!("{}", float.name());
-    let params = dm.param_list();
+    let params: Vec<Param> = dm.param_list().into_iter().map(Param::from).collect();
 
     let mut functions = vec![
         &layout.transition,

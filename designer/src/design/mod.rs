@@ -10,9 +10,15 @@
 //! - `optimal_guess.rs`: rest states and the polynomial initial guess of an arc;
 //! - `optimal_search.rs`: rest, move, rest: the optimum within the stroke (57);
 //! - `limits.rs`: the shortest motion and J against the motion time (`limits`);
-//! - `segments.rs`: a reference as a compact table of polynomial segments.
+//! - `segments.rs`: a reference as a compact table of polynomial segments;
+//! - `decisions.rs`: the controller's design decisions (gains, guard, landed
+//!   band, press, creep) as plain data, [`ControllerDesign`];
+//! - `plan.rs`: description → [`Design`] (controller and Kalman model), the
+//!   pipeline up to code generation;
+//! - `report.rs`: the design report of `reldesign build`.
 
 mod bvp;
+mod decisions;
 mod feasibility;
 mod fit_segments;
 mod lie;
@@ -21,12 +27,17 @@ mod linearization;
 mod optimal;
 mod optimal_guess;
 mod optimal_search;
+mod plan;
 mod reference;
+mod report;
 mod segments;
 
 pub use bvp::{
     jacobian_discrepancy, solve_bvp, solve_collocation, BvpError, BvpOptions, BvpProblem,
     BvpSolution,
+};
+pub use decisions::{
+    gains, triple_pole_settling_product, ControllerDesign, ControllerSpec, DesignedOperation,
 };
 pub use feasibility::{check as check_feasibility, Condition, Feasibility};
 pub use fit_segments::{
@@ -40,5 +51,6 @@ pub use optimal::{
     energy_optimal, CostateGuess, HamiltonianSystem, OptimalError, OptimalSpec, OptimalTrajectory,
     Switch,
 };
+pub use plan::{design_controller, design_kalman, Design, PlanError};
 pub use reference::{Flat, Polynomial, Reference};
 pub use segments::{Segment, Segments};

@@ -46,16 +46,11 @@ impl Segments {
         [t_k, at_k.z, at_k.v, at_k.a, at_k.jerk, c2, c3]
     }
 
-    /// Evaluates one segment at τ = t − t_k.
+    /// Evaluates one segment at τ = t − t_k (the generated controller's own
+    /// code, `reldesign_runtime::control::eval_segment`).
     pub fn eval_segment(s: &Segment, tau: f64) -> Flat {
-        let [_, z, v, c0, c1, c2, c3] = *s;
-        Flat {
-            z: z + tau
-                * (v + tau * (c0 / 2.0 + tau * (c1 / 6.0 + tau * (c2 / 12.0 + tau * c3 / 20.0)))),
-            v: v + tau * (c0 + tau * (c1 / 2.0 + tau * (c2 / 3.0 + tau * c3 / 4.0))),
-            a: c0 + tau * (c1 + tau * (c2 + tau * c3)),
-            jerk: c1 + tau * (2.0 * c2 + tau * 3.0 * c3),
-        }
+        let [z, v, a, jerk] = reldesign_runtime::control::eval_segment(s, tau);
+        Flat { z, v, a, jerk }
     }
 
     /// Index of the segment holding t (None before the first or after the end).

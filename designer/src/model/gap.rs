@@ -30,8 +30,12 @@ pub const MU0: f64 = 4.0e-7 * std::f64::consts::PI;
 /// Regularisation length of the McLyman logarithm [m] (see the module docs).
 pub const Z_EPS: f64 = 1e-9;
 
-/// R_gap(z) as an expression of the position symbol `z`.
-pub fn reluctance(g: &mut Graph, params: &mut Params, gap: &Gap, z: Id) -> Id {
+/// Model-level names of subexpressions (see `Model::named`).
+pub type Names = Vec<(&'static str, Id)>;
+
+/// R_gap(z) as an expression of the position symbol `z`; the fringing
+/// terms' names go to `names`.
+pub fn reluctance(g: &mut Graph, params: &mut Params, gap: &Gap, z: Id, names: &mut Names) -> Id {
     match gap {
         Gap::Linear { slope, offset } => {
             let k = params.key(g, "gap.slope", *slope);
@@ -42,54 +46,71 @@ pub fn reluctance(g: &mut Graph, params: &mut Params, gap: &Gap, z: Id) -> Id {
         Gap::McLyman {
             area,
             winding_length,
-        } => mclyman(g, params, *area, *winding_length, z),
+        } => mclyman(g, params, *area, *winding_length, z, names),
         Gap::McLymanFit {
             r0,
             r0_prime,
             k1,
             k2,
-        } => mclyman_fit(g, params, [*r0, *r0_prime, *k1, *k2], z),
+        } => mclyman_fit(g, params, [*r0, *r0_prime, *k1, *k2], z, names),
         Gap::Table { z: zs, r, r_prime } => Spline::fit(zs, r, r_prime.as_deref()).expression(g, z),
     }
 }
 
 /// ln(k / (z + Z_EPS)): the regularised McLyman logarithm.
-fn fringing_log(g: &mut Graph, k: Id, z: Id) -> Id {
+fn fringing_log(g: &mut Graph, k: Id, z: Id, names: &mut Names) -> Id {
     let eps = g.constant(Z_EPS);
     let ze = g.add(z, eps);
     let q = g.div(k, ze);
-    g.ln(q)
+    let log = g.ln(q);
+    names.extend([("z_reg", ze), ("fringe_log", log)]);
+    log
 }
 
 /// (6): R_gap = (z/(μ0·A)) / (1 + z/√A · ln(2·l_w/z)).
-fn mclyman(g: &mut Graph, params: &mut Params, area: f64, winding_length: f64, z: Id) -> Id {
+fn mclyman(
+    g: &mut Graph,
+    params: &mut Params,
+    area: f64,
+    winding_length: f64,
+    z: Id,
+    names: &mut Names,
+) -> Id {
     let a = params.key(g, "gap.area", area);
     let lw = params.key(g, "gap.winding_length", winding_length);
     let mu0 = g.constant(MU0);
     let two = g.constant(2.0);
     let two_lw = g.mul(two, lw);
-    let log = fringing_log(g, two_lw, z);
+    let log = fringing_log(g, two_lw, z, names);
     let sqrt_a = g.sqrt(a);
     let ratio = g.div(z, sqrt_a);
     let fringe = g.mul(ratio, log);
     let one = g.one();
     let den = g.add(one, fringe);
+    names.push(("fringe_den", den));
     let mu0_a = g.mul(mu0, a);
     let num = g.div(z, mu0_a);
     g.div(num, den)
 }
 
 /// jiles-atherton-actuator-model (11): R_gap = R_g0 + R'_g0·z / (1 + k1·z·ln(k2/z)).
-fn mclyman_fit(g: &mut Graph, params: &mut Params, [r0, r0p, k1, k2]: [f64; 4], z: Id) -> Id {
+fn mclyman_fit(
+    g: &mut Graph,
+    params: &mut Params,
+    [r0, r0p, k1, k2]: [f64; 4],
+    z: Id,
+    names: &mut Names,
+) -> Id {
     let r0 = params.key(g, "gap.r0", r0);
     let r0p = params.key(g, "gap.r0_prime", r0p);
     let k1 = params.key(g, "gap.k1", k1);
     let k2 = params.key(g, "gap.k2", k2);
-    let log = fringing_log(g, k2, z);
+    let log = fringing_log(g, k2, z, names);
     let k1z = g.mul(k1, z);
     let fringe = g.mul(k1z, log);
     let one = g.one();
     let den = g.add(one, fringe);
+    names.push(("fringe_den", den));
     let num = g.mul(r0p, z);
     let frac = g.div(num, den);
     g.add(r0, frac)

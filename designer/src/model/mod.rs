@@ -55,6 +55,10 @@ pub struct Model {
     pub passive_force: Id,
     pub r_gap: Id,
     pub r_gap_dz: Id,
+    /// Model-level names of subexpressions (`r_gap`, `f_mag`, `fringe_den`, …)
+    /// for generated code: each one an emitted expression reaches becomes a
+    /// `let` of that name.
+    pub named: Vec<(&'static str, Id)>,
     /// Stored magnetic energy W(z, φ) (not for the hysteretic core).
     pub stored_energy: Option<Id>,
     /// Coil resistance R(t).
@@ -97,9 +101,10 @@ impl Model {
         let u = g.symbol("u");
         let t = g.symbol("t");
 
+        let mut named = Vec::new();
         let r_gap = match gap_spline {
             Some(spline) => spline.expression(&mut g, z),
-            None => gap::reluctance(&mut g, &mut params, &description.gap, z),
+            None => gap::reluctance(&mut g, &mut params, &description.gap, z, &mut named),
         };
         let r_gap_dz = g.diff(r_gap, z);
         let mmf_core = self::core::mmf(&mut g, &mut params, &description.core, phi, hc);
@@ -122,6 +127,7 @@ impl Model {
             &mut g,
             description.supply.drive,
             [n, resistance, k_e, u, mmf],
+            &mut named,
         );
 
         let m = &description.mechanics;
@@ -140,6 +146,13 @@ impl Model {
         // (16) v̇ = (F_mag − F)/m
         let net = g.sub(f_mag, passive_force);
         let accel = g.div(net, mass);
+        named.extend([
+            ("r_gap", r_gap),
+            ("mmf", mmf),
+            ("f_mag", f_mag),
+            ("f_passive", passive_force),
+            ("f_net", net),
+        ]);
 
         let mut states = vec![z, v, phi];
         let mut f = vec![v, accel, phi_dot];
@@ -177,6 +190,7 @@ impl Model {
             passive_force,
             r_gap,
             r_gap_dz,
+            named,
             stored_energy,
             resistance,
         }
@@ -252,14 +266,21 @@ fn max_slope_change(a: &Spline, b: &Spline) -> f64 {
     worst / scale
 }
 
-/// (φ̇, coil current, coil voltage) for the drive mode.
-fn electrical(g: &mut Graph, drive: Drive, [n, r, k_e, u, mmf]: [Id; 5]) -> (Id, Id, Id) {
+/// (φ̇, coil current, coil voltage) for the drive mode; the name of the
+/// flux equation's denominator goes to `names`.
+fn electrical(
+    g: &mut Graph,
+    drive: Drive,
+    [n, r, k_e, u, mmf]: [Id; 5],
+    names: &mut gap::Names,
+) -> (Id, Id, Id) {
     match drive {
         Drive::Voltage => {
             // k = N² + R·k_e
             let n2 = g.powi(n, 2);
             let rk = g.mul(r, k_e);
             let k = g.add(n2, rk);
+            names.push(("flux_den", k));
             // φ̇ = (N·u − R·MMF)/k
             let nu = g.mul(n, u);
             let r_mmf = g.mul(r, mmf);

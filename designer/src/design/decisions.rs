@@ -1,0 +1,305 @@
+//! The controller's design decisions as plain data: the gains K of (48), the
+//! guard at φ → 0, the landed band, the press and the creep after t_f
+//! (perfect-tracking-soft-landing §3.2 and §4). Code generation only renders
+//! a [`ControllerDesign`]; the runtime's `control` module applies it.
+
+use crate::description::{Gains, Operation};
+use crate::model::Model;
+use crate::sym::Tape;
+
+use super::feasibility::Feasibility;
+use super::linearization::Linearization;
+use super::optimal::OptimalTrajectory;
+use super::plan::PlanError;
+use super::segments::Segments;
+
+/// 5 % settling-time criterion of a triple real pole.
+const SETTLING_FRACTION: f64 = 0.05;
+
+/// Fraction of the smallest reference flux below which the law is not
+/// evaluated (before rounding down to one significant digit).
+const GUARD_FRACTION: f64 = 1e-3;
+
+/// Fraction of the stroke within which the armature counts as landed.
+const LANDED_FRACTION: f64 = 1e-9;
+/// The reference after t_f lies this fraction of the stroke beyond the end stop.
+const PRESS_FRACTION: f64 = 1e-6;
+/// After t_f the reference creeps on beyond the stop by this fraction of the
+/// stroke per motion time t_f − t₀ …
+const CREEP_FRACTION: f64 = 2.5e-3;
+/// … up to this fraction of the stroke beyond it.
+const CREEP_MAX_FRACTION: f64 = 0.05;
+
+/// Reference samples per segment when searching the smallest flux.
+const FLUX_SAMPLES: usize = 64;
+
+/// λ·t_s of a triple real pole −λ with 5 % settling time t_s: the root of
+/// e^{−x}(1 + x + x²/2) = 0.05 (≈ 6.2958).
+pub fn triple_pole_settling_product() -> f64 {
+    // The residual decreases strictly for x > 0: bisection on [0, 50].
+    let residual = |x: f64| (-x).exp() * (1.0 + x + 0.5 * x * x) - SETTLING_FRACTION;
+    let (mut lo, mut hi) = (0.0_f64, 50.0_f64);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if residual(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// K = [k1, k2, k3] of (48): the error dynamics (49) ξ̃' = (A − BK)ξ̃ of the
+/// triple integrator have the characteristic polynomial
+/// s³ + k3·s² + k2·s + k1 = Π(s − p_i).
+///
+/// A settling time t_s places a triple pole at −λ, λ = 6.2958…/t_s (5 %
+/// criterion), so K = [λ³, 3λ², 3λ].
+pub fn gains(g: &Gains) -> [f64; 3] {
+    let [p1, p2, p3] = match *g {
+        Gains::SettlingTime(ts) => {
+            let lambda = triple_pole_settling_product() / ts;
+            [-lambda; 3]
+        }
+        Gains::Poles(p) => p,
+    };
+    [
+        -(p1 * p2 * p3),
+        p1 * p2 + p1 * p3 + p2 * p3,
+        -(p1 + p2 + p3),
+    ]
+}
+
+/// One designed operation: its reference, feasibility and table.
+#[derive(Debug, Clone)]
+pub struct DesignedOperation {
+    pub operation: Operation,
+    /// Rest position before t₀ (z₀ of (51)).
+    pub z0: f64,
+    /// Rest position after t_f (z_f of (51)); the end stop of the hold.
+    pub zf: f64,
+    pub feasibility: Feasibility,
+    /// z_m on [t₀, t_f], times from the operation's start.
+    pub table: Segments,
+    /// The energy-optimal solution when the shape is `energy-optimal`.
+    pub optimal: Option<OptimalTrajectory>,
+}
+
+/// What the description asks of the controller: the inputs of the decisions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControllerSpec {
+    /// K = [k1, k2, k3] (see [`gains`]).
+    pub gains: [f64; 3],
+    /// T_s [s].
+    pub sample_period: f64,
+    /// Supply limits [V or A].
+    pub u_min: f64,
+    pub u_max: f64,
+    /// t₀, t_f [s] from the operation's start.
+    pub takeoff: f64,
+    pub landing: f64,
+    /// `[controller] creep_speed` [m/s]; `None`: the default creep.
+    pub creep_speed: Option<f64>,
+}
+
+/// The designed feedback-linearizing controller: everything the emitted
+/// module states, as numbers.
+#[derive(Debug, Clone)]
+pub struct ControllerDesign {
+    pub linearization: Linearization,
+    /// K = [k1, k2, k3] of (48).
+    pub gains: [f64; 3],
+    /// T_s [s]: the controller runs once per sample period.
+    pub sample_period: f64,
+    /// Supply limits: every output is saturated to [u_min, u_max].
+    pub u_min: f64,
+    pub u_max: f64,
+    /// t₀, t_f [s] from the operation's start.
+    pub takeoff: f64,
+    pub landing: f64,
+    /// [Wb]: where φ ≤ `phi_guard` the law is not evaluated and u = u_max;
+    /// 10⁻³ of the smallest flux the reference needs, rounded down.
+    pub phi_guard: f64,
+    /// [m]: within this distance of the end stop the armature is in contact
+    /// (the expert rules after t_f); 10⁻⁹ of the stroke, rounded down.
+    pub landed_band: f64,
+    /// After t_f the reference lies `press`·stroke beyond the end stop …
+    pub press: f64,
+    /// … and creeps on at `creep`·stroke per second [1/s] …
+    pub creep: f64,
+    /// … up to `creep_max`·stroke beyond it.
+    pub creep_max: f64,
+    /// In the order of `[trajectory].operations`, no operation twice.
+    pub operations: Vec<DesignedOperation>,
+}
+
+impl ControllerDesign {
+    /// Checks `spec` and the operations' tables, and takes the decisions:
+    /// the guard threshold from the smallest flux the references need, the
+    /// landed band from the stroke, the creep from `creep_speed`.
+    pub fn decide(
+        model: &Model,
+        linearization: Linearization,
+        spec: &ControllerSpec,
+        operations: Vec<DesignedOperation>,
+    ) -> Result<ControllerDesign, PlanError> {
+        let stroke = check(spec, &operations)?;
+        let phi_min = smallest_reference_flux(model, &linearization, &operations)?;
+        let creep = match spec.creep_speed {
+            Some(speed) => speed / stroke,
+            None => CREEP_FRACTION / (spec.landing - spec.takeoff),
+        };
+        Ok(ControllerDesign {
+            linearization,
+            gains: spec.gains,
+            sample_period: spec.sample_period,
+            u_min: spec.u_min,
+            u_max: spec.u_max,
+            takeoff: spec.takeoff,
+            landing: spec.landing,
+            phi_guard: round_down_1sig(GUARD_FRACTION * phi_min),
+            landed_band: round_down_1sig(LANDED_FRACTION * stroke),
+            press: PRESS_FRACTION,
+            creep,
+            creep_max: CREEP_MAX_FRACTION,
+            operations,
+        })
+    }
+}
+
+/// The checks of [`ControllerDesign::decide`]; the stroke max |z₀ − z_f|.
+fn check(spec: &ControllerSpec, operations: &[DesignedOperation]) -> Result<f64, PlanError> {
+    if operations.is_empty() {
+        return Err(PlanError::NoOperation);
+    }
+    let bad = |name: &str, value: f64| PlanError::BadValue {
+        name: name.to_owned(),
+        value,
+    };
+    let positive =
+        |name: &str, v: f64| (v.is_finite() && v > 0.0).then_some(()).ok_or(bad(name, v));
+    let finite = |name: &str, v: f64| v.is_finite().then_some(()).ok_or(bad(name, v));
+    for (k, &g) in spec.gains.iter().enumerate() {
+        positive(&format!("k{}", k + 1), g)?;
+    }
+    positive("sample_period", spec.sample_period)?;
+    positive("takeoff", spec.takeoff)?;
+    positive("landing - takeoff", spec.landing - spec.takeoff)?;
+    finite("u_min", spec.u_min)?;
+    finite("u_max", spec.u_max)?;
+    positive("u_max - u_min", spec.u_max - spec.u_min)?;
+    if let Some(speed) = spec.creep_speed {
+        positive("creep_speed", speed)?;
+    }
+    let mut stroke: f64 = 0.0;
+    for (k, op) in operations.iter().enumerate() {
+        if operations[..k].iter().any(|o| o.operation == op.operation) {
+            return Err(PlanError::DuplicateOperation(op.operation));
+        }
+        finite("z0", op.z0)?;
+        finite("zf", op.zf)?;
+        stroke = stroke.max((op.z0 - op.zf).abs());
+        let s = &op.table;
+        let first = s
+            .segments
+            .first()
+            .ok_or(PlanError::EmptyTable(op.operation))?[0];
+        let tol = 1e-9 * spec.landing;
+        if (first - spec.takeoff).abs() > tol || (s.end - spec.landing).abs() > tol {
+            return Err(PlanError::TableTiming {
+                operation: op.operation,
+                first,
+                end: s.end,
+                takeoff: spec.takeoff,
+                landing: spec.landing,
+            });
+        }
+        for &x in s.segments.iter().flatten() {
+            finite("reference table entry", x)?;
+        }
+    }
+    positive("stroke |z0 - zf|", stroke)?;
+    Ok(stroke)
+}
+
+/// `x > 0` rounded down to one significant digit (so that a small change of
+/// the design does not change the emitted threshold).
+fn round_down_1sig(x: f64) -> f64 {
+    let e = x.log10().floor();
+    let digit = (x / 10f64.powf(e)).floor().clamp(1.0, 9.0);
+    format!("{digit}e{e}").parse().unwrap_or(x)
+}
+
+/// min over the reference (rest positions and samples of every segment) of
+/// the flux T⁻¹ needs, √((ξ₃ − a₀)/c₂) (42), over the samples where it is
+/// positive and finite.
+fn smallest_reference_flux(
+    model: &Model,
+    lin: &Linearization,
+    operations: &[DesignedOperation],
+) -> Result<f64, PlanError> {
+    let mut inputs = lin.xi.to_vec();
+    inputs.extend(model.params.iter().map(|(_, id, _)| id));
+    let tape = Tape::compile(&model.graph, &inputs, &[lin.flux_squared])
+        .map_err(|e| PlanError::UnboundSymbol(e.0))?;
+    let mut scratch = tape.scratch();
+    let mut point: Vec<f64> = vec![0.0; 3];
+    point.extend(model.params.iter().map(|(_, _, v)| v));
+    let mut out = [0.0];
+    let mut smallest = f64::INFINITY;
+    let mut visit = |xi: [f64; 3]| {
+        point[..3].copy_from_slice(&xi);
+        tape.eval(&point, &mut scratch, &mut out);
+        let phi2 = out[0];
+        if phi2.is_finite() && phi2 > 0.0 {
+            smallest = smallest.min(phi2.sqrt());
+        }
+    };
+    for op in operations {
+        visit([op.z0, 0.0, 0.0]);
+        visit([op.zf, 0.0, 0.0]);
+        let segs = &op.table.segments;
+        for (k, seg) in segs.iter().enumerate() {
+            let next = segs.get(k + 1).map_or(op.table.end, |s| s[0]);
+            let h = next - seg[0];
+            for i in 0..=FLUX_SAMPLES {
+                let tau = h * i as f64 / FLUX_SAMPLES as f64;
+                let f = Segments::eval_segment(seg, tau);
+                visit([f.z, f.v, f.a]);
+            }
+        }
+    }
+    if smallest.is_finite() {
+        Ok(smallest)
+    } else {
+        Err(PlanError::NoFluxFloor)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_significant_digit_rounds_down() {
+        assert_eq!(round_down_1sig(3.7e-9), 3e-9);
+        assert_eq!(round_down_1sig(1e-6), 1e-6);
+        assert_eq!(round_down_1sig(9.99e-4), 9e-4);
+    }
+
+    #[test]
+    fn gains_from_settling_time_and_poles() {
+        // "a 1 ms 5 % settling time of the triple pole is λ ≈ 6296 s⁻¹"
+        let [k1, k2, k3] = gains(&Gains::SettlingTime(1e-3));
+        let lambda = k3 / 3.0;
+        assert!((lambda - 6295.8).abs() < 0.05, "λ = {lambda}");
+        assert!((k2 - 3.0 * lambda * lambda).abs() <= 1e-9 * k2);
+        assert!((k1 - lambda.powi(3)).abs() <= 1e-9 * k1);
+        // the step response of the triple pole is at 95 % at t_s
+        let x: f64 = lambda * 1e-3;
+        assert!(((-x).exp() * (1.0 + x + x * x / 2.0) - 0.05).abs() < 1e-12);
+        // (s + 1)(s + 2)(s + 3) = s³ + 6s² + 11s + 6
+        assert_eq!(gains(&Gains::Poles([-1.0, -2.0, -3.0])), [6.0, 11.0, 6.0]);
+    }
+}

@@ -1,0 +1,323 @@
+//! From a description to a complete design, ready to emit: the pipeline
+//! behind `reldesign build`, the `build.rs` call and the `design!` macro up
+//! to (not including) code generation.
+//!
+//! description → model → feedback linearization (α, β, T, T⁻¹) → per
+//! operation a reference (polynomial or energy-optimal) → feasibility (54),
+//! (56), (57) → reference table → the decisions of `decisions.rs`; and the
+//! discretised model (84)–(87) of the EKF/UKF. An infeasible design is an
+//! error that says which condition fails, where, and what to try.
+
+use crate::description::{Description, Drive, Estimator, Operation, Shape};
+use crate::model::Model;
+use crate::observe::discrete::{DiscreteModel, KalmanSettings, ResistanceSettings};
+
+use super::decisions::{gains, ControllerDesign, ControllerSpec, DesignedOperation};
+use super::feasibility::check as check_feasibility;
+use super::fit_segments::{fit_segments, SegmentTolerance};
+use super::linearization::{DesignError, Linearization};
+use super::optimal::{energy_optimal, OptimalError, OptimalSpec, OptimalTrajectory};
+use super::reference::{Polynomial, Reference};
+
+/// Why a description could not be designed (the file name is the caller's).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlanError {
+    #[error(
+        "nothing to build: add [trajectory] and [controller] sections, or an [observer] section (see the README)"
+    )]
+    NothingToBuild,
+    /// (`[controller]` without `[trajectory]` is refused by the parser.)
+    #[error("[trajectory] alone builds nothing: add a [controller] section to track it (see the README)")]
+    TrajectoryWithoutController,
+    #[error("the {estimator} observer: {message}")]
+    Observer {
+        estimator: &'static str,
+        message: String,
+    },
+    #[error("{0}")]
+    Design(#[from] DesignError),
+    #[error(
+        "the {operation} reference is infeasible (perfect-tracking-soft-landing §4):\n{report}"
+    )]
+    Infeasible {
+        operation: &'static str,
+        report: String,
+    },
+    #[error("the {operation} energy-optimal trajectory: {message}")]
+    Optimal {
+        operation: &'static str,
+        message: String,
+    },
+    #[error("the {operation} reference table: {message}")]
+    Table {
+        operation: &'static str,
+        message: String,
+    },
+    #[error("the controller has no operation")]
+    NoOperation,
+    #[error("the {0:?} operation is given twice")]
+    DuplicateOperation(Operation),
+    #[error("the reference table of the {0:?} operation is empty")]
+    EmptyTable(Operation),
+    #[error("the reference table of the {operation:?} operation spans [{first}, {end}] s, not the motion [t0, tf] = [{takeoff}, {landing}] s")]
+    TableTiming {
+        operation: Operation,
+        first: f64,
+        end: f64,
+        takeoff: f64,
+        landing: f64,
+    },
+    #[error("the design value `{name}` = {value} is not finite or out of range")]
+    BadValue { name: String, value: f64 },
+    #[error("the reference never needs a positive, finite flux: no guard threshold for φ → 0 can be derived")]
+    NoFluxFloor,
+    #[error("internal error: the symbol `{0}` of the linearization is unbound")]
+    UnboundSymbol(String),
+}
+
+impl Operation {
+    /// `closing` or `opening`, as reports and the description name it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Operation::Closing => "closing",
+            Operation::Opening => "opening",
+        }
+    }
+}
+
+/// A complete design, ready to emit: the controller and/or the observers.
+pub struct Design {
+    pub description: Description,
+    pub model: Model,
+    /// From `[trajectory]` + `[controller]`.
+    pub controller: Option<ControllerDesign>,
+    /// The EKF/UKF discretised model, from `[observer]` with "ekf" or "ukf".
+    pub kalman: Option<DiscreteModel>,
+}
+
+impl Design {
+    /// Designs everything the description's `[trajectory]`, `[controller]`
+    /// and `[observer]` ask for.
+    pub fn new(description: &Description) -> Result<Design, PlanError> {
+        let mut model = Model::build(description);
+        let controller = match (&description.trajectory, &description.controller) {
+            (Some(_), Some(_)) => Some(design_controller(description, &mut model)?),
+            (None, None) => None,
+            _ => return Err(PlanError::TrajectoryWithoutController),
+        };
+        let kalman = design_kalman(description, &model)?;
+        if controller.is_none() && description.observer.is_none() {
+            return Err(PlanError::NothingToBuild);
+        }
+        Ok(Design {
+            description: description.clone(),
+            model,
+            controller,
+            kalman,
+        })
+    }
+}
+
+/// `[trajectory]` + `[controller]`: linearization, references, feasibility,
+/// tables, decisions.
+pub fn design_controller(
+    description: &Description,
+    model: &mut Model,
+) -> Result<ControllerDesign, PlanError> {
+    let (Some(trajectory), Some(controller)) = (&description.trajectory, &description.controller)
+    else {
+        return Err(PlanError::NothingToBuild);
+    };
+    let linearization = Linearization::derive(model)?;
+    let mech = &description.mechanics;
+    let bounds = (
+        description.supply.u_min.max(-trajectory.u_bound),
+        trajectory.u_bound,
+    );
+    let mut operations = Vec::new();
+    for &operation in &trajectory.operations {
+        let (z0, zf) = match operation {
+            Operation::Closing => (mech.z_max, mech.z_min),
+            Operation::Opening => (mech.z_min, mech.z_max),
+        };
+        let name = operation.name();
+        let polynomial = Polynomial {
+            z0,
+            zf,
+            t0: trajectory.takeoff,
+            tf: trajectory.landing,
+        };
+        let (reference, optimal): (Box<dyn Reference>, Option<OptimalTrajectory>) =
+            match trajectory.shape {
+                Shape::Polynomial => (Box::new(polynomial), None),
+                Shape::EnergyOptimal => {
+                    let spec = OptimalSpec {
+                        u_max_limit: description.supply.u_max,
+                        ..OptimalSpec::new(
+                            z0,
+                            zf,
+                            trajectory.takeoff,
+                            trajectory.landing,
+                            bounds.0,
+                            bounds.1,
+                        )
+                    };
+                    let solution = energy_optimal(model, &linearization, &spec).map_err(|e| {
+                        PlanError::Optimal {
+                            operation: name,
+                            message: optimal_message(&e, description),
+                        }
+                    })?;
+                    (Box::new(solution.clone()), Some(solution))
+                }
+            };
+        let feasibility =
+            check_feasibility(model, &linearization, reference.as_ref(), bounds, 4000);
+        if !feasibility.is_feasible() {
+            let mut report = feasibility.report();
+            if optimal.is_none() {
+                report.push_str(&polynomial_remedy(
+                    model,
+                    &linearization,
+                    &polynomial,
+                    bounds,
+                ));
+            }
+            return Err(PlanError::Infeasible {
+                operation: name,
+                report,
+            });
+        }
+        let breaks: Vec<f64> = optimal.iter().flat_map(|o| o.breaks()).collect();
+        let fit = fit_segments(reference.as_ref(), &breaks, &SegmentTolerance::default()).map_err(
+            |e| PlanError::Table {
+                operation: name,
+                message: e.to_string(),
+            },
+        )?;
+        operations.push(DesignedOperation {
+            operation,
+            z0,
+            zf,
+            feasibility,
+            table: fit.table,
+            optimal,
+        });
+    }
+    let spec = ControllerSpec {
+        gains: gains(&controller.gains),
+        sample_period: controller.sample_period,
+        u_min: description.supply.u_min,
+        u_max: description.supply.u_max,
+        takeoff: trajectory.takeoff,
+        landing: trajectory.landing,
+        creep_speed: controller.creep_speed,
+    };
+    ControllerDesign::decide(model, linearization, &spec, operations)
+}
+
+/// `[observer.kalman]` → the discretised model (84)–(87) of the EKF/UKF.
+pub fn design_kalman(
+    description: &Description,
+    model: &Model,
+) -> Result<Option<DiscreteModel>, PlanError> {
+    let Some(o) = &description.observer else {
+        return Ok(None);
+    };
+    let wanted = o
+        .estimators
+        .iter()
+        .any(|e| matches!(e, Estimator::Ekf | Estimator::Ukf));
+    let (true, Some(settings)) = (wanted, KalmanSettings::from_observer(o)) else {
+        return Ok(None);
+    };
+    DiscreteModel::with_resistance(model, &settings, ResistanceSettings::from_observer(o))
+        .map(Some)
+        .map_err(|e| PlanError::Observer {
+            estimator: "ekf/ukf",
+            message: e.to_string(),
+        })
+}
+
+/// What makes an infeasible polynomial feasible: the motion time it needs
+/// (bisected to 0.5 % on the feasibility check), or that no time up to ×16 does.
+fn polynomial_remedy(
+    model: &mut Model,
+    lin: &Linearization,
+    polynomial: &Polynomial,
+    bounds: (f64, f64),
+) -> String {
+    let duration = polynomial.tf - polynomial.t0;
+    let mut feasible = |d: f64| {
+        let p = Polynomial {
+            tf: polynomial.t0 + d,
+            ..*polynomial
+        };
+        check_feasibility(model, lin, &p, bounds, 1000).is_feasible()
+    };
+    let Some(mut hi) = [1.5, 2.5, 4.0, 8.0, 16.0]
+        .into_iter()
+        .map(|k| k * duration)
+        .find(|&d| feasible(d))
+    else {
+        return "  no polynomial of up to 16× this motion time is feasible within these bounds: \
+                see `reldesign limits` for what the device can do\n"
+            .to_string();
+    };
+    let mut lo = duration;
+    while hi - lo > 5e-3 * hi {
+        let mid = 0.5 * (lo + hi);
+        if feasible(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    format!(
+        "  the polynomial needs trajectory.landing − trajectory.takeoff ≥ {:.4} ms (it is {:.4} ms); \
+         shape = \"energy-optimal\" may need less (`reldesign limits` gives its shortest motion)\n",
+        hi * 1e3,
+        duration * 1e3
+    )
+}
+
+/// What an energy-optimal failure means for the description's keys.
+fn optimal_message(e: &OptimalError, description: &Description) -> String {
+    let unit = match description.supply.drive {
+        Drive::Voltage => "V",
+        Drive::Current => "A",
+    };
+    let supply = description.supply.u_max;
+    match e {
+        OptimalError::BoundTooLow {
+            needed,
+            given,
+            duration,
+            ..
+        } => format!(
+            "no motion of {:.4} ms keeps the input within trajectory.u_bound = {given:.4} {unit}: \
+             it needs trajectory.u_bound ≥ {:.4} {unit} (the supply allows {supply:.4} {unit}), \
+             or a longer motion (trajectory.landing − trajectory.takeoff)",
+            duration * 1e3,
+            needed * (1.0 + 1e-3),
+        ),
+        OptimalError::TooShort {
+            needed,
+            given,
+            u_min,
+            u_max,
+            ..
+        } => format!(
+            "no motion of {:.4} ms exists with the input in [{u_min:.4}, {u_max:.4}] {unit}{}: \
+             it needs trajectory.landing − trajectory.takeoff ≥ {:.4} ms",
+            given * 1e3,
+            if *u_max < supply {
+                " (a larger trajectory.u_bound, up to the supply, does not help)"
+            } else {
+                ""
+            },
+            needed * (1.0 + 1e-3) * 1e3,
+        ),
+        other => other.to_string(),
+    }
+}

@@ -1,0 +1,95 @@
+//! The human-readable design report `reldesign build` prints: gains, the
+//! linearization's singularity, per operation the reference, its
+//! feasibility and its table, and the observers.
+
+use std::fmt::Write as _;
+
+use crate::description::Estimator;
+
+use super::optimal::OptimalTrajectory;
+use super::plan::Design;
+
+impl Design {
+    /// The report (one block per operation, then the observers).
+    pub fn report(&self) -> String {
+        let mut s = String::new();
+        if let Some(c) = &self.controller {
+            let _ = writeln!(
+                s,
+                "gains K = [{:e}, {:e}, {:e}] (eq. 48)",
+                c.gains[0], c.gains[1], c.gains[2]
+            );
+            let _ = writeln!(s, "{}", c.linearization.singularity_text(&self.model.graph));
+            for o in &c.operations {
+                let _ = writeln!(s, "\n{} ({:e} m → {:e} m):", o.operation.name(), o.z0, o.zf);
+                if let Some(opt) = &o.optimal {
+                    let _ = writeln!(
+                        s,
+                        "  energy-optimal: J = ∫u² dt = {:.6e} V²·s, max |u| = {:.4} V, mesh {} nodes, residual {:.2e}, {} saturation switch(es)",
+                        opt.cost,
+                        opt.max_abs_input,
+                        opt.t.len(),
+                        opt.max_residual,
+                        opt.switches.len()
+                    );
+                    if let Some(rest) = rest_text(opt) {
+                        let _ = writeln!(s, "  {rest}");
+                    }
+                    if let Some(what) = &opt.smoothed_gap {
+                        let _ = writeln!(s, "  note: {what}");
+                    }
+                }
+                let _ = write!(s, "{}", o.feasibility.report());
+                let _ = writeln!(s, "  reference table: {} segments", o.table.segments.len());
+            }
+        }
+        if let Some(o) = &self.description.observer {
+            let names: Vec<&str> = o
+                .estimators
+                .iter()
+                .map(|e| match e {
+                    Estimator::Semera => "semera",
+                    Estimator::Integral => "integral",
+                    Estimator::Ekf => "ekf",
+                    Estimator::Ukf => "ukf",
+                })
+                .collect();
+            let _ = writeln!(
+                s,
+                "\nobservers: {} at T_s = {:e} s (σ_v = {:e} V, σ_i = {:e} A)",
+                names.join(", "),
+                o.sample_period,
+                o.voltage_noise,
+                o.current_noise
+            );
+        }
+        s
+    }
+}
+
+/// Where the energy-optimal motion is shorter than [t₀, t_f]: when it moves,
+/// where it rests, and why.
+fn rest_text(opt: &OptimalTrajectory) -> Option<String> {
+    let (t0, tf) = (opt.spec.t0, opt.spec.tf);
+    let (ta, tb) = opt.arc;
+    if ta <= t0 && tb >= tf {
+        return None;
+    }
+    let (place, u) = if tb < tf {
+        (
+            format!("lands at {:.4} ms and rests", tb * 1e3),
+            opt.rest_inputs[1],
+        )
+    } else {
+        (
+            format!("rests until {:.4} ms, then moves", ta * 1e3),
+            opt.rest_inputs[0],
+        )
+    };
+    Some(format!(
+        "the motion {place} (holding input {u:.4}): it lasts {:.4} ms, and any longer interval \
+         is spent at rest, which costs less than moving slower ({:.6e} of J)",
+        (tb - ta) * 1e3,
+        opt.rest_cost,
+    ))
+}

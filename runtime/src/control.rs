@@ -1,0 +1,262 @@
+//! The soft-landing controller's operation logic, written once for every
+//! design and both floats (perfect-tracking-soft-landing §3.2 and §4).
+//!
+//! Generated code holds the model: the tracking law (50) ([`Law::law`]), the
+//! design values ([`Settings`]) and one reference table per operation
+//! ([`Motion`]). [`SoftLanding`] runs one operation over them:
+//!
+//! - before t₀ (pre-movement stage, §4): ξ_r = [z₀, 0, 0], j_r = 0, so the law
+//!   brings ξ₃ = a(x) to 0, i.e. the forces into balance at takeoff;
+//! - on [t₀, t_f]: ξ_r, j_r from the table ([`eval_segment`]), the segment
+//!   cursor advanced monotonically (lookup with `.get()`);
+//! - after t_f: ξ_r = [z_f + (z_f − z₀)·(press + creep·(t − t_f)), (z_f − z₀)·creep, 0],
+//!   a reference just beyond the end stop that keeps creeping beyond it up to
+//!   `creep_max`, so the loop closes whatever gap the tracking error left and
+//!   still lands where the plant differs from the model; once the armature is
+//!   at its end stop (within `landed_band`: contact, not proximity) the expert
+//!   rules of model-free-sliding-mode-soft-landing (43) apply: closing →
+//!   u = u_max·sgn φ (holds it closed; sgn 0 taken as +1, a NaN φ gives 0),
+//!   opening → u = 0;
+//! - guard at φ → 0: where φ ≤ `phi_guard` the law is not evaluated and
+//!   u = u_max drives the flux into D₀⁺ = {φ > 0} ([`guarded_law`]);
+//! - every output is saturated to [u_min, u_max] (NaN → the bound nearest 0,
+//!   ±∞ → the bounds), so any input gives a finite u.
+//!
+//! No allocation, no panic path, no `as`; generic over the float ([`Scalar`]
+//! plus `From<u8>` for the polynomial's small integer divisors).
+
+use core::fmt::Debug;
+use core::marker::PhantomData;
+
+use crate::linalg::Scalar;
+
+/// One segment of a reference table: [t_k, z_k, v_k, c0, c1, c2, c3], t_k
+/// from the operation's start; a(τ) = c0 + c1·τ + c2·τ² + c3·τ³ with
+/// τ = t − t_k, v and z its integrals from v_k and z_k.
+pub type Row<T> = [T; 7];
+
+/// Which end stop an operation lands on, which decides its hold rule (43).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Landing {
+    /// Closing, z_max → z_min: at the stop u = u_max·sgn φ holds it closed.
+    Closing,
+    /// Opening, z_min → z_max: at the stop u = 0 lets the spring hold it open.
+    Opening,
+}
+
+/// One designed operation (51): the reference on [t₀, t_f] and its rest positions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Motion<T: 'static> {
+    pub landing: Landing,
+    /// z₀: the rest position before t₀.
+    pub z0: T,
+    /// z_f: the end stop held after t_f.
+    pub zf: T,
+    /// One [`Row`] per segment, in time order.
+    pub table: &'static [Row<T>],
+}
+
+/// The design values the operation logic reads (the consts of the emitted module).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings<T> {
+    /// Supply limits: every output lies in [u_min, u_max].
+    pub u_min: T,
+    pub u_max: T,
+    /// t₀ [s] from the operation's start: end of the pre-movement stage.
+    pub takeoff: T,
+    /// t_f [s] from the operation's start: end of the motion.
+    pub landing: T,
+    /// [Wb]: where φ ≤ `phi_guard` the law is not evaluated and u = u_max.
+    pub phi_guard: T,
+    /// [m]: within this distance of its end stop the armature is in contact.
+    pub landed_band: T,
+    /// After t_f the reference lies `press`·stroke beyond the end stop …
+    pub press: T,
+    /// … and creeps on at `creep`·stroke per second [1/s] …
+    pub creep: T,
+    /// … up to `creep_max`·stroke beyond it.
+    pub creep_max: T,
+}
+
+/// What the emitted module provides: its operations, design values and law.
+pub trait Law<T> {
+    /// The designed operations (an enum of the emitted module).
+    type Operation: Copy + Debug + PartialEq;
+    const SETTINGS: Settings<T>;
+    /// The reference and rest positions of `operation`.
+    fn motion(operation: Self::Operation) -> Motion<T>;
+    /// u of the tracking law (50) at the state x = [z, v, φ] and the reference
+    /// [z_r, v_r, a_r, j_r]: not guarded, not saturated.
+    fn law(x: [T; 3], reference: [T; 4]) -> T;
+}
+
+/// [z_r, v_r, a_r, j_r] of one table row at τ = t − t_k (the integrals of
+/// the cubic acceleration, `designer::design::Segments`).
+#[inline]
+pub fn eval_segment<T: Scalar + From<u8>>(row: &Row<T>, tau: T) -> [T; 4] {
+    let [_, z, v, c0, c1, c2, c3] = *row;
+    let n = |k: u8| T::from(k);
+    [
+        z + tau
+            * (v + tau * (c0 / n(2) + tau * (c1 / n(6) + tau * (c2 / n(12) + tau * c3 / n(20))))),
+        v + tau * (c0 + tau * (c1 / n(2) + tau * (c2 / n(3) + tau * c3 / n(4)))),
+        c0 + tau * (c1 + tau * (c2 + tau * c3)),
+        c1 + tau * (n(2) * c2 + tau * n(3) * c3),
+    ]
+}
+
+/// `u` clamped to [u_min, u_max]; a NaN gives the bound nearest 0 (so a
+/// numerical failure never commands full voltage), ±∞ the bounds (as
+/// [`crate::saturate`]).
+#[inline]
+pub fn saturate<T: Scalar>(u: T, settings: &Settings<T>) -> T {
+    // NaN is the one value unordered with itself
+    let u = if u.partial_cmp(&u).is_none() {
+        T::ZERO
+    } else {
+        u
+    };
+    let u = if u > settings.u_min {
+        u
+    } else {
+        settings.u_min
+    };
+    if u < settings.u_max {
+        u
+    } else {
+        settings.u_max
+    }
+}
+
+/// The law (50) as applied: where φ ≤ `phi_guard` (φ → 0, where β = 1/L_g L_f²h
+/// blows up and D₀⁺ is left) it is not evaluated and u = u_max drives the flux
+/// back into D₀⁺; otherwise [`Law::law`]. Saturated.
+#[inline]
+pub fn guarded_law<L: Law<T>, T: Scalar>(x: [T; 3], reference: [T; 4]) -> T {
+    let settings = L::SETTINGS;
+    let [_, _, phi] = x;
+    if phi <= settings.phi_guard {
+        return saturate(settings.u_max, &settings);
+    }
+    saturate(L::law(x, reference), &settings)
+}
+
+/// One operation of the actuator under the law `L` (the rules in the module
+/// docs): pre-movement before t₀, tracking of the table on [t₀, t_f], hold at
+/// z_f after t_f. Allocation- and panic-free.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SoftLanding<L: Law<T>, T> {
+    operation: L::Operation,
+    /// Time at which the operation started [s].
+    start: T,
+    /// Current segment of the table (only moves forward).
+    cursor: usize,
+    law: PhantomData<L>,
+}
+
+impl<L: Law<T>, T: Scalar + From<u8> + 'static> SoftLanding<L, T> {
+    /// A controller for `operation`, started at t = 0.
+    #[must_use]
+    pub const fn new(operation: L::Operation) -> Self {
+        SoftLanding {
+            operation,
+            start: T::ZERO,
+            cursor: 0,
+            law: PhantomData,
+        }
+    }
+
+    /// Starts the operation at `t_start` [s]: reference times count from here.
+    pub fn start(&mut self, t_start: T) {
+        self.start = t_start;
+        self.cursor = 0;
+    }
+
+    /// The operation this controller runs.
+    #[must_use]
+    pub const fn operation(&self) -> L::Operation {
+        self.operation
+    }
+
+    /// [z_r, v_r, a_r, j_r] at `t` (51): z₀ at rest before t₀, the table on
+    /// [t₀, t_f], after t_f just beyond z_f and creeping on (press, creep).
+    /// Advances the segment cursor.
+    pub fn reference(&mut self, t: T) -> [T; 4] {
+        let settings = L::SETTINGS;
+        let motion = L::motion(self.operation);
+        let time = t - self.start;
+        let rest = [motion.z0, T::ZERO, T::ZERO, T::ZERO];
+        if (settings.takeoff..=settings.landing).contains(&time) {
+            while let Some(&[t_next, ..]) = motion.table.get(self.cursor.saturating_add(1)) {
+                if t_next <= time {
+                    self.cursor = self.cursor.saturating_add(1);
+                } else {
+                    break;
+                }
+            }
+            match motion.table.get(self.cursor) {
+                Some(row) => {
+                    let [t_k, ..] = *row;
+                    eval_segment(row, time - t_k)
+                }
+                None => rest,
+            }
+        } else if time > settings.landing {
+            let stroke = motion.zf - motion.z0;
+            let creep = settings.creep * (time - settings.landing);
+            if creep < settings.creep_max {
+                let z = motion.zf + stroke * (settings.press + creep);
+                [z, stroke * settings.creep, T::ZERO, T::ZERO]
+            } else {
+                let z = motion.zf + stroke * (settings.press + settings.creep_max);
+                [z, T::ZERO, T::ZERO, T::ZERO]
+            }
+        } else {
+            // before t₀ (and a NaN time): the pre-movement stage
+            rest
+        }
+    }
+
+    /// After t_f at the end stop: the expert rule (43), closing → u = u_max·sgn φ
+    /// (sgn 0 = +1, NaN φ → 0), opening → u = 0; `None` elsewhere.
+    fn hold(&self, time: T, z: T, phi: T) -> Option<T> {
+        let settings = L::SETTINGS;
+        if time > settings.landing {
+            let motion = L::motion(self.operation);
+            match motion.landing {
+                Landing::Closing if z <= motion.zf + settings.landed_band => {
+                    let u = if phi < T::ZERO {
+                        -settings.u_max
+                    } else if phi >= T::ZERO {
+                        settings.u_max
+                    } else {
+                        T::ZERO
+                    };
+                    return Some(saturate(u, &settings));
+                }
+                Landing::Opening if z >= motion.zf - settings.landed_band => {
+                    return Some(saturate(T::ZERO, &settings));
+                }
+                _ => {}
+            }
+        }
+        None
+    }
+
+    /// The input u in [u_min, u_max] at time `t` [s] for the measured state
+    /// x = [z, v, φ]: the hold rule at the end stop, else [`guarded_law`] at
+    /// the reference of [`SoftLanding::reference`]. Finite for any input.
+    pub fn step(&mut self, t: T, z: T, v: T, phi: T) -> T {
+        if let Some(u) = self.hold(t - self.start, z, phi) {
+            return u;
+        }
+        let reference = self.reference(t);
+        guarded_law::<L, T>([z, v, phi], reference)
+    }
+}
+
+impl<L: Law<T>, T: Scalar + From<u8> + 'static> crate::Controller<T> for SoftLanding<L, T> {
+    fn step(&mut self, t: T, y: &crate::Measurement<T>) -> T {
+        SoftLanding::step(self, t, y.z, y.v, y.phi)
+    }
+}
