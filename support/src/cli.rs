@@ -47,7 +47,7 @@ impl Cli {
 macro_rules! rd {
     ($($arg:expr),* $(,)?) => {
         $crate::Cli::new(env!("CARGO_BIN_EXE_reldesign"))
-            .run(&[$(::std::ffi::OsStr::new(&$arg)),*])
+            .run::<&::std::ffi::OsStr>(&[$(::std::ffi::OsStr::new(&$arg)),*])
     };
 }
 
