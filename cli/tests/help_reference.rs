@@ -18,12 +18,7 @@ use std::collections::BTreeSet;
 use std::path::{Component, Path, PathBuf};
 use std::process::Command;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("cli/ has a parent")
-        .to_path_buf()
-}
+use support::root;
 
 /// `reldesign ARGS --help` as the binary prints it, without colour and
 /// without trailing spaces on its lines.
