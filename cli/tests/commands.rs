@@ -8,47 +8,15 @@
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use designer::description::{parse_file, Core, Description, Drive};
 use serde_json::Value;
+use support::{assert_close, example_path, example_paths, rd, root, toml_files, Cli, TempDir, Tol};
 
-const BIN: &str = env!("CARGO_BIN_EXE_reldesign");
-
-// ---------------------------------------------------------------------------
-// helpers
-// ---------------------------------------------------------------------------
-
-/// The workspace root (examples/, tests/data/ live there).
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("cli/ has a parent")
-        .to_path_buf()
-}
-
-fn example(file: &str) -> PathBuf {
-    root().join("examples").join(file)
-}
+const CLI: Cli = Cli::new(env!("CARGO_BIN_EXE_reldesign"));
 
 fn three_pulses() -> PathBuf {
     root().join("tests/data/ja-three-pulses.csv")
-}
-
-fn toml_files(dir: &Path) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
-        .map(|e| e.expect("directory entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    files.sort();
-    assert!(!files.is_empty(), "no *.toml in {}", dir.display());
-    files
-}
-
-fn examples() -> Vec<PathBuf> {
-    toml_files(&root().join("examples"))
 }
 
 fn description(path: &Path) -> Description {
@@ -57,147 +25,6 @@ fn description(path: &Path) -> Description {
 
 fn base_name(path: &Path) -> String {
     path.file_name().unwrap().to_string_lossy().into_owned()
-}
-
-/// One run of the binary.
-struct Run {
-    args: String,
-    code: Option<i32>,
-    stdout: Vec<u8>,
-    stderr: String,
-}
-
-impl Run {
-    fn stdout(&self) -> String {
-        String::from_utf8(self.stdout.clone()).expect("stdout is UTF-8")
-    }
-
-    fn context(&self) -> String {
-        format!(
-            "`reldesign {}` exited with {:?}\n--- stdout ---\n{}\n--- stderr ---\n{}",
-            self.args,
-            self.code,
-            String::from_utf8_lossy(&self.stdout),
-            self.stderr
-        )
-    }
-
-    /// Exit 0, no panic. Returns stdout.
-    fn ok(&self) -> String {
-        assert_eq!(self.code, Some(0), "expected success\n{}", self.context());
-        assert_no_panic(&self.stderr, &self.context());
-        self.stdout()
-    }
-
-    /// A clean rejection: non-zero exit (not a signal), nothing on stdout, no
-    /// panic or backtrace, and every needle on stderr. A needle is searched
-    /// with whitespace and the report's `│` margin removed, so that a message
-    /// wrapped by the error renderer still matches.
-    fn rejected(&self, needles: &[&str]) {
-        self.rejected_in("", needles);
-    }
-
-    /// As `rejected`, with `case` describing the input in the failure message.
-    fn rejected_in(&self, case: &str, needles: &[&str]) {
-        let ctx = format!("{case}\n{}", self.context());
-        match self.code {
-            Some(0) => panic!("expected a failure\n{ctx}"),
-            None => panic!("killed by a signal\n{ctx}"),
-            Some(_) => {}
-        }
-        assert_no_panic(&self.stderr, &ctx);
-        assert!(self.stdout.is_empty(), "stdout must stay empty\n{ctx}");
-        assert!(
-            !self.stderr.trim().is_empty(),
-            "no message on stderr\n{ctx}"
-        );
-        for needle in needles {
-            assert!(
-                squeeze(&self.stderr).contains(&squeeze(needle)),
-                "stderr does not mention {needle:?}\n{ctx}"
-            );
-        }
-    }
-}
-
-fn assert_no_panic(stderr: &str, ctx: &str) {
-    for bad in ["panicked", "RUST_BACKTRACE", "stack backtrace"] {
-        assert!(!stderr.contains(bad), "panic text {bad:?} on stderr\n{ctx}");
-    }
-}
-
-fn squeeze(s: &str) -> String {
-    s.chars()
-        .filter(|c| !c.is_whitespace() && *c != '│')
-        .collect()
-}
-
-/// Runs the binary with any mix of `&str`, `Path`, `PathBuf` arguments.
-macro_rules! rd {
-    ($($arg:expr),* $(,)?) => {
-        exec(&[$(std::ffi::OsStr::new(&$arg)),*])
-    };
-}
-
-fn exec<S: AsRef<OsStr>>(args: &[S]) -> Run {
-    let out = Command::new(BIN)
-        .args(args)
-        .env("NO_COLOR", "1")
-        .env_remove("CLICOLOR_FORCE")
-        .output()
-        .expect("cannot run the reldesign binary");
-    Run {
-        args: args
-            .iter()
-            .map(|a| a.as_ref().to_string_lossy().into_owned())
-            .collect::<Vec<_>>()
-            .join(" "),
-        code: out.status.code(),
-        stdout: out.stdout,
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
-}
-
-/// A fresh directory under the system temp dir, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        static COUNTER: AtomicUsize = AtomicUsize::new(0);
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let dir =
-            std::env::temp_dir().join(format!("reldesign-cli-{tag}-{}-{n}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("create temp dir");
-        TempDir(dir)
-    }
-
-    fn join(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-
-    fn write(&self, name: &str, text: &str) -> PathBuf {
-        let p = self.join(name);
-        std::fs::write(&p, text).expect("write temp file");
-        p
-    }
-
-    /// Names of the files in the directory, sorted (hidden ones included, so a
-    /// leftover temporary file of an atomic write shows up).
-    fn files(&self) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(&self.0)
-            .expect("list temp dir")
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        v.sort();
-        v
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
 }
 
 /// A parsed `simulate` output.
@@ -281,7 +108,7 @@ fn has_field_state(d: &Description) -> bool {
 
 #[test]
 fn check_summarises_every_example_deterministically() {
-    for path in examples() {
+    for path in example_paths() {
         let d = description(&path);
         let first = rd!("check", path);
         let out = first.ok();
@@ -459,14 +286,10 @@ fn assert_shapes(out: &Value, n: usize, nx: usize) {
     }
 }
 
-fn rel_err(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
-}
-
 #[test]
 fn eval_perfect_tracking_valve() {
     let dir = TempDir::new("eval-pt");
-    let model = example("perfect-tracking-valve.toml");
+    let model = example_path("perfect-tracking-valve.toml");
     let states = dir.write(
         "STATES.json",
         r#"{"x": [[0, 0, 0], [5e-4, 0.1, 1e-5], [1e-3, -0.5, -2e-5]], "u": [0, 12, -24]}"#,
@@ -480,11 +303,11 @@ fn eval_perfect_tracking_valve() {
     let r_gap = numbers(&out["r_gap"]);
     let r_gap_dz = numbers(&out["r_gap_dz"]);
     assert_eq!(r_gap[0], 0.0, "R_gap(0) of the McLyman gap");
-    assert!(
-        rel_err(r_gap_dz[0], 1.0 / (mu0 * a)) <= 1e-12,
-        "R_gap'(0) = {} but 1/(μ0·A) = {}",
+    assert_close(
         r_gap_dz[0],
-        1.0 / (mu0 * a)
+        1.0 / (mu0 * a),
+        Tol::rel(1e-12),
+        "R_gap'(0) = 1/(μ0·A)",
     );
     assert!(
         r_gap[1] > 0.0 && r_gap[2] > r_gap[1],
@@ -506,23 +329,14 @@ fn eval_perfect_tracking_valve() {
         let k = k + 1;
         let f_mag = numbers(&out["f_mag"])[k];
         let want = -0.5 * r_gap_dz[k] * phi * phi;
-        assert!(
-            rel_err(f_mag, want) <= 1e-14,
-            "F_mag[{k}] = {f_mag}, −½R'φ² = {want}"
-        );
+        assert_close(f_mag, want, Tol::rel(1e-14), format!("F_mag[{k}] = −½R'φ²"));
         let mmf = r_gap[k] * phi + r_core0 / (1.0 - f64::abs(phi) / phi_sat) * phi;
         let i_want = (n_turns * mmf + k_e * u) / (n_turns * n_turns + r_coil * k_e);
         let i = numbers(&out["i"])[k];
-        assert!(
-            rel_err(i, i_want) <= 1e-12,
-            "i[{k}] = {i}, spec formula {i_want}"
-        );
+        assert_close(i, i_want, Tol::rel(1e-12), format!("i[{k}], spec formula"));
         let dphi = numbers(&out["f"][k])[2];
         let dphi_want = (n_turns * u - r_coil * mmf) / (n_turns * n_turns + r_coil * k_e);
-        assert!(
-            rel_err(dphi, dphi_want) <= 1e-12,
-            "φ̇[{k}] = {dphi}, spec {dphi_want}"
-        );
+        assert_close(dphi, dphi_want, Tol::rel(1e-12), format!("φ̇[{k}], spec"));
     }
 
     // Shortest round-trip numbers: each token parses back and has exactly the
@@ -567,11 +381,9 @@ fn eval_perfect_tracking_valve() {
             let alpha = out["alpha"][k].as_f64().expect("α is a number");
             let beta = out["beta"][k].as_f64().expect("β is a number");
             assert!(lglf2h[k] != 0.0, "L_gL_f²h ≠ 0 with flux at state {k}");
-            assert!(
-                rel_err(beta, 1.0 / lglf2h[k]) <= 1e-13,
-                "β = 1/L_gL_f²h at {k}"
-            );
-            assert!(rel_err(alpha, -lf3h[k] / lglf2h[k]) <= 1e-13, "α at {k}");
+            let tol = Tol::rel(1e-13);
+            assert_close(beta, 1.0 / lglf2h[k], tol, format!("β = 1/L_gL_f²h at {k}"));
+            assert_close(alpha, -lf3h[k] / lglf2h[k], tol, format!("α at {k}"));
         }
     }
 }
@@ -579,7 +391,7 @@ fn eval_perfect_tracking_valve() {
 #[test]
 fn eval_jiles_atherton_valve_has_four_states() {
     let dir = TempDir::new("eval-ja");
-    let model = example("jiles-atherton-valve.toml");
+    let model = example_path("jiles-atherton-valve.toml");
     let states = dir.write(
         "STATES.json",
         r#"{"x": [[0, 0, 0, 0], [4.5e-4, 0.2, 5e-6, 300], [9e-4, -1, -1e-5, -1500]],
@@ -602,9 +414,11 @@ fn eval_jiles_atherton_valve_has_four_states() {
         "R_gap(0) = r0: {text}"
     );
     let r_gap_dz = numbers(&out["r_gap_dz"]);
-    assert!(
-        rel_err(r_gap_dz[0], 7.94e10) <= 1e-15,
-        "R_gap'(0) = r0_prime"
+    assert_close(
+        r_gap_dz[0],
+        7.94e10,
+        Tol::rel(1e-15),
+        "R_gap'(0) = r0_prime",
     );
     let r_gap = numbers(&out["r_gap"]);
     assert!(
@@ -613,17 +427,14 @@ fn eval_jiles_atherton_valve_has_four_states() {
     );
     // Spring at rest, no flux: v̇ = −(k_s·0 − k_s·z_s)/m = 55·0.015/1.6e-3.
     let f0 = numbers(&out["f"][0]);
-    assert!(
-        rel_err(f0[1], 55.0 * 0.015 / 1.6e-3) <= 1e-14,
-        "f at rest: {f0:?}"
-    );
+    assert_close(f0[1], 55.0 * 0.015 / 1.6e-3, Tol::rel(1e-14), "v̇ at rest");
     assert_eq!((f0[0], f0[2], f0[3]), (0.0, 0.0, 0.0), "f at rest: {f0:?}");
 }
 
 #[test]
 fn eval_rejects_bad_states() {
     let dir = TempDir::new("eval-bad");
-    let model = example("perfect-tracking-valve.toml");
+    let model = example_path("perfect-tracking-valve.toml");
     let cases: &[(&str, &str, &[&str])] = &[
         (
             "wrong state length",
@@ -687,7 +498,7 @@ fn simulate_replays_the_three_pulse_record_on_every_example() {
     let input = three_pulses();
     let (t_in, v_in) = read_input(&input);
     assert!(t_in.len() > 1000, "the record has {} samples", t_in.len());
-    for path in examples() {
+    for path in example_paths() {
         let d = description(&path);
         let out = dir.join("OUT.csv");
         let _ = std::fs::remove_file(&out);
@@ -766,7 +577,7 @@ fn simulate_replays_the_three_pulse_record_on_every_example() {
 #[test]
 fn simulate_is_deterministic_and_stdout_equals_out() {
     let dir = TempDir::new("sim-determinism");
-    let model = example("jiles-atherton-valve.toml");
+    let model = example_path("jiles-atherton-valve.toml");
     let input = three_pulses();
     let mut outputs = vec![];
     for name in ["a.csv", "b.csv"] {
@@ -791,7 +602,7 @@ fn generated(dir: &TempDir, model: &Path, input_args: &[&str]) -> Csv {
     let mut args: Vec<&OsStr> = vec![OsStr::new("simulate"), model.as_os_str()];
     args.extend(input_args.iter().map(OsStr::new));
     args.extend([OsStr::new("--out"), out.as_os_str()]);
-    exec(&args).ok();
+    CLI.run(&args).ok();
     let csv = Csv::parse(&std::fs::read_to_string(&out).unwrap());
     std::fs::remove_file(&out).unwrap();
     csv
@@ -800,7 +611,7 @@ fn generated(dir: &TempDir, model: &Path, input_args: &[&str]) -> Csv {
 #[test]
 fn simulate_pulse_closes_and_reopens_the_perfect_tracking_valve() {
     let dir = TempDir::new("sim-pulse");
-    let model = example("perfect-tracking-valve.toml");
+    let model = example_path("perfect-tracking-valve.toml");
     let csv = generated(
         &dir,
         &model,
@@ -847,7 +658,7 @@ fn simulate_pulse_closes_and_reopens_the_perfect_tracking_valve() {
 #[test]
 fn simulate_square_wave_and_negative_pulse() {
     let dir = TempDir::new("sim-square");
-    let model = example("perfect-tracking-valve.toml");
+    let model = example_path("perfect-tracking-valve.toml");
     let csv = generated(
         &dir,
         &model,
@@ -890,7 +701,7 @@ fn simulate_square_wave_and_negative_pulse() {
 #[test]
 fn simulate_plot_writes_an_svg() {
     let dir = TempDir::new("sim-plot");
-    let model = example("perfect-tracking-valve.toml");
+    let model = example_path("perfect-tracking-valve.toml");
     let (out, svg) = (dir.join("OUT.csv"), dir.join("out.svg"));
     rd!(
         "simulate",
@@ -932,7 +743,7 @@ fn simulate_plot_writes_an_svg() {
 #[test]
 fn simulate_rejects_bad_generated_inputs() {
     let dir = TempDir::new("sim-badargs");
-    let model = example("perfect-tracking-valve.toml");
+    let model = example_path("perfect-tracking-valve.toml");
     let input = three_pulses();
     let out = dir.join("OUT.csv");
     let m = model.to_str().unwrap();
@@ -993,7 +804,7 @@ fn simulate_rejects_bad_generated_inputs() {
         ),
     ];
     for (args, needles) in cases {
-        let run = exec(args);
+        let run = CLI.run(args);
         run.rejected_in(&format!("case {args:?}"), needles);
         assert!(
             dir.files().is_empty(),
@@ -1069,7 +880,7 @@ fn bad_descriptions_are_rejected_and_leave_no_files() {
 #[test]
 fn simulate_rejects_bad_records_and_leaves_the_output_alone() {
     let dir = TempDir::new("bad-csv");
-    let model = example("perfect-tracking-valve.toml");
+    let model = example_path("perfect-tracking-valve.toml");
     const OLD: &str = "t,v,i,z,vz,phi,mode\n0.0,0.0,0.0,0.001,0.0,0.0,3\n";
     // (what, CSV text, needles besides the file name)
     let cases: &[(&str, &str, &[&str])] = &[
@@ -1151,7 +962,7 @@ fn simulate_rejects_bad_records_and_leaves_the_output_alone() {
 #[test]
 fn simulate_output_paths() {
     let dir = TempDir::new("sim-paths");
-    let model = example("perfect-tracking-valve.toml");
+    let model = example_path("perfect-tracking-valve.toml");
     // A missing output directory is created (README: "create output directories").
     let out = dir.join("new-dir").join("OUT.csv");
     rd!("simulate", model, "--input", three_pulses(), "--out", out).ok();
@@ -1189,7 +1000,7 @@ fn simulate_output_paths() {
 #[test]
 fn failed_plot_leaves_the_csv_untouched() {
     let dir = TempDir::new("sim-plot-fail");
-    let model = example("perfect-tracking-valve.toml");
+    let model = example_path("perfect-tracking-valve.toml");
     let out = dir.write("OUT.csv", "old\n");
     let svg = dir.join("plot.svg");
     std::fs::create_dir(&svg).unwrap();
@@ -1218,7 +1029,7 @@ fn long_paths_are_not_wrapped() {
     std::fs::write(&input, "t,v\n0,0\n1e-5,abc\n").unwrap();
     let run = rd!(
         "simulate",
-        example("perfect-tracking-valve.toml"),
+        example_path("perfect-tracking-valve.toml"),
         "--input",
         input,
     );
@@ -1260,7 +1071,7 @@ fn help_lists_the_subcommands() {
 #[test]
 fn usage_errors_are_helpful() {
     rd!("frobnicate", "valve.toml").rejected(&["frobnicate", "--help"]);
-    exec::<&str>(&[]).rejected(&["Usage", "check", "simulate"]);
+    rd!().rejected(&["Usage", "check", "simulate"]);
     rd!("check").rejected(&["MODEL"]);
     rd!("eval", "valve.toml").rejected(&["STATES"]);
     rd!("simulate", "valve.toml", "--bogus").rejected(&["--bogus"]);
@@ -1274,14 +1085,9 @@ fn usage_errors_are_helpful() {
 fn build_emits_the_checked_in_module_deterministically() {
     let dir = TempDir::new("build");
     let (a, b) = (dir.join("a.rs"), dir.join("b.rs"));
-    let model = example("perfect-tracking-valve.toml");
+    let model = example_path("perfect-tracking-valve.toml");
     for out in [&a, &b] {
-        let run = exec(&[
-            OsStr::new("build"),
-            model.as_os_str(),
-            OsStr::new("--out"),
-            out.as_os_str(),
-        ]);
+        let run = rd!("build", model, "--out", out);
         assert!(run.ok().is_empty(), "the code goes to --out, not stdout");
         for needle in ["energy-optimal: J =", "reference table:", "(54)", "gains K"] {
             assert!(
@@ -1303,11 +1109,7 @@ fn build_emits_the_checked_in_module_deterministically() {
         "generated/ is stale or build differs from it"
     );
     // stdout mode prints the same module
-    let run = exec(&[
-        OsStr::new("build"),
-        model.as_os_str(),
-        OsStr::new("--quiet"),
-    ]);
+    let run = rd!("build", model, "--quiet");
     assert_eq!(run.ok().as_bytes(), code.as_slice());
     assert!(
         run.stderr.is_empty(),
@@ -1322,12 +1124,12 @@ fn build_emits_the_checked_in_module_deterministically() {
 fn build_refuses_what_it_cannot_design() {
     let dir = TempDir::new("build-bad");
     let out = dir.join("out.rs");
-    let run = exec(&[
-        OsStr::new("build"),
-        example("jiles-atherton-valve.toml").as_os_str(),
-        OsStr::new("--out"),
-        out.as_os_str(),
-    ]);
+    let run = rd!(
+        "build",
+        example_path("jiles-atherton-valve.toml"),
+        "--out",
+        out
+    );
     run.rejected(&[
         "jiles-atherton-valve.toml",
         "nothing to build",
@@ -1337,17 +1139,12 @@ fn build_refuses_what_it_cannot_design() {
     assert!(!out.exists());
     // The paper's valve with a 5th-degree polynomial within ±20 V: the closing
     // needs 24.5 V right after takeoff (Fig. 5's saturation).
-    let text = std::fs::read_to_string(example("perfect-tracking-valve.toml"))
+    let text = std::fs::read_to_string(example_path("perfect-tracking-valve.toml"))
         .unwrap()
         .replace("shape = \"energy-optimal\"", "shape = \"polynomial\"");
     let model = dir.join("polynomial.toml");
     std::fs::write(&model, text).unwrap();
-    let run = exec(&[
-        OsStr::new("build"),
-        model.as_os_str(),
-        OsStr::new("--out"),
-        out.as_os_str(),
-    ]);
+    let run = rd!("build", model, "--out", out);
     run.rejected(&[
         "polynomial.toml",
         "closing reference is infeasible",
@@ -1356,17 +1153,12 @@ fn build_refuses_what_it_cannot_design() {
     ]);
     assert!(!out.exists());
     // A [trajectory] with nothing to track it.
-    let text = std::fs::read_to_string(example("perfect-tracking-valve.toml")).unwrap();
+    let text = std::fs::read_to_string(example_path("perfect-tracking-valve.toml")).unwrap();
     let start = text.find("[controller]").unwrap();
     let end = start + text[start..].find("\n\n").unwrap();
     let model = dir.join("no-controller.toml");
     std::fs::write(&model, format!("{}{}", &text[..start], &text[end..])).unwrap();
-    let run = exec(&[
-        OsStr::new("build"),
-        model.as_os_str(),
-        OsStr::new("--out"),
-        out.as_os_str(),
-    ]);
+    let run = rd!("build", model, "--out", out);
     run.rejected(&["no-controller.toml", "[trajectory] alone", "[controller]"]);
     assert!(!out.exists());
 }

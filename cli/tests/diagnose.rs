@@ -15,15 +15,14 @@
 //! with `--causes` to stay fast.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use designer::description::{parse_file, parse_str, Core, Description};
 use reldesign_identify::diagnose::Cause;
 use reldesign_tests::hidden::{baseline, hidden_case, write_case, Excitation, HiddenCase};
 use serde_json::Value;
+use support::{example_path, files_in, rd, Cli, TempDir};
 
-const BIN: &str = env!("CARGO_BIN_EXE_reldesign");
+const CLI: Cli = Cli::new(env!("CARGO_BIN_EXE_reldesign"));
 
 const EXAMPLE: &str = "semera-valve.toml";
 
@@ -40,7 +39,7 @@ const RECOVERY_TOLERANCE: f64 = 0.1;
 /// The SEMERA valve's case for `cause`: three square-wave cycles, 40 µs
 /// sampling, σ_v = 15 mV, σ_i = 1 mA, no `z` column.
 fn semera_case(cause: Cause, seed: u64) -> HiddenCase {
-    let path = reldesign_tests::root().join("examples").join(EXAMPLE);
+    let path = example_path(EXAMPLE);
     let text = std::fs::read_to_string(&path).unwrap();
     let desc = parse_str(&text, EXAMPLE).unwrap_or_else(|e| panic!("{e}"));
     let excitation = Excitation::square_wave(&baseline(&desc));
@@ -54,113 +53,6 @@ fn drawn(case: &HiddenCase, key: &str) -> f64 {
         .find(|(k, _)| k == key)
         .unwrap_or_else(|| panic!("{key} not drawn: {:?}", case.drawn))
         .1
-}
-
-/// One run of the binary.
-struct Run {
-    args: String,
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-}
-
-impl Run {
-    fn context(&self) -> String {
-        format!(
-            "`reldesign {}` exited with {:?}\n--- stdout ---\n{}\n--- stderr ---\n{}",
-            self.args, self.code, self.stdout, self.stderr
-        )
-    }
-
-    /// Exit 0. Returns stdout.
-    fn ok(&self) -> &str {
-        assert_eq!(self.code, Some(0), "expected success\n{}", self.context());
-        &self.stdout
-    }
-
-    /// Non-zero exit (not a signal), no panic, nothing on stdout, and every
-    /// needle on stderr (compared with whitespace and the report's `│`
-    /// margin removed, so that wrapped messages still match).
-    fn rejected(&self, needles: &[&str]) {
-        let ctx = self.context();
-        assert!(
-            matches!(self.code, Some(c) if c != 0),
-            "expected a failure\n{ctx}"
-        );
-        assert!(!self.stderr.contains("panicked"), "panic\n{ctx}");
-        assert!(self.stdout.is_empty(), "stdout must stay empty\n{ctx}");
-        for needle in needles {
-            assert!(
-                squeeze(&self.stderr).contains(&squeeze(needle)),
-                "stderr does not mention {needle:?}\n{ctx}"
-            );
-        }
-    }
-}
-
-fn squeeze(s: &str) -> String {
-    s.chars()
-        .filter(|c| !c.is_whitespace() && *c != '│')
-        .collect()
-}
-
-fn run<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Run {
-    let out = Command::new(BIN)
-        .args(args)
-        .env("NO_COLOR", "1")
-        .output()
-        .expect("cannot run the reldesign binary");
-    Run {
-        args: args
-            .iter()
-            .map(|a| a.as_ref().to_string_lossy().into_owned())
-            .collect::<Vec<_>>()
-            .join(" "),
-        code: out.status.code(),
-        stdout: String::from_utf8(out.stdout).expect("stdout is UTF-8"),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
-}
-
-/// A fresh directory under the system temp dir, removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        static COUNTER: AtomicUsize = AtomicUsize::new(0);
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!(
-            "reldesign-diagnose-{tag}-{}-{n}",
-            std::process::id()
-        ));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).expect("create temp dir");
-        TempDir(dir)
-    }
-
-    fn path(&self) -> &Path {
-        &self.0
-    }
-
-    /// Names of the files in the directory, sorted (hidden ones included).
-    fn files(&self) -> Vec<String> {
-        files_in(&self.0)
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn files_in(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 /// stdout as exactly one JSON object (trailing text fails the parse).
@@ -198,7 +90,7 @@ fn spec_fields(m: &serde_json::Map<String, Value>) -> (String, PathBuf) {
 /// The extended model passes `reldesign check` and parses.
 fn checked_model(path: &Path) -> Description {
     assert!(path.is_file(), "{} was not written", path.display());
-    run(&["check".as_ref(), path.as_os_str()]).ok();
+    rd!("check", path).ok();
     parse_file(path).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -225,15 +117,8 @@ fn json_names_hidden_saturation_and_writes_the_extended_model_in_out_dir() {
     let dir = TempDir::new("saturation");
     let (model, data) = write_case(&dir.path().join("case"), &case);
     let out = dir.path().join("out");
-    let r = run(&[
-        "diagnose".as_ref(),
-        model.as_os_str(),
-        data.as_os_str(),
-        "--json".as_ref(),
-        "--out".as_ref(),
-        out.as_os_str(),
-    ]);
-    let m = one_object(r.ok());
+    let r = rd!("diagnose", model, data, "--json", "--out", out);
+    let m = one_object(&r.ok());
     let (cause, extended) = spec_fields(&m);
     assert_eq!(cause, "saturation", "{}", r.context());
     assert!(number(&m, "gain") >= 0.5, "{}", r.context());
@@ -283,15 +168,8 @@ fn baseline_data_gives_none() {
     let case = semera_case(Cause::None, 22);
     let dir = TempDir::new("none");
     let (model, data) = write_case(dir.path(), &case);
-    let r = run(&[
-        "diagnose".as_ref(),
-        model.as_os_str(),
-        data.as_os_str(),
-        "--json".as_ref(),
-        "--causes".as_ref(),
-        QUICK_CAUSES.as_ref(),
-    ]);
-    let m = one_object(r.ok());
+    let r = rd!("diagnose", model, data, "--json", "--causes", QUICK_CAUSES);
+    let m = one_object(&r.ok());
     let (cause, extended) = spec_fields(&m);
     assert_eq!(cause, "none", "{}", r.context());
     // The baseline already sits on the noise floor: nothing to gain.
@@ -310,13 +188,13 @@ fn text_report_and_files_next_to_the_data() {
     let data = dir.path().join("bench-run.csv");
     std::fs::write(&model, &case.baseline_toml).unwrap();
     std::fs::write(&data, &case.data_csv).unwrap();
-    let r = run(&[
-        "diagnose".as_ref(),
-        model.as_os_str(),
-        data.as_os_str(),
-        "--causes".as_ref(),
-        "eddy-currents,resistance-drift".as_ref(),
-    ]);
+    let r = rd!(
+        "diagnose",
+        model,
+        data,
+        "--causes",
+        "eddy-currents,resistance-drift"
+    );
     let text = r.ok();
     for needle in [
         "cause: eddy-currents",
@@ -329,7 +207,7 @@ fn text_report_and_files_next_to_the_data() {
         assert!(text.contains(needle), "no {needle:?} in\n{}", r.context());
     }
     assert!(
-        serde_json::from_str::<Value>(text).is_err(),
+        serde_json::from_str::<Value>(&text).is_err(),
         "text mode printed JSON"
     );
     assert_outputs(dir.path(), "bench-run");
@@ -385,12 +263,12 @@ fn rejected_without_output(model_toml: &str, data_csv: &str, extra: &[&str], nee
         out.as_os_str(),
     ];
     args.extend(extra.iter().map(std::ffi::OsStr::new));
-    run(&args).rejected(needles);
+    CLI.run(&args).rejected(needles);
     assert_eq!(dir.files(), ["bad-record.csv", "valve.toml"]);
     // Without --out: nothing next to the data either.
     args.truncate(3);
     args.extend(extra.iter().map(std::ffi::OsStr::new));
-    run(&args).rejected(needles);
+    CLI.run(&args).rejected(needles);
     assert_eq!(dir.files(), ["bad-record.csv", "valve.toml"]);
 }
 

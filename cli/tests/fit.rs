@@ -4,38 +4,19 @@
 //! parameters; bad parameters fail with a message naming them.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use designer::description::{parse_file, Gap};
 use serde_json::Value;
-
-const BIN: &str = env!("CARGO_BIN_EXE_reldesign");
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("cli/ has a parent")
-        .to_path_buf()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("reldesign-fit-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().unwrap()
-}
+use support::{example_path, rd, TempDir};
 
 /// A recording of the SEMERA valve (0/30 V square wave, 30 ms, 20 µs) and a
 /// copy of the description with R = 90 Ω and φ_sat = 1.6e-5 Wb.
 fn setup(dir: &Path) -> (PathBuf, PathBuf) {
-    let example = root().join("examples/semera-valve.toml");
+    let example = example_path("semera-valve.toml");
     let data = dir.join("rec.csv");
-    let out = run(&[
+    rd!(
         "simulate",
-        example.to_str().unwrap(),
+        example,
         "--square",
         "30:0:0.02:0.5",
         "--t-end",
@@ -43,13 +24,9 @@ fn setup(dir: &Path) -> (PathBuf, PathBuf) {
         "--dt",
         "2e-5",
         "--out",
-        data.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+        data
+    )
+    .ok();
     let text = std::fs::read_to_string(&example).unwrap();
     let text = text
         .replacen("resistance = 75.0", "resistance = 90.0", 1)
@@ -61,27 +38,23 @@ fn setup(dir: &Path) -> (PathBuf, PathBuf) {
 
 #[test]
 fn fit_recovers_resistance_and_saturation_flux_and_writes_the_model() {
-    let dir = scratch("fit");
-    let (model, data) = setup(&dir);
+    let dir = TempDir::new("fit-fit");
+    let (model, data) = setup(dir.path());
     let fitted = dir.join("fitted.toml");
-    let out = run(&[
+    let out = rd!(
         "fit",
-        model.to_str().unwrap(),
-        data.to_str().unwrap(),
+        model,
+        data,
         "--param",
         "coil.resistance=30:200",
         "--param",
         "core.phi_sat",
         "--out",
-        fitted.to_str().unwrap(),
-        "--json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        fitted,
+        "--json"
+    )
+    .ok();
+    let v: Value = serde_json::from_str(&out).unwrap();
     let r = v["values"]["coil.resistance"].as_f64().unwrap();
     let phi_sat = v["values"]["core.phi_sat"].as_f64().unwrap();
     // The recording is noise-free but its edges were exact jumps, replayed
@@ -104,21 +77,9 @@ fn fit_recovers_resistance_and_saturation_flux_and_writes_the_model() {
 
 #[test]
 fn text_output_names_values_errors_and_identifiability() {
-    let dir = scratch("text");
-    let (model, data) = setup(&dir);
-    let out = run(&[
-        "fit",
-        model.to_str().unwrap(),
-        data.to_str().unwrap(),
-        "--param",
-        "coil.resistance",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let s = String::from_utf8_lossy(&out.stdout);
+    let dir = TempDir::new("fit-text");
+    let (model, data) = setup(dir.path());
+    let s = rd!("fit", model, data, "--param", "coil.resistance").ok();
     assert!(
         s.contains("coil.resistance")
             && s.contains("wNRMSE current")
@@ -129,36 +90,22 @@ fn text_output_names_values_errors_and_identifiability() {
 
 #[test]
 fn unknown_parameters_and_bad_bounds_are_named() {
-    let dir = scratch("bad");
-    let (model, data) = setup(&dir);
+    let dir = TempDir::new("fit-bad");
+    let (model, data) = setup(dir.path());
     let fitted = dir.join("never.toml");
     for (param, needle) in [
         ("core.b", "`core.b`"),
         ("coil.resistance=5:1", "LO < HI"),
         ("mechanics.mass=-1:1", "mechanics.mass"),
     ] {
-        let out = run(&[
-            "fit",
-            model.to_str().unwrap(),
-            data.to_str().unwrap(),
-            "--param",
-            param,
-            "--out",
-            fitted.to_str().unwrap(),
-        ]);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            !out.status.success() && err.contains(needle),
-            "{param}: {err}"
-        );
-        assert!(!err.contains("panicked") && out.stdout.is_empty());
+        rd!("fit", model, data, "--param", param, "--out", fitted).rejected(&[needle]);
         assert!(!fitted.exists());
     }
 }
 
 #[test]
 fn gap_mode_fits_a_reluctance_table() {
-    let dir = scratch("gap");
+    let dir = TempDir::new("fit-gap");
     // R = r0 + r0'·z/(1 + k1·z·ln(k2/z)) and its derivative (13), exact.
     let (r0, r0p, k1, k2) = (2.41e6, 7.94e10, 1350.0, 9.95e-3);
     let mut csv = String::from("# generated gap table\nz,r,r_prime\n");
@@ -171,24 +118,20 @@ fn gap_mode_fits_a_reluctance_table() {
     }
     let table = dir.join("gap.csv");
     std::fs::write(&table, csv).unwrap();
-    let model = root().join("examples/jiles-atherton-valve.toml");
+    let model = example_path("jiles-atherton-valve.toml");
     let fitted = dir.join("gap.toml");
-    let out = run(&[
+    let out = rd!(
         "fit",
-        model.to_str().unwrap(),
-        table.to_str().unwrap(),
+        model,
+        table,
         "--gap",
         "mclyman-fit",
         "--out",
-        fitted.to_str().unwrap(),
-        "--json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+        fitted,
+        "--json"
+    )
+    .ok();
+    let v: Value = serde_json::from_str(&out).unwrap();
     assert!(v["nrmse_r"].as_f64().unwrap() < 1e-5, "{v}");
     assert!(v["nrmse_r_prime"].as_f64().unwrap() < 1e-5, "{v}");
     match parse_file(&fitted).unwrap().gap {

@@ -16,29 +16,19 @@
 
 use std::collections::BTreeSet;
 use std::path::{Component, Path, PathBuf};
-use std::process::Command;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("cli/ has a parent")
-        .to_path_buf()
-}
+use support::{rd, root, Cli, TempDir};
+
+const CLI: Cli = Cli::new(env!("CARGO_BIN_EXE_reldesign"));
 
 /// `reldesign ARGS --help` as the binary prints it, without colour and
 /// without trailing spaces on its lines.
 fn help(args: &[&str]) -> Result<String, String> {
-    let output = Command::new(env!("CARGO_BIN_EXE_reldesign"))
-        .args(args)
-        .arg("--help")
-        .env("NO_COLOR", "1")
-        .env_remove("CLICOLOR_FORCE")
-        .output()
-        .map_err(|e| format!("cannot run reldesign: {e}"))?;
-    if !output.status.success() {
-        return Err(String::from_utf8_lossy(&output.stderr).into_owned());
+    let run = CLI.run(&[args, &["--help"]].concat());
+    if !run.succeeded() {
+        return Err(run.stderr);
     }
-    let text = String::from_utf8(output.stdout).map_err(|e| e.to_string())?;
+    let text = String::from_utf8(run.stdout).map_err(|e| e.to_string())?;
     Ok(text
         .lines()
         .map(str::trim_end)
@@ -436,8 +426,7 @@ fn toml_blocks(text: &str) -> Vec<(usize, String)> {
 #[test]
 fn descriptions_in_the_docs_are_valid() {
     let root = root();
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("docs-descriptions");
-    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    let dir = TempDir::new("docs-descriptions");
     let mut checked = 0;
     let mut invalid = Vec::new();
     for file in markdown_files() {
@@ -455,17 +444,10 @@ fn descriptions_in_the_docs_are_valid() {
             }
             let path = dir.join(format!("{}-{line}.toml", shown.replace('/', "-")));
             std::fs::write(&path, &body).expect("write a description");
-            let output = Command::new(env!("CARGO_BIN_EXE_reldesign"))
-                .arg("check")
-                .arg(&path)
-                .output()
-                .expect("run reldesign check");
+            let run = rd!("check", path);
             checked += 1;
-            if !output.status.success() {
-                invalid.push(format!(
-                    "{shown}:{line}: {}",
-                    String::from_utf8_lossy(&output.stderr).trim()
-                ));
+            if !run.succeeded() {
+                invalid.push(format!("{shown}:{line}: {}", run.stderr.trim()));
             }
         }
     }

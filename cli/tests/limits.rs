@@ -12,57 +12,29 @@
 //!   with the design's own "needs" figure.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use serde_json::Value;
+use support::{example_path, rd, root, TempDir};
 
-const BIN: &str = env!("CARGO_BIN_EXE_reldesign");
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("cli/ has a parent")
-        .to_path_buf()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("reldesign-limits-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn relay_with(name: &str, replacements: &[(&str, &str)]) -> PathBuf {
+/// `tests/data/relay-12v.toml` with some of its text replaced, in a fresh
+/// directory (kept while the returned `TempDir` lives).
+fn relay_with(name: &str, replacements: &[(&str, &str)]) -> (TempDir, PathBuf) {
     let mut text = std::fs::read_to_string(root().join("tests/data/relay-12v.toml")).unwrap();
     for (from, to) in replacements {
         assert!(text.contains(from), "{from}");
         text = text.replacen(from, to, 1);
     }
-    let path = scratch(name).join("relay.toml");
-    std::fs::write(&path, text).unwrap();
-    path
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().unwrap()
+    let dir = TempDir::new(&format!("limits-{name}"));
+    let path = dir.write("relay.toml", text);
+    (dir, path)
 }
 
 /// `reldesign build MODEL`, the code written to a scratch directory (never
 /// next to the model: some models are the repository's test data).
 fn build(model: &Path) -> (bool, String) {
-    static BUILDS: AtomicUsize = AtomicUsize::new(0);
-    let k = BUILDS.fetch_add(1, Ordering::Relaxed);
-    let out_rs = scratch(&format!("build-{k}")).join("out.rs");
-    let out = run(&[
-        "build",
-        model.to_str().unwrap(),
-        "--out",
-        out_rs.to_str().unwrap(),
-    ]);
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let dir = TempDir::new("limits-build");
+    let run = rd!("build", model, "--out", dir.join("out.rs"));
+    (run.succeeded(), run.stderr)
 }
 
 /// The number that follows `key` in `text`.
@@ -93,7 +65,7 @@ fn a_slow_motion_lands_early_and_rests_and_the_report_says_so() {
 
 #[test]
 fn a_bound_too_low_says_which_bound_it_needs() {
-    let model = relay_with(
+    let (_dir, model) = relay_with(
         "bound",
         &[
             ("landing = 11e-3", "landing = 7e-3"),
@@ -118,7 +90,7 @@ fn a_bound_too_low_says_which_bound_it_needs() {
 
 #[test]
 fn a_motion_too_short_says_which_time_it_needs() {
-    let model = relay_with("short", &[("landing = 11e-3", "landing = 2.5e-3")]);
+    let (_dir, model) = relay_with("short", &[("landing = 11e-3", "landing = 2.5e-3")]);
     let (ok, err) = build(&model);
     assert!(!ok);
     assert!(
@@ -138,7 +110,7 @@ fn a_motion_too_short_says_which_time_it_needs() {
 fn a_rest_state_that_needs_no_flux_is_named() {
     // no preload and no spring: the armature rests anywhere without flux, so
     // the rest states of (61)–(62) are outside the linearizable region φ > 0
-    let model = relay_with(
+    let (_dir, model) = relay_with(
         "rest",
         &[
             ("stiffness = 200.0", "stiffness = 0.0"),
@@ -160,12 +132,12 @@ fn a_rest_state_that_needs_no_flux_is_named() {
 
 #[test]
 fn a_hermite_table_gap_is_designed_on_its_c2_twin() {
-    let text = std::fs::read_to_string(root().join("examples/table-gap-valve.toml")).unwrap();
+    let text = std::fs::read_to_string(example_path("table-gap-valve.toml")).unwrap();
     let design = "\n[trajectory]\noperations = [\"closing\"]\ntakeoff = 1e-3\nlanding = 6e-3\n\
                   shape = \"energy-optimal\"\nu_bound = 20.0\n\n[controller]\n\
                   law = \"feedback-linearization\"\nsettling_time = 1e-3\nsample_period = 1e-5\n";
-    let path = scratch("table").join("table.toml");
-    std::fs::write(&path, text + design).unwrap();
+    let dir = TempDir::new("limits-table");
+    let path = dir.write("table.toml", text + design);
     let (ok, report) = build(&path);
     assert!(ok, "{report}");
     assert!(
@@ -181,21 +153,10 @@ fn a_hermite_table_gap_is_designed_on_its_c2_twin() {
 #[test]
 fn limits_prints_json_and_a_plot_consistent_with_the_design() {
     let model = root().join("tests/data/relay-12v.toml");
-    let dir = scratch("limits");
+    let dir = TempDir::new("limits-limits");
     let svg = dir.join("limits.svg");
-    let out = run(&[
-        "limits",
-        model.to_str().unwrap(),
-        "--json",
-        "--plot",
-        svg.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let out = rd!("limits", model, "--json", "--plot", svg).ok();
+    let v: Value = serde_json::from_str(&out).unwrap();
     let ops = v["operations"].as_array().unwrap();
     assert_eq!(ops.len(), 2);
     assert_eq!(ops[0]["operation"], "closing");
@@ -218,8 +179,7 @@ fn limits_prints_json_and_a_plot_consistent_with_the_design() {
     let svg = std::fs::read_to_string(svg).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("closing (shortest"));
 
-    let text = run(&["limits", model.to_str().unwrap()]);
-    let text = String::from_utf8_lossy(&text.stdout);
+    let text = rd!("limits", model).ok();
     for needle in [
         "closing:",
         "opening:",
@@ -233,22 +193,13 @@ fn limits_prints_json_and_a_plot_consistent_with_the_design() {
 
 #[test]
 fn limits_refuses_a_hysteretic_core_with_a_reason() {
-    let out = run(&[
-        "limits",
-        root()
-            .join("examples/jiles-atherton-valve.toml")
-            .to_str()
-            .unwrap(),
-    ]);
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("not input-affine"), "{err}");
+    rd!("limits", example_path("jiles-atherton-valve.toml")).rejected(&["not input-affine"]);
 }
 
 #[test]
 fn an_infeasible_polynomial_says_which_time_it_needs_and_that_time_works() {
     let poly = [("shape = \"energy-optimal\"", "shape = \"polynomial\"")];
-    let short = relay_with(
+    let (_short, short) = relay_with(
         "poly-short",
         &[poly[0], ("landing = 11e-3", "landing = 3e-3")],
     );
@@ -262,10 +213,11 @@ fn an_infeasible_polynomial_says_which_time_it_needs_and_that_time_works() {
     // the polynomial needs more time than the energy-optimal motion (3.56 ms)
     assert!(needed > 3.6, "{needed}");
     let landing = format!("landing = {:e}", 1e-3 + 1.002 * needed * 1e-3);
-    let enough = relay_with("poly-enough", &[poly[0], ("landing = 11e-3", &landing)]);
+    let (_enough, enough) = relay_with("poly-enough", &[poly[0], ("landing = 11e-3", &landing)]);
     let (ok, report) = build(&enough);
     assert!(ok, "{report}");
     let landing = format!("landing = {:e}", 1e-3 + 0.98 * needed * 1e-3);
-    let too_short = relay_with("poly-too-short", &[poly[0], ("landing = 11e-3", &landing)]);
+    let (_too_short, too_short) =
+        relay_with("poly-too-short", &[poly[0], ("landing = 11e-3", &landing)]);
     assert!(!build(&too_short).0);
 }

@@ -3,11 +3,8 @@
 //! the unobservable intervals, and every bad input is rejected with the file
 //! and the row or key named, leaving no output behind.
 
-use std::ffi::OsStr;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::path::PathBuf;
 
 use designer::description::{parse_file, Description};
 use designer::model::Model;
@@ -15,124 +12,17 @@ use designer::observe::integral::{Integral, IntegralConfig};
 use designer::observe::semera::{Semera, SemeraConfig};
 use designer::replay::replay;
 use designer::sim::{Options, PiecewiseLinear};
-
-const BIN: &str = env!("CARGO_BIN_EXE_reldesign");
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+use support::{example_path, rd, root, TempDir};
 
 fn valve_path() -> PathBuf {
-    root().join("examples/semera-valve.toml")
+    example_path("semera-valve.toml")
 }
 
-/// A scratch directory under the target dir, emptied on creation.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> TempDir {
-        static N: AtomicUsize = AtomicUsize::new(0);
-        let dir = root().join("target/tmp").join(format!(
-            "observe-{tag}-{}-{}",
-            std::process::id(),
-            N.fetch_add(1, Ordering::SeqCst)
-        ));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn join(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-
-    fn write(&self, name: &str, text: &str) -> PathBuf {
-        let p = self.join(name);
-        std::fs::write(&p, text).unwrap();
-        p
-    }
-
-    fn files(&self) -> Vec<String> {
-        let mut f: Vec<String> = std::fs::read_dir(&self.0)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        f.sort();
-        f
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-struct Run {
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-    args: String,
-}
-
-fn observe(args: &[&OsStr]) -> Run {
-    let out = Command::new(BIN)
-        .arg("observe")
-        .args(args)
-        .env("NO_COLOR", "1")
-        .output()
-        .unwrap();
-    Run {
-        code: out.status.code(),
-        stdout: String::from_utf8(out.stdout).unwrap(),
-        stderr: String::from_utf8(out.stderr).unwrap(),
-        args: args
-            .iter()
-            .map(|a| a.to_string_lossy().into_owned())
-            .collect::<Vec<_>>()
-            .join(" "),
-    }
-}
-
+/// `reldesign observe ARGS…`.
 macro_rules! obs {
     ($($arg:expr),* $(,)?) => {
-        observe(&[$(OsStr::new(&$arg)),*])
+        rd!("observe", $($arg),*)
     };
-}
-
-impl Run {
-    fn context(&self) -> String {
-        format!(
-            "`reldesign observe {}` exited with {:?}\n--- stdout ---\n{}\n--- stderr ---\n{}",
-            self.args, self.code, self.stdout, self.stderr
-        )
-    }
-
-    fn ok(&self) {
-        assert_eq!(self.code, Some(0), "{}", self.context());
-    }
-
-    /// Non-zero exit, nothing on stdout, no panic, every needle on stderr
-    /// (whitespace and the report's margins ignored).
-    fn rejected(&self, needles: &[&str]) {
-        let ctx = self.context();
-        assert!(matches!(self.code, Some(c) if c != 0), "{ctx}");
-        assert!(self.stdout.is_empty(), "stdout must stay empty\n{ctx}");
-        for bad in ["panicked", "RUST_BACKTRACE"] {
-            assert!(!self.stderr.contains(bad), "{ctx}");
-        }
-        let squeeze = |s: &str| -> String {
-            s.chars()
-                .filter(|c| !c.is_whitespace() && *c != '│')
-                .collect()
-        };
-        for n in needles {
-            assert!(
-                squeeze(&self.stderr).contains(&squeeze(n)),
-                "stderr does not mention {n:?}\n{ctx}"
-            );
-        }
-    }
 }
 
 /// Two cycles of the 0/30 V square wave through the semera valve, sampled
@@ -194,20 +84,20 @@ fn observe_writes_the_designer_estimates_and_the_blind_intervals() {
     let data = dir.write("DATA.csv", &text);
     let out = dir.join("OUT.csv");
     let run = obs!(valve_path(), data, "--out", out, "--stride", "4");
-    run.ok();
+    let report = run.ok();
     assert!(run.stderr.is_empty(), "{}", run.context());
     assert!(
-        run.stdout.contains("DATA.csv: 801 samples"),
+        report.contains("DATA.csv: 801 samples"),
         "{}",
         run.context()
     );
-    assert!(run.stdout.contains("unobservable intervals"));
+    assert!(report.contains("unobservable intervals"));
     assert!(
-        run.stdout.contains("no current"),
+        report.contains("no current"),
         "the rest at the end is blind"
     );
     assert!(
-        run.stdout.contains("no excitation"),
+        report.contains("no excitation"),
         "the steady current is blind"
     );
     assert_eq!(dir.files(), ["DATA.csv", "OUT.csv"]);
@@ -240,8 +130,7 @@ fn observe_writes_the_designer_estimates_and_the_blind_intervals() {
 
     // without --out: the CSV on stdout, the report on stderr
     let run = obs!(valve_path(), data);
-    run.ok();
-    assert_eq!(run.stdout, want);
+    assert_eq!(run.ok(), want);
     assert!(run.stderr.contains("unobservable intervals"));
     assert_eq!(dir.files(), ["DATA.csv", "OUT.csv"]);
 }

@@ -16,20 +16,14 @@
 //! failure, not a skip. `RELDESIGN_PYTHON` overrides the interpreter.
 
 use std::ffi::OsString;
-use std::path::{Path, PathBuf};
 use std::process::Command;
+
+use support::{example_paths, root};
 
 const BIN: &str = env!("CARGO_BIN_EXE_reldesign");
 const INSTALL: &str = "the oracles need python3 with casadi, numpy and scipy: \
                        run `pip install casadi numpy scipy` (or set RELDESIGN_PYTHON \
                        to an interpreter that has them)";
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("cli/ has a parent")
-        .to_path_buf()
-}
 
 fn python() -> OsString {
     std::env::var_os("RELDESIGN_PYTHON").unwrap_or_else(|| "python3".into())
@@ -85,18 +79,8 @@ fn oracle(script: &str, args: &[OsString], verdict: &str) {
 }
 
 fn examples() -> Vec<OsString> {
-    let dir = root().join("examples");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
-        .map(|e| e.expect("directory entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    files.sort();
-    assert!(
-        files.len() >= 5,
-        "expected the five examples in {}",
-        dir.display()
-    );
+    let files = example_paths();
+    assert!(files.len() >= 5, "expected the five examples: {files:?}");
     // Relative to the workspace root, as in the documented command line.
     files
         .iter()

@@ -4,40 +4,14 @@
 //! `simulate` writes is valid measured data whatever `--dt` (no shorter last
 //! step).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
 use designer::record::Record;
+use support::{example_path, rd, Run, TempDir};
 
-const BIN: &str = env!("CARGO_BIN_EXE_reldesign");
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("cli/ has a parent")
-        .to_path_buf()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("reldesign-records-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().unwrap()
-}
-
-fn simulate(input: &Path, out: &Path) -> Output {
-    let model = root().join("examples/semera-valve.toml");
-    run(&[
-        "simulate",
-        model.to_str().unwrap(),
-        "--input",
-        input.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ])
+fn simulate(input: &Path, out: &Path) -> Run {
+    let model = example_path("semera-valve.toml");
+    rd!("simulate", model, "--input", input, "--out", out)
 }
 
 /// A 5 ms, 30 V pulse sampled every 50 µs, in the given layout.
@@ -59,11 +33,11 @@ fn pulse(header: &str, sep: &str, eol: &str, quote: bool) -> String {
 
 #[test]
 fn daq_exports_replay_as_the_plain_form_does() {
-    let dir = scratch("daq");
+    let dir = TempDir::new("records-daq");
     let plain_in = dir.join("plain.csv");
     std::fs::write(&plain_in, pulse("t,v,i", ",", "\n", false)).unwrap();
     let plain_out = dir.join("plain-out.csv");
-    assert!(simulate(&plain_in, &plain_out).status.success());
+    simulate(&plain_in, &plain_out).ok();
     let expected = std::fs::read_to_string(&plain_out).unwrap();
     let forms = [
         (
@@ -82,34 +56,23 @@ fn daq_exports_replay_as_the_plain_form_does() {
         let input = dir.join(format!("{name}.csv"));
         std::fs::write(&input, text).unwrap();
         let out = dir.join(format!("{name}-out.csv"));
-        let o = simulate(&input, &out);
-        assert!(
-            o.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+        simulate(&input, &out).ok();
         assert_eq!(std::fs::read_to_string(&out).unwrap(), expected, "{name}");
     }
     let eu = dir.join("eu.csv");
     std::fs::write(&eu, "t;v;i\n0;1,5;0\n5e-5;1,5;0\n").unwrap();
-    let o = simulate(&eu, &dir.join("eu-out.csv"));
-    assert!(!o.status.success());
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        err.contains("eu.csv:2") && err.contains("decimal comma"),
-        "{err}"
-    );
+    simulate(&eu, &dir.join("eu-out.csv")).rejected(&["eu.csv:2", "decimal comma"]);
 }
 
 #[test]
 fn what_simulate_writes_is_uniform_measured_data_whatever_the_step() {
-    let dir = scratch("dt");
-    let model = root().join("examples/semera-valve.toml");
+    let dir = TempDir::new("records-dt");
+    let model = example_path("semera-valve.toml");
     for dt in ["7e-6", "2e-5", "3.3e-5"] {
         let out = dir.join(format!("sq-{dt}.csv"));
-        let o = run(&[
+        rd!(
             "simulate",
-            model.to_str().unwrap(),
+            model,
             "--square",
             "30:0:0.01:0.5",
             "--t-end",
@@ -117,9 +80,9 @@ fn what_simulate_writes_is_uniform_measured_data_whatever_the_step() {
             "--dt",
             dt,
             "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            out
+        )
+        .ok();
         let r = Record::read(&out).unwrap();
         let t = r.time(2).unwrap();
         r.check_uniform(&t)

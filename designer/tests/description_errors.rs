@@ -5,26 +5,13 @@
 //! one-line message must contain the file name and every fragment.
 //! Every `examples/*.toml` must parse; a few values are spot-checked.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use designer::description::{
     parse_file, parse_str, Controller, Core, Description, Drive, FloatType, Gains, Gap, Law,
     Operation, Shape, Trajectory,
 };
-
-fn workspace_dir(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
-}
-
-fn toml_files(dir: &Path) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
-        .map(|entry| entry.expect("directory entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
-    files
-}
+use support::{assert_close, example_path, example_paths, root, toml_files, Tol};
 
 /// The fragments of the `# expect:` first line.
 fn expectations(path: &Path) -> Vec<String> {
@@ -78,7 +65,7 @@ fn check_bad(path: &Path) -> Option<String> {
 
 #[test]
 fn every_bad_description_is_rejected_with_its_expected_message() {
-    let files = toml_files(&workspace_dir("tests/data/bad"));
+    let files = toml_files(&root().join("tests/data/bad"));
     assert!(
         files.len() >= 24,
         "expected at least 24 bad descriptions, found {}",
@@ -98,8 +85,7 @@ fn every_bad_description_is_rejected_with_its_expected_message() {
 /// The physics sections of a bundled example (its design sections, and the
 /// comment lines that introduce them, are cut off so tests can add their own).
 fn example_text(name: &str) -> String {
-    let text =
-        std::fs::read_to_string(workspace_dir("examples").join(name)).expect("example exists");
+    let text = std::fs::read_to_string(example_path(name)).expect("example exists");
     let mut lines: Vec<&str> = text
         .lines()
         .take_while(|l| !l.starts_with("[trajectory]") && !l.starts_with("[controller]"))
@@ -114,21 +100,15 @@ fn example_text(name: &str) -> String {
 }
 
 fn example(name: &str) -> Description {
-    let path = workspace_dir("examples").join(name);
-    parse_file(&path).unwrap_or_else(|e| panic!("{e}"))
+    parse_file(&example_path(name)).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn assert_close(actual: f64, expected: f64, what: &str) {
-    let tolerance = 1e-12 * expected.abs().max(1e-300);
-    assert!(
-        (actual - expected).abs() <= tolerance,
-        "{what}: {actual} != {expected}"
-    );
-}
+/// Values the parser computes from the description: exact but for rounding.
+const EXACT: Tol = Tol::rel(1e-12);
 
 #[test]
 fn every_bundled_example_parses() {
-    let files = toml_files(&workspace_dir("examples"));
+    let files = example_paths();
     assert!(
         files.len() >= 5,
         "expected at least 5 examples, found {}",
@@ -177,12 +157,23 @@ fn preload_is_resolved_from_rest_position() {
     assert_close(
         ja.mechanics.preload,
         -55.0 * 0.015,
+        EXACT,
         "JA valve F0 = -k_s·z_s",
     );
     let sm = example("sliding-mode-valve.toml");
-    assert_close(sm.mechanics.preload, -61.8 * 0.019, "sliding-mode valve F0");
+    assert_close(
+        sm.mechanics.preload,
+        -61.8 * 0.019,
+        EXACT,
+        "sliding-mode valve F0",
+    );
     let semera = example("semera-valve.toml");
-    assert_close(semera.mechanics.preload, -37.0 * 22.5e-3, "semera valve F0");
+    assert_close(
+        semera.mechanics.preload,
+        -37.0 * 22.5e-3,
+        EXACT,
+        "semera valve F0",
+    );
 }
 
 #[test]
@@ -224,6 +215,7 @@ fn semera_valve_has_linear_gap_and_no_eddy() {
             ref other => panic!("expected a saturating core, got {other:?}"),
         },
         0.024 / 1200.0,
+        EXACT,
         "phi_sat = lambda_sat/N",
     );
     assert_eq!(d.coil.eddy, 0.0);
@@ -316,7 +308,7 @@ fn diagnostic_renders_file_position_and_label() {
 
 #[test]
 fn unreadable_file_is_an_error_naming_it() {
-    let path = workspace_dir("tests/data/bad/does-not-exist.toml");
+    let path = root().join("tests/data/bad/does-not-exist.toml");
     let err = parse_file(&path).expect_err("missing file");
     assert!(err.to_string().contains("does-not-exist.toml"), "{err}");
     assert!(err.to_string().contains("cannot read"), "{err}");
@@ -377,7 +369,7 @@ fn with_sections(example: &str, sections: &str) -> Description {
 
 #[test]
 fn the_perfect_tracking_example_carries_the_papers_design() {
-    for path in toml_files(&workspace_dir("examples")) {
+    for path in example_paths() {
         let d = parse_file(&path).unwrap_or_else(|e| panic!("{e}"));
         let designed = path
             .file_name()

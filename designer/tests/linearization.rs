@@ -6,18 +6,14 @@
 //! - T⁻¹(T(x)) = x on D₀⁺ (eqs. 41–42);
 //! - the relative degree is lost at φ = 0 and the Jiles–Atherton core is refused.
 
-use std::path::Path;
-
 use designer::description::parse_file;
 use designer::design::{DesignError, Linearization};
 use designer::model::Model;
 use designer::sym::Tape;
+use support::example_path;
 
 fn model(file: &str) -> Model {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../examples")
-        .join(file);
-    Model::build(&parse_file(&path).unwrap_or_else(|e| panic!("{e}")))
+    Model::build(&parse_file(&example_path(file)).unwrap_or_else(|e| panic!("{e}")))
 }
 
 const AFFINE_EXAMPLES: [&str; 4] = [

@@ -16,8 +16,6 @@
 // index loops over records and small matrices
 #![allow(clippy::needless_range_loop)]
 
-use std::path::{Path, PathBuf};
-
 use designer::description::{parse_file, parse_str, Core, Description, Drive};
 use designer::model::Model;
 use designer::observe::discrete::{DiscreteModel, Estimate, KalmanSettings};
@@ -25,23 +23,14 @@ use designer::observe::ekf::Ekf;
 use designer::observe::ukf::Ukf;
 use designer::replay::replay;
 use designer::sim::{EventKind, Mode, Options, PiecewiseLinear};
-
-fn examples_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples")
-}
+use support::{example_path, example_paths};
 
 fn example(file: &str) -> Description {
-    parse_file(&examples_dir().join(file)).unwrap_or_else(|e| panic!("{e}"))
+    parse_file(&example_path(file)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn all_examples() -> Vec<(String, Description)> {
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(examples_dir())
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    paths.sort();
-    paths
+    example_paths()
         .into_iter()
         .map(|p| {
             let name = p.file_name().unwrap().to_string_lossy().into_owned();
@@ -530,7 +519,7 @@ fn filters_on_the_jiles_atherton_valve() {
 /// tracked.
 #[test]
 fn current_drive_and_resistance_drift_run() {
-    let text = std::fs::read_to_string(examples_dir().join("perfect-tracking-valve.toml")).unwrap();
+    let text = std::fs::read_to_string(example_path("perfect-tracking-valve.toml")).unwrap();
     // the physics sections only (a controller needs voltage drive)
     let physics = &text[..text.find("\n[trajectory]").unwrap()];
     let variants = [

@@ -3,8 +3,6 @@
 //! constant-inductance RL circuit, the behaviour at zero current, and the
 //! `[observer]` section of the description.
 
-use std::path::Path;
-
 use designer::description::{
     parse_file, parse_str, Estimator, FloatType, IntegralSettings, SemeraSettings,
 };
@@ -13,15 +11,7 @@ use designer::observe::observability::{
     analyse, determinant, noise_std, polynomial, ObservabilitySettings, Status,
 };
 use designer::observe::semera::{Semera, SemeraConfig};
-
-fn close(a: f64, b: f64, tol: f64) -> bool {
-    (a - b).abs() <= tol * b.abs().max(1.0)
-}
-
-#[track_caller]
-fn assert_close(got: f64, want: f64, tol: f64, what: &str) {
-    assert!(close(got, want, tol), "{what}: got {got:e}, want {want:e}");
-}
+use support::{assert_close, example_path, Tol};
 
 /// Δ = 0.5, σ_v = 1, σ_i = 0.1, n_σ = 1, r̄₀ = 2, σ_r0 = 1, l̄₀ = 1, σ_l0 = 1,
 /// N = 2, no process noise: numbers a hand can follow.
@@ -46,7 +36,12 @@ fn small_semera(rate: f64, accel: f64) -> SemeraConfig {
 fn assert_matrix(got: [[f64; 3]; 3], want: [[f64; 3]; 3], what: &str) {
     for i in 0..3 {
         for j in 0..3 {
-            assert_close(got[i][j], want[i][j], 1e-15, &format!("{what}[{i}][{j}]"));
+            assert_close(
+                got[i][j],
+                want[i][j],
+                Tol::rel(1e-15),
+                format!("{what}[{i}][{j}]"),
+            );
         }
     }
 }
@@ -84,7 +79,7 @@ fn algorithm_1_by_hand() {
     );
     let x = s.state();
     for (g, w) in x.iter().zip([11.0 / 6.0, 2.0 / 3.0, 2.0 / 3.0]) {
-        assert_close(*g, w, 1e-15, "x̂_{2/1}");
+        assert_close(*g, w, Tol::rel(1e-15), "x̂_{2/1}");
     }
     let third = 1.0 / 3.0;
     assert_matrix(
@@ -99,11 +94,11 @@ fn algorithm_1_by_hand() {
 
     let e = s.step(2.0, 2.0);
     assert!(e.valid);
-    assert_close(e.r, 5.0 / 6.0, 1e-15, "r̂_2");
-    assert_close(e.l, 2.0 / 3.0, 1e-15, "l̂_2");
-    assert_close(e.lambda, 4.0 / 3.0, 1e-15, "λ̂_2");
-    assert_close(e.phi, 2.0 / 3.0, 1e-15, "φ̂_2");
-    assert_close(e.reluctance, 6.0, 1e-15, "R̂_2");
+    assert_close(e.r, 5.0 / 6.0, Tol::rel(1e-15), "r̂_2");
+    assert_close(e.l, 2.0 / 3.0, Tol::rel(1e-15), "l̂_2");
+    assert_close(e.lambda, 4.0 / 3.0, Tol::rel(1e-15), "λ̂_2");
+    assert_close(e.phi, 2.0 / 3.0, Tol::rel(1e-15), "φ̂_2");
+    assert_close(e.reluctance, 6.0, Tol::rel(1e-15), "R̂_2");
     assert_matrix(
         s.covariance(),
         [
@@ -198,7 +193,7 @@ fn observation_noise_variance_is_that_of_12() {
     assert_close(
         want,
         1.0 + 0.01 * ((2.0 + 2.0f64).powi(2) + 4.0),
-        1e-15,
+        Tol::rel(1e-15),
         "R (15)",
     );
     assert!(((sum2 / n as f64) - want).abs() < 0.02 * want);
@@ -249,11 +244,16 @@ fn a_constant_inductance_rl_circuit_gives_its_r_and_l() {
     for k in [n / 4 * 3 + n / 8 - 1, n - n / 8 + 10] {
         let e = est[k];
         assert!(e.valid, "sample {k}");
-        assert_close(e.r, r, 1e-4, &format!("SEMERA r̂ at sample {k}"));
-        assert_close(e.l, l, 1e-4, &format!("SEMERA l̂ at sample {k}"));
-        assert_close(e.lambda, l * i[k], 1e-4, &format!("SEMERA λ̂ at sample {k}"));
-        assert_close(e.phi, l * i[k] / 100.0, 1e-4, "φ̂ = λ̂/N");
-        assert_close(e.reluctance, 1e4 / l, 1e-4, "R̂ = N²/l̂");
+        assert_close(e.r, r, Tol::rel(1e-4), format!("SEMERA r̂ at sample {k}"));
+        assert_close(e.l, l, Tol::rel(1e-4), format!("SEMERA l̂ at sample {k}"));
+        assert_close(
+            e.lambda,
+            l * i[k],
+            Tol::rel(1e-4),
+            format!("SEMERA λ̂ at sample {k}"),
+        );
+        assert_close(e.phi, l * i[k] / 100.0, Tol::rel(1e-4), "φ̂ = λ̂/N");
+        assert_close(e.reluctance, 1e4 / l, Tol::rel(1e-4), "R̂ = N²/l̂");
     }
 
     let mut g = Integral::new(&IntegralConfig {
@@ -273,11 +273,11 @@ fn a_constant_inductance_rl_circuit_gives_its_r_and_l() {
     // with λ_end = l·i_end ≈ 0
     let ops = n / 4;
     let (su, si): (f64, f64) = (u[..ops].iter().sum(), i[..ops].iter().sum());
-    assert_close(est[ops].r, su / si, 1e-14, "r̄ of (47)");
-    assert_close(est[ops].r, r, 1e-4, "r̄ after one operation");
+    assert_close(est[ops].r, su / si, Tol::rel(1e-14), "r̄ of (47)");
+    assert_close(est[ops].r, r, Tol::rel(1e-4), "r̄ after one operation");
     let k = 3 * ops + ops / 4;
-    assert_close(est[k].lambda, l * i[k], 1e-3, "integral λ̂");
-    assert_close(est[k].l, l, 1e-3, "integral l̂");
+    assert_close(est[k].lambda, l * i[k], Tol::rel(1e-3), "integral λ̂");
+    assert_close(est[k].l, l, Tol::rel(1e-3), "integral l̂");
 }
 
 /// Algorithm 2 by hand: Δ = 0.5, λ₀ = 0.1, r̄₀ = 2, l̄₀ = 1, σ_i = 0.1,
@@ -306,20 +306,25 @@ fn algorithm_2_by_hand() {
     });
     let e = g.step(10.0, 1.0);
     assert_eq!((e.r, e.l, e.valid), (2.0, 1.0, false));
-    assert_close(e.lambda, 4.1, 1e-15, "λ̂_1");
-    assert_close(e.phi, 2.05, 1e-15, "φ̂_1");
+    assert_close(e.lambda, 4.1, Tol::rel(1e-15), "λ̂_1");
+    assert_close(e.phi, 2.05, Tol::rel(1e-15), "φ̂_1");
     let e = g.step(10.0, 3.0);
     assert!(e.valid);
-    assert_close(e.lambda, 6.1, 1e-15, "λ̂_2");
-    assert_close(e.l, 6.1 / 3.0, 1e-15, "l̂_2");
-    assert_close(e.reluctance, 4.0 / (6.1 / 3.0), 1e-15, "R̂_2");
+    assert_close(e.lambda, 6.1, Tol::rel(1e-15), "λ̂_2");
+    assert_close(e.l, 6.1 / 3.0, Tol::rel(1e-15), "l̂_2");
+    assert_close(e.reluctance, 4.0 / (6.1 / 3.0), Tol::rel(1e-15), "R̂_2");
     let e = g.step(0.0, 2.0);
-    assert_close(e.lambda, 4.1, 1e-15, "λ̂_3");
-    assert_close(e.l, 2.05, 1e-15, "l̂_3");
+    assert_close(e.lambda, 4.1, Tol::rel(1e-15), "λ̂_3");
+    assert_close(e.l, 2.05, Tol::rel(1e-15), "l̂_3");
     assert_eq!(e.r, 2.0);
     let e = g.step(10.0, 0.05);
-    assert_close(e.r, 10.0 / 3.0, 1e-15, "r̄ of (47)");
-    assert_close(e.lambda, 0.1 + 0.5 * (10.0 - 1.0 / 6.0), 1e-15, "λ̂_4");
+    assert_close(e.r, 10.0 / 3.0, Tol::rel(1e-15), "r̄ of (47)");
+    assert_close(
+        e.lambda,
+        0.1 + 0.5 * (10.0 - 1.0 / 6.0),
+        Tol::rel(1e-15),
+        "λ̂_4",
+    );
     assert_eq!((e.l, e.valid), (1.0, false));
 }
 
@@ -359,7 +364,7 @@ fn integral_estimator_at_rest_and_with_missing_samples() {
     assert_close(
         e.lambda,
         1e-4 * (48.0 - 50.0 * 0.2),
-        1e-14,
+        Tol::rel(1e-14),
         "λ̂ without a reset",
     );
 }
@@ -385,7 +390,8 @@ fn observability_determinant_32() {
         assert_close(
             determinant(i, dt),
             det,
-            1e-9 * (det.abs() + 1e9),
+            // the terms of (31) are of order 1e9: 1e-9 of that is rounding
+            Tol::rel(1e-9).or_abs(1.0),
             "(32) vs (31)",
         );
     }
@@ -457,7 +463,7 @@ fn observability_noise_level_matches_sampling() {
 /// The `[observer]` section: the example carries Table II; defaults.
 #[test]
 fn observer_section_parses() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/semera-valve.toml");
+    let path = example_path("semera-valve.toml");
     let d = parse_file(&path).unwrap();
     let o = d.observer.as_ref().unwrap();
     assert_eq!(o.estimators, [Estimator::Semera, Estimator::Integral]);

@@ -8,20 +8,19 @@
 //!   feasible; with loose bounds there is no saturation;
 //! - the scipy/CasADi oracle's figures (tests/oracle/check_optimal.py).
 
-use std::path::Path;
-
 use designer::description::parse_file;
 use designer::design::{
     energy_optimal, Linearization, OptimalError, OptimalSpec, OptimalTrajectory, Reference,
 };
 use designer::model::Model;
+use support::{assert_close, example_path, Tol};
 
 fn model(file: &str) -> Model {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../examples")
-        .join(file);
-    Model::build(&parse_file(&path).unwrap_or_else(|e| panic!("{e}")))
+    Model::build(&parse_file(&example_path(file)).unwrap_or_else(|e| panic!("{e}")))
 }
+
+/// Agreement with the oracle's figures.
+const ORACLE: Tol = Tol::rel(1e-6);
 
 const T0: f64 = 1e-3;
 const TF: f64 = 6e-3;
@@ -34,10 +33,6 @@ fn solve((z0, zf): (f64, f64), bound: f64) -> (Model, OptimalTrajectory) {
     let spec = OptimalSpec::new(z0, zf, T0, TF, -bound, bound);
     let traj = energy_optimal(&mut m, &lin, &spec).unwrap_or_else(|e| panic!("{e}"));
     (m, traj)
-}
-
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / b.abs()
 }
 
 /// Every check that does not depend on the figures.
@@ -79,7 +74,7 @@ fn check_solution(m: &mut Model, traj: &OptimalTrajectory, bound: f64) {
     assert!(spread <= 1e-7 * h0.abs(), "H spread {spread:e} of {h0:e}");
     for k in 0..200 {
         let h = traj.hamiltonian_at(T0 + (TF - T0) * (k as f64 + 0.5) / 200.0);
-        assert!(rel(h, h0) < 1e-5, "H {h:e} vs {h0:e}");
+        assert_close(h, h0, Tol::rel(1e-5), "H");
     }
     // ẋ = f(x, u*): RK4 with u*(t) from the interpolant, from x0
     let f = m.compile(&m.f.clone());
@@ -147,8 +142,8 @@ fn check_solution(m: &mut Model, traj: &OptimalTrajectory, bound: f64) {
 fn closing_with_20_volt_bounds_saturates_at_the_start() {
     let (mut m, traj) = solve(CLOSING, 20.0);
     check_solution(&mut m, &traj, 20.0);
-    assert!(rel(traj.cost, 1.00442170647) < 1e-6, "J = {}", traj.cost);
-    assert!(rel(traj.guess_cost, 0.8473778041) < 1e-6);
+    assert_close(traj.cost, 1.00442170647, ORACLE, "J");
+    assert_close(traj.guess_cost, 0.8473778041, ORACLE, "J of the polynomial");
     // the polynomial violates ±20 V (24.55 V), so it is no competitor here
     assert!(traj.guess_max_abs_input > 20.0);
     assert_eq!(traj.max_abs_input, 20.0);
@@ -162,7 +157,7 @@ fn closing_with_20_volt_bounds_saturates_at_the_start() {
 fn opening_with_20_volt_bounds_has_one_saturated_arc() {
     let (mut m, traj) = solve(OPENING, 20.0);
     check_solution(&mut m, &traj, 20.0);
-    assert!(rel(traj.cost, 0.926455240668) < 1e-6, "J = {}", traj.cost);
+    assert_close(traj.cost, 0.926455240668, ORACLE, "J");
     assert!(traj.cost < traj.guess_cost);
     assert_eq!(traj.max_abs_input, 20.0);
     let t: Vec<(f64, bool)> = traj.switches.iter().map(|s| (s.t, s.entering)).collect();
@@ -186,8 +181,8 @@ fn loose_bounds_do_not_saturate_and_beat_the_polynomial() {
             traj.cost,
             traj.guess_cost
         );
-        assert!(rel(traj.cost, j) < 1e-6, "J = {}", traj.cost);
-        assert!(rel(traj.max_abs_input, umax) < 1e-6);
+        assert_close(traj.cost, j, ORACLE, "J");
+        assert_close(traj.max_abs_input, umax, ORACLE, "max |u|");
     }
 }
 

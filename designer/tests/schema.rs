@@ -3,25 +3,10 @@
 //! model's parameters are the schema's symbols, and the generated reference
 //! page is fresh.
 
-use std::path::{Path, PathBuf};
-
 use designer::description::schema::{self, Domain, Kind, Presence};
 use designer::description::{parse_file, parse_str};
 use designer::model::Model;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn examples() -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(root().join("examples"))
-        .expect("examples/")
-        .map(|e| e.expect("entry").path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    files.sort();
-    files
-}
+use support::{example_path, example_paths, root};
 
 /// A value outside `domain`, if the domain excludes any.
 fn outside(domain: Domain) -> Option<f64> {
@@ -36,7 +21,7 @@ fn outside(domain: Domain) -> Option<f64> {
 #[test]
 fn every_number_outside_its_schema_domain_is_refused_with_its_unit() {
     let mut checked = 0;
-    for file in examples() {
+    for file in example_paths() {
         let text = std::fs::read_to_string(&file).expect("readable example");
         let doc: toml_edit::DocumentMut = text.parse().expect("example is TOML");
         for key in schema::KEYS.iter().filter(|k| k.kind == Kind::Number) {
@@ -75,8 +60,8 @@ fn every_number_outside_its_schema_domain_is_refused_with_its_unit() {
 
 #[test]
 fn defaults_are_the_schemas() {
-    let text = std::fs::read_to_string(root().join("examples/perfect-tracking-valve.toml"))
-        .expect("example");
+    let text =
+        std::fs::read_to_string(example_path("perfect-tracking-valve.toml")).expect("example");
     let d = parse_str(&text, "p.toml").expect("valid");
     let default = |path: &str| match schema::key(path).presence {
         Presence::Default(x) => x,
@@ -88,7 +73,7 @@ fn defaults_are_the_schemas() {
 
 #[test]
 fn model_parameters_are_schema_symbols_with_the_description_values() {
-    for file in examples() {
+    for file in example_paths() {
         let d = parse_file(&file).expect("valid example");
         let model = Model::build(&d);
         for (symbol, _, value) in model.params.iter() {

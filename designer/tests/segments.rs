@@ -22,14 +22,13 @@
 //! knots: z ≤ 7.2e-11 m, v ≤ 8.0e-7 m/s (the end-of-segment errors), a and
 //! jerk ~1e-9 relative (one-sided extrapolation at the switches).
 
-use std::path::Path;
-
 use designer::description::parse_file;
 use designer::design::{
     energy_optimal, fit_segments, knot_jumps, table_errors, FitError, Flat, Linearization,
     OptimalSpec, OptimalTrajectory, Polynomial, Reference, SegmentFit, SegmentTolerance, Signal,
 };
 use designer::model::Model;
+use support::example_path;
 
 const T0: f64 = 1e-3;
 const TF: f64 = 6e-3;
@@ -37,8 +36,7 @@ const CLOSING: (f64, f64) = (1e-3, 0.0);
 const OPENING: (f64, f64) = (0.0, 1e-3);
 
 fn optimal((z0, zf): (f64, f64), bound: f64) -> OptimalTrajectory {
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/perfect-tracking-valve.toml");
+    let path = example_path("perfect-tracking-valve.toml");
     let mut m = Model::build(&parse_file(&path).unwrap_or_else(|e| panic!("{e}")));
     let lin = Linearization::derive(&mut m).unwrap();
     let spec = OptimalSpec::new(z0, zf, T0, TF, -bound, bound);

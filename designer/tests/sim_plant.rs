@@ -3,21 +3,15 @@
 //! acceleration tapes against the whole field, the continuation beyond the
 //! stops, and the batched coil outputs against the single-point ones.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use designer::description::{parse_file, Description};
 use designer::model::{Model, ModelPlant};
 use designer::sim::{Branches, Plant, State, MAX_SWITCHES};
+use support::{assert_close, example_paths, Tol};
 
 fn examples() -> Vec<(PathBuf, Description)> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    paths.sort();
-    paths
+    example_paths()
         .into_iter()
         .map(|p| {
             let d = parse_file(&p).unwrap();
@@ -58,10 +52,6 @@ fn field(plant: &ModelPlant, x: &State, u: f64, branch: &Branches) -> State {
     dx
 }
 
-fn close(a: f64, b: f64, rel: f64) -> bool {
-    (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-300)
-}
-
 #[test]
 fn only_the_jiles_atherton_core_switches_and_its_function_is_the_flux_rate() {
     for (path, d) in examples() {
@@ -77,12 +67,7 @@ fn only_the_jiles_atherton_core_switches_and_its_function_is_the_flux_rate() {
             plant.switching(0.0, &x, 7.0, &mut s);
             let mut live = [0.0; 4];
             plant.deriv(0.0, &x, 7.0, &mut live);
-            assert!(
-                close(s[0], live[2], 1e-14),
-                "s = {} vs φ̇ = {}",
-                s[0],
-                live[2]
-            );
+            assert_close(s[0], live[2], Tol::rel(1e-14), "s = φ̇");
             let held = field(&plant, &x, 7.0, &[s[0].signum(), 0.0, 0.0, 0.0]);
             assert_eq!(held, live, "at {x:?}");
             // The other branch differs (in dH_c/dt only).
@@ -103,10 +88,11 @@ fn resting_field_and_acceleration_agree_with_the_whole_field() {
             let mut resting = [f64::NAN; 4];
             plant.deriv_resting(0.0, &x, -3.0, &branch, &mut resting);
             for i in 2..plant.dim() {
-                assert!(close(resting[i], whole[i], 1e-13), "{path:?} {i}: {x:?}");
+                let what = format!("{path:?} {i}: {x:?}");
+                assert_close(resting[i], whole[i], Tol::rel(1e-13), what);
             }
             let a = plant.accel_branch(0.0, &x, -3.0, &branch);
-            assert!(close(a, whole[1], 1e-13), "{path:?}: {a} vs {}", whole[1]);
+            assert_close(a, whole[1], Tol::rel(1e-13), format!("{path:?}: v̇"));
         }
     }
 }
@@ -165,7 +151,8 @@ fn batched_coil_outputs_match_single_points() {
             let one = plant.current_and_voltage(t[k], &xs[k], u[k]);
             assert_eq!((current[k], voltage[k]), one, "{path:?} point {k}");
             let coil = plant.coil(t[k], &xs[k], u[k]);
-            assert!(close(coil.current, one.0, 1e-13) && close(coil.voltage, one.1, 1e-13));
+            assert_close(coil.current, one.0, Tol::rel(1e-13), "coil current");
+            assert_close(coil.voltage, one.1, Tol::rel(1e-13), "coil voltage");
         }
     }
 }

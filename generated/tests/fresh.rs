@@ -2,23 +2,15 @@
 //! (rust-analyzer style): regenerates every module from its example and fails
 //! when one is stale. `UPDATE_GENERATED=1` rewrites stale files instead.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+use support::{example_paths, root};
 
 /// Examples with design sections (controller or observer), and the module
 /// each one generates.
 fn designed_examples() -> Vec<(PathBuf, String)> {
     let mut out = Vec::new();
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(root().join("examples"))
-        .expect("examples/")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    paths.sort();
-    for path in paths {
+    for path in example_paths() {
         let d = designer::description::parse_file(&path).unwrap_or_else(|e| panic!("{e}"));
         if d.controller.is_some() || d.observer.is_some() {
             out.push((path, d.name));

@@ -4,7 +4,6 @@
 //! and `identify::fit` must recover them and bring the weighted error down
 //! to the noise floor (the error of the true description on the same data).
 
-use std::path::Path;
 use std::time::Instant;
 
 use designer::description::{parse_file, Description};
@@ -13,12 +12,10 @@ use reldesign_identify::{
     current_wnrmse, fit, params, reduced_parameters, simulate_outputs, FitOptions, FitParam,
     Measured, Sensitivities,
 };
+use support::example_path;
 
 fn example(name: &str) -> Description {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../examples")
-        .join(name);
-    parse_file(&path).unwrap()
+    parse_file(&example_path(name)).unwrap()
 }
 
 /// SplitMix64 and Box–Muller: seeded standard normal samples.

@@ -2,8 +2,6 @@
 //! differences of whole replays, on the saturating valve: a stuck armature
 //! (no motion) and a record with motion, bounces and sticking impacts.
 
-use std::path::Path;
-
 use designer::description::{parse_file, Description};
 use designer::model::Model;
 use designer::replay::{replay, Replay};
@@ -11,6 +9,7 @@ use designer::sim::{EventKind, Options, PiecewiseLinear};
 use reldesign_identify::edges::replay_input;
 use reldesign_identify::sensitivity::{check, forward, OutputSensitivities};
 use reldesign_identify::{params, Measured};
+use support::example_path;
 
 const PATHS: [&str; 5] = [
     "coil.resistance",
@@ -21,8 +20,7 @@ const PATHS: [&str; 5] = [
 ];
 
 fn valve() -> Description {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/semera-valve.toml");
-    let mut d = parse_file(&path).unwrap();
+    let mut d = parse_file(&example_path("semera-valve.toml")).unwrap();
     // An eddy-current term, so that its sensitivity is not trivially zero.
     params::set(&mut d, "coil.eddy", 2e3).unwrap();
     d
@@ -156,7 +154,6 @@ fn the_analytic_jacobian_matches_central_differences_through_impacts() {
 fn reset_parameters_and_hysteresis_are_not_supported() {
     let d = valve();
     assert!(check(&d, &["coil.resistance", "mechanics.restitution"]).is_err());
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/jiles-atherton-valve.toml");
-    let ja = parse_file(&path).unwrap();
+    let ja = parse_file(&example_path("jiles-atherton-valve.toml")).unwrap();
     assert!(check(&ja, &["coil.resistance"]).is_err());
 }

@@ -27,7 +27,7 @@ use reldesign_identify::edges::{located, replay_input};
 use reldesign_identify::edit::write_physics;
 use reldesign_identify::wnrmse;
 
-use crate::{root, Rng};
+use crate::{example_path, Rng};
 
 /// Sample period of the records [s] (the semera paper samples at 50 µs).
 pub const SAMPLE_PERIOD: f64 = 40e-6;
@@ -676,7 +676,7 @@ pub fn hidden_case(
     with_z: bool,
     seed: u64,
 ) -> HiddenCase {
-    let path = root().join("examples").join(example_file);
+    let path = example_path(example_file);
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("{}: cannot read: {e}", path.display()));
     hidden_case_of(&text, example_file, cause, excitation, with_z, seed)

@@ -4,26 +4,14 @@
 pub mod devices;
 pub mod hidden;
 
-use std::path::{Path, PathBuf};
-
 use designer::description::{parse_file, parse_str, Description};
 use designer::model::Model;
 use designer::sim::{Event, EventKind, Limit};
-
-/// The workspace root.
-pub fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+pub use support::{example_path, root};
 
 /// Every bundled example description, sorted by file name.
 pub fn examples() -> Vec<(String, Description)> {
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(root().join("examples"))
-        .expect("examples/ exists")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    paths.sort();
-    paths
+    support::example_paths()
         .into_iter()
         .map(|p| {
             let d = parse_file(&p).unwrap_or_else(|e| panic!("{e}"));
@@ -39,13 +27,12 @@ pub fn examples() -> Vec<(String, Description)> {
 
 /// One bundled example by file name.
 pub fn example(file: &str) -> Description {
-    parse_file(&root().join("examples").join(file)).unwrap_or_else(|e| panic!("{e}"))
+    parse_file(&example_path(file)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// A bundled example with some lines of its TOML text replaced.
 pub fn example_with(file: &str, replacements: &[(&str, &str)]) -> Description {
-    let mut text =
-        std::fs::read_to_string(root().join("examples").join(file)).expect("example exists");
+    let mut text = std::fs::read_to_string(example_path(file)).expect("example exists");
     for (from, to) in replacements {
         assert!(text.contains(from), "`{from}` not found in {file}");
         text = text.replacen(from, to, 1);

@@ -23,33 +23,86 @@ enum Drive {
     Pulses,
 }
 
-/// (example, cause, drive, with z column, seed)
-type Case = (&'static str, Cause, Drive, bool, u64);
+use Cause::{Bouncing, EddyCurrents, Fringing, Hysteresis, ResistanceDrift, Saturation};
+use Drive::{Pulses, Square};
+
+/// One hidden-effect record to diagnose.
+#[derive(Debug, Clone, Copy)]
+struct Case<A> {
+    /// The actuator: a bundled example's file name, or the index of a
+    /// generated device.
+    actuator: A,
+    /// The effect hidden in the data.
+    cause: Cause,
+    drive: Drive,
+    /// Whether the record carries the `z` column.
+    with_z: bool,
+    seed: u64,
+}
+
+impl<A: std::fmt::Display> std::fmt::Display for Case<A> {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        let Case { cause, drive, .. } = self;
+        let (z, seed) = (self.with_z, self.seed);
+        write!(f, "{} {cause} {drive:?} z={z} seed={seed}", self.actuator)
+    }
+}
+
+impl Case<&str> {
+    /// The record of the case on its bundled example.
+    fn record(&self) -> HiddenCase {
+        let excitation = excitation(self.actuator, self.drive);
+        hidden_case(
+            self.actuator,
+            self.cause,
+            &excitation,
+            self.with_z,
+            self.seed,
+        )
+    }
+}
+
+impl Case<u64> {
+    /// The record of the case on its generated device.
+    fn record(&self) -> HiddenCase {
+        device_case_with(
+            self.actuator,
+            self.cause,
+            self.with_z,
+            self.seed,
+            |base| match self.drive {
+                Square => Excitation::square_wave(base),
+                Pulses => Excitation::pulses(base),
+            },
+        )
+    }
+}
 
 const SEMERA: &str = "semera-valve.toml";
 const TRACKING: &str = "perfect-tracking-valve.toml";
 const SLIDING: &str = "sliding-mode-valve.toml";
 const TABLE: &str = "table-gap-valve.toml";
 
-const CI_CASES: &[Case] = &[
-    (SEMERA, Cause::EddyCurrents, Drive::Square, false, 1),
-    (TRACKING, Cause::EddyCurrents, Drive::Pulses, true, 2),
-    (SEMERA, Cause::Saturation, Drive::Pulses, false, 3),
-    (SLIDING, Cause::Saturation, Drive::Square, true, 4),
-    (TABLE, Cause::Hysteresis, Drive::Pulses, false, 5),
-    (SEMERA, Cause::Hysteresis, Drive::Square, true, 6),
-    (SLIDING, Cause::Fringing, Drive::Square, false, 7),
-    (SEMERA, Cause::Fringing, Drive::Pulses, true, 8),
-    (TRACKING, Cause::ResistanceDrift, Drive::Square, false, 9),
-    (SLIDING, Cause::ResistanceDrift, Drive::Pulses, true, 10),
-    (SEMERA, Cause::Bouncing, Drive::Square, true, 11),
-    (TRACKING, Cause::Bouncing, Drive::Pulses, false, 12),
-    (SEMERA, Cause::None, Drive::Square, false, 13),
-    (SLIDING, Cause::None, Drive::Pulses, true, 14),
+#[rustfmt::skip]
+const CI_CASES: &[Case<&str>] = &[
+    Case { actuator: SEMERA,   cause: EddyCurrents,    drive: Square, with_z: false, seed: 1 },
+    Case { actuator: TRACKING, cause: EddyCurrents,    drive: Pulses, with_z: true,  seed: 2 },
+    Case { actuator: SEMERA,   cause: Saturation,      drive: Pulses, with_z: false, seed: 3 },
+    Case { actuator: SLIDING,  cause: Saturation,      drive: Square, with_z: true,  seed: 4 },
+    Case { actuator: TABLE,    cause: Hysteresis,      drive: Pulses, with_z: false, seed: 5 },
+    Case { actuator: SEMERA,   cause: Hysteresis,      drive: Square, with_z: true,  seed: 6 },
+    Case { actuator: SLIDING,  cause: Fringing,        drive: Square, with_z: false, seed: 7 },
+    Case { actuator: SEMERA,   cause: Fringing,        drive: Pulses, with_z: true,  seed: 8 },
+    Case { actuator: TRACKING, cause: ResistanceDrift, drive: Square, with_z: false, seed: 9 },
+    Case { actuator: SLIDING,  cause: ResistanceDrift, drive: Pulses, with_z: true,  seed: 10 },
+    Case { actuator: SEMERA,   cause: Bouncing,        drive: Square, with_z: true,  seed: 11 },
+    Case { actuator: TRACKING, cause: Bouncing,        drive: Pulses, with_z: false, seed: 12 },
+    Case { actuator: SEMERA,   cause: Cause::None,     drive: Square, with_z: false, seed: 13 },
+    Case { actuator: SLIDING,  cause: Cause::None,     drive: Pulses, with_z: true,  seed: 14 },
 ];
 
 fn excitation(example: &str, drive: Drive) -> Excitation {
-    let path = reldesign_tests::root().join("examples").join(example);
+    let path = reldesign_tests::example_path(example);
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let desc = parse_str(&text, example).unwrap_or_else(|e| panic!("{e}"));
     let base = reldesign_tests::hidden::baseline(&desc);
@@ -117,15 +170,15 @@ fn recovery(case: &HiddenCase, parameters: &[FittedParameter]) -> Option<String>
 const HELD_OUT_VISIBLE: f64 = 3.0;
 
 /// What went wrong with one case, or nothing.
-fn check(&(example, cause, drive, with_z, seed): &Case) -> Option<String> {
-    let case = hidden_case(example, cause, &excitation(example, drive), with_z, seed);
+fn check(c: &Case<&str>) -> Option<String> {
+    let case = c.record();
     let (d, parameters) = run(&case);
-    let missed = (d.cause == cause)
+    let missed = (d.cause == c.cause)
         .then(|| recovery(&case, &parameters))
         .flatten();
     let held = d.held_out.map_or(f64::NAN, |h| h.gain);
     let summary = format!(
-        "{example} {cause} {drive:?} z={with_z} seed={seed}: answered {} (gain {:.1} %, held-out {:.1} %; \
+        "{c}: answered {} (gain {:.1} %, held-out {:.1} %; \
          baseline {:.3} %, extended {:.3} %, floor {:.3} %; ranking {}; not identifiable {:?}; rejected {:?})",
         d.cause,
         100.0 * d.whole.gain,
@@ -141,14 +194,14 @@ fn check(&(example, cause, drive, with_z, seed): &Case) -> Option<String> {
             .collect::<Vec<_>>()
     );
     eprintln!("{summary}");
-    let right = d.cause == cause;
+    let right = d.cause == c.cause;
     // The held-out end shows the effect only when the baseline misses it
     // there (a bounce or a fringing error may fall in the fitted part only).
     let held_shows_effect = d
         .held_out
         .is_some_and(|h| h.baseline_wnrmse > HELD_OUT_VISIBLE * d.noise_floor);
     let held_ok = !held_shows_effect || held >= 0.5;
-    let gained = cause == Cause::None || (d.whole.gain >= 0.5 && held_ok);
+    let gained = c.cause == Cause::None || (d.whole.gain >= 0.5 && held_ok);
     if let Some(m) = &missed {
         eprintln!("  recovery: {m}");
     }
@@ -156,12 +209,12 @@ fn check(&(example, cause, drive, with_z, seed): &Case) -> Option<String> {
         .then(|| format!("{summary}\n  {}", missed.unwrap_or_default()))
 }
 
-fn check_all(cases: &[Case]) {
+fn check_all(cases: &[Case<&str>]) {
     check_all_but(cases, 0);
 }
 
 /// Every case right but at most `allowed`.
-fn check_all_but(cases: &[Case], allowed: usize) {
+fn check_all_but(cases: &[Case<&str>], allowed: usize) {
     let failures: Vec<String> = cases.iter().filter_map(check).collect();
     assert!(
         failures.len() <= allowed,
@@ -188,10 +241,16 @@ fn full_matrix() {
                 // Its [controller] needs a core the design supports (not JA).
                 continue;
             }
-            for drive in [Drive::Square, Drive::Pulses] {
+            for drive in [Square, Pulses] {
                 for with_z in [false, true] {
                     seed += 1;
-                    cases.push((example, cause, drive, with_z, seed));
+                    cases.push(Case {
+                        actuator: example,
+                        cause,
+                        drive,
+                        with_z,
+                        seed,
+                    });
                 }
             }
         }
@@ -214,9 +273,10 @@ fn write_cases() {
     let Ok(dir) = std::env::var("DIAGNOSE_CASES") else {
         return;
     };
-    for &(example, cause, drive, with_z, seed) in CI_CASES {
-        let case = hidden_case(example, cause, &excitation(example, drive), with_z, seed);
-        let name = format!("{}-{cause}-{seed}", example.trim_end_matches(".toml"));
+    for c in CI_CASES {
+        let case = c.record();
+        let example = c.actuator.trim_end_matches(".toml");
+        let name = format!("{example}-{}-{}", c.cause, c.seed);
         reldesign_tests::hidden::write_case(&std::path::Path::new(&dir).join(name), &case);
     }
 }
@@ -259,14 +319,6 @@ fn write_long_case() {
 /// Device families of the generator (`reldesign_tests::devices`) whose
 /// hidden-effect records the confusion matrix is drawn from.
 const DEVICE_SEED: u64 = 12;
-
-/// A hidden-effect case on generated device `index`.
-fn device_case(index: u64, cause: Cause, drive: Drive, with_z: bool, seed: u64) -> HiddenCase {
-    device_case_with(index, cause, with_z, seed, |base| match drive {
-        Drive::Square => Excitation::square_wave(base),
-        Drive::Pulses => Excitation::pulses(base),
-    })
-}
 
 /// A hidden-effect case on generated device `index` under the excitation
 /// `drive` makes of its baseline.
@@ -341,14 +393,15 @@ impl Confusion {
 
 /// Diagnoses hidden-effect cases on generated devices: the confusion matrix
 /// and what went wrong (a wrong cause, or a named cause without gain).
-fn confusion(cases: &[(u64, Cause, Drive, bool, u64)]) -> Confusion {
+fn confusion(cases: &[Case<u64>]) -> Confusion {
     let mut m = Confusion::new();
-    for &(index, cause, drive, with_z, seed) in cases {
-        let case = device_case(index, cause, drive, with_z, seed);
+    for c in cases {
+        let case = c.record();
         let (d, parameters) = run(&case);
+        let cause = c.cause;
         m.add(cause, d.cause);
         let summary = format!(
-            "device_{DEVICE_SEED}_{index} {cause} {drive:?} z={with_z} seed={seed}: answered {} \
+            "device_{DEVICE_SEED}_{c}: answered {} \
              (gain {:.1} %; baseline {:.3} %, extended {:.3} %, floor {:.3} %)",
             d.cause,
             100.0 * d.whole.gain,
@@ -372,10 +425,11 @@ fn confusion(cases: &[(u64, Cause, Drive, bool, u64)]) -> Confusion {
 
 #[test]
 fn causes_are_found_on_generated_devices() {
+    #[rustfmt::skip]
     let m = confusion(&[
-        (1, Cause::EddyCurrents, Drive::Square, false, 201),
-        (2, Cause::Saturation, Drive::Pulses, false, 202),
-        (4, Cause::None, Drive::Square, false, 203),
+        Case { actuator: 1, cause: EddyCurrents, drive: Square, with_z: false, seed: 201 },
+        Case { actuator: 2, cause: Saturation,   drive: Pulses, with_z: false, seed: 202 },
+        Case { actuator: 4, cause: Cause::None,  drive: Square, with_z: false, seed: 203 },
     ]);
     assert!(m.failures.is_empty(), "{}", m.failures.join("\n"));
 }
@@ -395,7 +449,13 @@ fn confusion_matrix_on_generated_devices() {
             } else {
                 Drive::Pulses
             };
-            cases.push((index, cause, drive, false, seed));
+            cases.push(Case {
+                actuator: index,
+                cause,
+                drive,
+                with_z: false,
+                seed,
+            });
         }
     }
     let m = confusion(&cases);

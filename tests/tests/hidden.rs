@@ -13,6 +13,7 @@ use reldesign_tests::hidden::{
     Sampling, SAMPLE_PERIOD,
 };
 use reldesign_tests::Rng;
+use support::TempDir;
 
 /// The examples the generator supports with every cause. (The perfect-
 /// tracking valve designs a controller, which rules out a Jiles–Atherton
@@ -211,11 +212,10 @@ fn record_parses_with_the_right_columns() {
         .iter()
         .all(|&v| v == 0.0 || v == amplitude));
     // write_case writes the two files.
-    let dir = std::env::temp_dir().join(format!("reldesign-hidden-{}", std::process::id()));
-    let (m, data) = write_case(&dir, &c);
+    let dir = TempDir::new("hidden");
+    let (m, data) = write_case(dir.path(), &c);
     assert_eq!(std::fs::read_to_string(&m).unwrap(), c.baseline_toml);
     assert_eq!(std::fs::read_to_string(&data).unwrap(), c.data_csv);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// The armature closes (z near z_min) and then opens (z near z_max again).

@@ -18,6 +18,7 @@ use designer::record::Record;
 use reldesign_identify::diagnose::{diagnose, Cause, Options};
 use reldesign_identify::gap_fit::{fit_gap, GapModel, GapTable};
 use reldesign_identify::{simulate_outputs, Measured, SimOutputs};
+use support::{assert_close, TempDir, Tol};
 
 /// Coil current of the quasi-static FEA [A] (12 V on 10 Ω; data README).
 const I_STATIC: f64 = 1.2;
@@ -207,13 +208,6 @@ fn simulate(desc: &Description, data: &Measured) -> SimOutputs {
     simulate_outputs(desc, data).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn assert_near(name: &str, value: f64, expected: f64, tolerance: f64) {
-    assert!(
-        (value - expected).abs() <= tolerance,
-        "{name}: {value:.6e}, expected {expected:.6e} ± {tolerance:.1e}"
-    );
-}
-
 #[test]
 fn gap_fit_reproduces_the_example() {
     let desc = reldesign_tests::example(EXAMPLE);
@@ -283,21 +277,26 @@ fn pull_in_against_the_fea_transient() {
     // The FEA figures are rows of the table (a check of this test's reading
     // of it): arrival 12.6134 ms, current peak 7.6 ms, dip bottom 12.6868 ms,
     // landing after two rebounds 15.0127 ms.
-    assert_near("FEA arrival", fea_figs.arrival, FEA_ARRIVAL, 1e-7);
-    assert_near("FEA peak", fea_figs.peak, 7.6e-3, 1e-7);
-    assert_near("FEA dip", fea_figs.dip, 12.6868e-3, 1e-7);
-    assert_near("FEA landing", fea_figs.landing, 15.0127e-3, 1e-7);
+    assert_close(fea_figs.arrival, FEA_ARRIVAL, Tol::abs(1e-7), "FEA arrival");
+    assert_close(fea_figs.peak, 7.6e-3, Tol::abs(1e-7), "FEA peak");
+    assert_close(fea_figs.dip, 12.6868e-3, Tol::abs(1e-7), "FEA dip");
+    assert_close(fea_figs.landing, 15.0127e-3, Tol::abs(1e-7), "FEA landing");
     // Measured: NRMSE 9.14 %, arrival 12.74 ms, peak 7.95 ms, the dip's
     // bottom and the landing at the arrival (γ = 0: no rebound).
     assert!(e_i < 0.095, "current NRMSE {e_i}");
-    assert_near("simulated arrival", sim_figs.arrival, 12.74e-3, 0.05e-3);
-    assert_near("simulated peak", sim_figs.peak, 7.95e-3, 0.1e-3);
-    assert_near("simulated dip", sim_figs.dip, 12.74e-3, 0.05e-3);
-    assert_near(
-        "simulated landing",
+    assert_close(
+        sim_figs.arrival,
+        12.74e-3,
+        Tol::abs(0.05e-3),
+        "simulated arrival",
+    );
+    assert_close(sim_figs.peak, 7.95e-3, Tol::abs(0.1e-3), "simulated peak");
+    assert_close(sim_figs.dip, 12.74e-3, Tol::abs(0.05e-3), "simulated dip");
+    assert_close(
         sim_figs.landing,
         sim_figs.arrival,
-        1e-9,
+        Tol::abs(1e-9),
+        "simulated landing",
     );
 }
 
@@ -350,13 +349,6 @@ fn report(data: &Measured, sim: &SimOutputs) {
     }
 }
 
-/// A temporary directory of this test process.
-fn temp_dir() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("reldesign-msl-solenoid-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
-    dir
-}
-
 /// The measured-data CSV (`shared/spec/measured-data.md`): t,v,i,z.
 fn write_csv(path: &Path, data: &Measured) {
     let z = data.z.as_ref().expect("the resampled transient has z");
@@ -376,12 +368,12 @@ fn write_csv(path: &Path, data: &Measured) {
 #[test]
 fn diagnose_the_fea_record() {
     let desc = reldesign_tests::example(EXAMPLE);
-    let dir = temp_dir();
+    let dir = TempDir::new("msl-solenoid");
     let path = dir.join("pullin-12V-fea-uniform.csv");
     write_csv(&path, &measured(&transient(), DT));
     let data = Measured::read(&path).unwrap_or_else(|e| panic!("{e}"));
     let d = diagnose(&desc, &data, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
-    std::fs::remove_dir_all(&dir).ok();
+    drop(dir);
     println!(
         "diagnose: cause {}; whole record wNRMSE {:.2} % -> {:.2} % (gain {:.1} %)",
         d.cause,

@@ -28,7 +28,7 @@ use designer::design::{
 };
 use designer::model::Model;
 use reldesign_tests::devices::devices;
-use reldesign_tests::{examples, root};
+use reldesign_tests::{example_path, examples, root};
 
 const TIMES: [f64; 5] = [3e-3, 5e-3, 8e-3, 12e-3, 20e-3];
 const TAKEOFF: f64 = 1e-3;
@@ -214,7 +214,7 @@ fn example_cases() -> Vec<Case> {
         if Model::build(&d).dim() != 3 {
             continue;
         }
-        let path = root().join("examples").join(&file);
+        let path = example_path(&file);
         cases.extend(grid(&file, &path.to_string_lossy(), &d));
     }
     cases
@@ -283,7 +283,7 @@ fn whole_grid_with_the_scipy_oracle() {
 fn arcs_agree_with_scipy_solve_bvp() {
     // the paper's valve and every fifth device of the CI family: a few dozen arcs
     let file = "perfect-tracking-valve.toml";
-    let path = root().join("examples").join(file);
+    let path = example_path(file);
     let d = reldesign_tests::example(file);
     let mut cases = grid(file, &path.to_string_lossy(), &d);
     cases.extend(device_cases(1, 15, |i| i % 5 == 0, "scipy"));

@@ -30,7 +30,7 @@ struct Subject {
 }
 
 fn example(file: &str) -> Subject {
-    let path = reldesign_tests::root().join("examples").join(file);
+    let path = reldesign_tests::example_path(file);
     Subject {
         name: file.to_string(),
         text: std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())),

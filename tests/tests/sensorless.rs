@@ -24,7 +24,7 @@ mod sensorless_valve {
     include!(concat!(env!("OUT_DIR"), "/sensorless_valve.rs"));
 }
 use reldesign_generated::perfect_tracking_valve::f64 as example64;
-use reldesign_tests::{impacts, root, Rng};
+use reldesign_tests::{example_path, impacts, root, Rng};
 use sensorless_valve::f64 as c64;
 
 const VALVE: &str = "perfect-tracking-valve.toml";
@@ -50,7 +50,7 @@ phi_sat = 25e-6             # φ_sat = 25 µWb, Table 1";
 /// The perfect-tracking valve with the JA core and k_s, R scaled: physics
 /// only (the design sections need the design model, not the plant).
 fn mismatched_plant(ks_factor: f64, r_factor: f64) -> Description {
-    let text = std::fs::read_to_string(root().join("examples").join(VALVE)).expect("example");
+    let text = std::fs::read_to_string(example_path(VALVE)).expect("example");
     let physics = text
         .split("[trajectory]")
         .next()
