@@ -2,7 +2,7 @@
 //! (the build.rs way in, prost-build style) for `tests/sensorless.rs`.
 
 fn main() {
-    if let Err(e) = codegen::compile("data/sensorless-valve.toml") {
+    if let Err(e) = reldesign_build::compile("data/sensorless-valve.toml") {
         eprintln!("{e}");
         std::process::exit(1);
     }

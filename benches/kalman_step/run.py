@@ -4,8 +4,8 @@
 Usage: bash benches/kalman_step.sh [--n N] [--time-n N] [--runs R] [--reps R]
 
 The driver (benches/kalman_step/rust, its own workspace, cargo --release, target dir
-target/kalman_step) generates its filters in build.rs with codegen::emit_ekf and
-codegen::emit_ukf (the runtime's reldesign_runtime::observe::{Ekf, Ukf} on the emitted
+target/kalman_step) generates its filters in build.rs with reldesign_build::emit_ekf and
+reldesign_build::emit_ukf (the runtime's reldesign_runtime::observe::{Ekf, Ukf} on the emitted
 model functions) from examples/perfect-tracking-valve.toml (T_s = 50 µs, σ_v = 15 mV,
 σ_i = 1 mA, the process noise of the observer tests) and a 400-sample noisy record of
 the valve driven open loop (closing with 24 V, opening with 0 V and a −24 V pulse,

@@ -28,7 +28,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
     let description = crate::load(&args.model)?;
     let design = designer::design::Design::new(&description)
         .map_err(|e| fail(format!("{}: {e}", description.source.file_name)))?;
-    let code = codegen::emit(&design).map_err(fail)?;
+    let code = reldesign_build::emit(&design).map_err(fail)?;
     if !args.quiet {
         eprintln!(
             "{}: design of `{}`\n{}",

@@ -87,13 +87,11 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
             discrete,
             floats: floats(&o.floats),
         };
-        macros.push(
-            emit_kalman_macro(&input).map_err(|e| BuildError::Observer {
-                file: file(),
-                estimator: "ekf/ukf",
-                message: e.to_string(),
-            })?,
-        );
+        macros.push(emit_kalman_macro(&input).map_err(|e| BuildError::Observer {
+            file: file(),
+            estimator: "ekf/ukf",
+            message: e.to_string(),
+        })?);
         type Emitter = fn(&ObserverInput) -> Result<String, ObserverError>;
         let kinds: [(Estimator, &str, &str, Emitter); 2] = [
             (Estimator::Ekf, "ekf", "The extended Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).", emit_ekf),

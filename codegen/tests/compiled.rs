@@ -13,11 +13,11 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use codegen::{emit_function, emit_params, Float, FunctionSpec, Param};
 use designer::description::parse_file;
 use designer::design::Linearization;
 use designer::model::Model;
 use designer::sym::{Graph, Id, Tape};
+use reldesign_build::{emit_function, emit_params, Float, FunctionSpec, Param};
 
 /// One function to emit, with the reference points it is evaluated at.
 struct Case {

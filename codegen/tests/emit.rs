@@ -4,11 +4,11 @@
 
 use std::path::Path;
 
-use codegen::{emit_function, emit_params, EmitError, Float, FunctionSpec, Param};
 use designer::description::parse_str;
 use designer::design::Linearization;
 use designer::model::Model;
 use designer::sym::{Graph, Id};
+use reldesign_build::{emit_function, emit_params, EmitError, Float, FunctionSpec, Param};
 
 const VALVE: &str = "../examples/perfect-tracking-valve.toml";
 

@@ -19,9 +19,6 @@ use common::{cargo, clippy_panic_free, workspace_target, write_if_changed};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use codegen::{
-    emit_ekf, emit_kalman_macro, emit_observer_params, emit_ukf, wrap_module, Float, ObserverInput,
-};
 use designer::description::{parse_file, parse_str, Core, Description};
 use designer::model::Model;
 use designer::observe::discrete::{DiscreteModel, Estimate, KalmanSettings, ResistanceSettings};
@@ -29,6 +26,9 @@ use designer::observe::ekf::Ekf;
 use designer::observe::ukf::Ukf;
 use designer::replay::replay;
 use designer::sim::{Options, PiecewiseLinear};
+use reldesign_build::{
+    emit_ekf, emit_kalman_macro, emit_observer_params, emit_ukf, wrap_module, Float, ObserverInput,
+};
 
 const TS: f64 = 50e-6;
 
@@ -89,7 +89,8 @@ fn emit(d: &Description, resistance: bool, floats: &[Float]) -> String {
         discrete: &dm,
         floats: floats.to_vec(),
     };
-    let ok = |r: Result<String, codegen::ObserverError>| r.unwrap_or_else(|e| panic!("{e}"));
+    let ok =
+        |r: Result<String, reldesign_build::ObserverError>| r.unwrap_or_else(|e| panic!("{e}"));
     ok(emit_observer_params(&input))
         + "\n"
         + &ok(emit_kalman_macro(&input))
@@ -420,7 +421,7 @@ fn every_parameter_and_setting_is_written_once() {
         let mut names: Vec<String> = dm
             .model_params
             .iter()
-            .map(|(name, _, _)| codegen::const_name(name).unwrap())
+            .map(|(name, _, _)| reldesign_build::const_name(name).unwrap())
             .collect();
         names.extend(["Z_MIN", "Z_MAX", "T_S", "VOLTAGE_NOISE", "CURRENT_NOISE"].map(String::from));
         names.extend(
@@ -564,7 +565,7 @@ fn emitted_filters_compile_pass_clippy_and_match_the_designer() {
     assert!(lines.next().is_none());
 }
 
-/// Through the build (`codegen::Design`): a file declares `params!` (with
+/// Through the build (`reldesign_build::Design`): a file declares `params!` (with
 /// the stops) and `kalman!` once, with a controller (whose emitter writes
 /// `params!`) and without one (the observers' own).
 #[test]
@@ -579,7 +580,8 @@ fn the_build_declares_params_and_kalman_once() {
     ] {
         let d = parse_str(&toml, "valve.toml").unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(d.controller.is_some(), name == "with a controller");
-        let code = codegen::Design::new(&d).unwrap().emit().unwrap();
+        let design = designer::design::Design::new(&d).unwrap();
+        let code = reldesign_build::emit(&design).unwrap();
         for (needle, count) in [
             ("macro_rules! params {", 1),
             ("macro_rules! kalman {", 1),

@@ -11,9 +11,9 @@
 
 use std::path::{Path, PathBuf};
 
-use codegen::{const_name, emit};
 use designer::description::parse_str;
 use designer::design::Design;
+use reldesign_build::{const_name, emit};
 
 /// Top-level modules that still declare the parameters themselves.
 const NOT_YET_ON_PARAMS: &[&str] = &["ekf", "ukf"];

@@ -1,4 +1,4 @@
-//! The emitted SEMERA and integral estimators (`codegen::emit_semera`, in the
+//! The emitted SEMERA and integral estimators (`reldesign_build::emit_semera`, in the
 //! file `reldesign build` writes): deterministic bytes, one changed line per
 //! changed parameter, compilation as a `#![no_std]`, `#![forbid(unsafe_code)]`
 //! crate under clippy's panic lints (the emitted settings, and the runtime's
@@ -17,13 +17,14 @@ use common::{cargo, clippy_panic_free, workspace_target, write_if_changed};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use codegen::{emit_semera, Design, Float, SemeraError, SemeraInput};
 use designer::description::{parse_file, Description};
+use designer::design::Design;
 use designer::model::Model;
 use designer::observe::integral::{Integral, IntegralConfig};
 use designer::observe::semera::{Estimate, Semera, SemeraConfig};
 use designer::replay::replay;
 use designer::sim::{Options, PiecewiseLinear};
+use reldesign_build::{emit, emit_semera, Float, SemeraError, SemeraInput};
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -35,9 +36,8 @@ fn valve() -> Description {
 
 /// The whole emitted file (`params!`, then `pub mod estimators`).
 fn file(d: &Description) -> String {
-    Design::new(d)
-        .and_then(|design| design.emit())
-        .unwrap_or_else(|e| panic!("{e}"))
+    let design = Design::new(d).unwrap_or_else(|e| panic!("{e}"));
+    emit(&design).unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]

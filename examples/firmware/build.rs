@@ -6,7 +6,7 @@
 
 fn main() {
     // Relative to this crate's directory (the build script's working directory).
-    if let Err(error) = codegen::compile("../perfect-tracking-valve.toml") {
+    if let Err(error) = reldesign_build::compile("../perfect-tracking-valve.toml") {
         eprintln!("error: {error}");
         std::process::exit(1);
     }

@@ -27,11 +27,11 @@ fn generated_code_is_fresh() {
     let designed = designed_examples();
     assert!(!designed.is_empty(), "no example carries design sections");
     for (example, name) in designed {
-        let (_, code) = codegen::build_file(&example).unwrap_or_else(|e| panic!("{e}"));
+        let (_, code) = reldesign_build::build_file(&example).unwrap_or_else(|e| panic!("{e}"));
         let target = root().join("generated/src").join(format!("{name}.rs"));
         if std::fs::read_to_string(&target).ok().as_deref() != Some(code.as_str()) {
             if update {
-                codegen::write_if_changed(&target, &code).unwrap_or_else(|e| panic!("{e}"));
+                reldesign_build::write_if_changed(&target, &code).unwrap_or_else(|e| panic!("{e}"));
                 eprintln!("updated {}", target.display());
             } else {
                 stale.push(target.display().to_string());

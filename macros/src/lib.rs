@@ -3,7 +3,7 @@
 //! checked-in generated file.
 //!
 //! The macro runs the same pipeline as `reldesign build` and
-//! `codegen::compile` (description → model → feedback linearization →
+//! `reldesign_build::compile` (description → model → feedback linearization →
 //! references → feasibility → reference tables → emitted Rust) and splices
 //! the emitted module into your crate. All three ways produce the same code,
 //! byte for byte.
@@ -54,14 +54,14 @@
 //! Editing the TOML file re-runs the design on the next `cargo build` (see
 //! the `include_bytes!` in the expansion). Designing takes about a second in
 //! an unoptimized build; the macro runs whenever the calling crate compiles.
-//! If that matters, prefer the `build.rs` route (`codegen::compile`), whose
+//! If that matters, prefer the `build.rs` route (`reldesign_build::compile`), whose
 //! output cargo caches until the description changes.
 //!
 //! # Choosing between the three ways
 //!
 //! * `design!` — least ceremony; code is never seen (use `cargo expand` or
 //!   `reldesign build` to read it).
-//! * `build.rs` + `codegen::compile` + `include!(concat!(env!("OUT_DIR"), "/<name>.rs"))`
+//! * `build.rs` + `reldesign_build::compile` + `include!(concat!(env!("OUT_DIR"), "/<name>.rs"))`
 //!   — prost-build style, cached by cargo.
 //! * `reldesign build --out src/<name>.rs` and commit the file — reviewable,
 //!   no generator in the firmware's dependency tree at all.
@@ -129,8 +129,8 @@ fn try_expand(input: TokenStream, manifest_dir: Option<&Path>) -> syn::Result<To
         )));
     }
 
-    let (design, code) =
-        codegen::build_file(&path).map_err(|e| error(e.to_string().trim_end().to_string()))?;
+    let (design, code) = reldesign_build::build_file(&path)
+        .map_err(|e| error(e.to_string().trim_end().to_string()))?;
 
     let name = &design.description.name;
     let module: Ident = syn::parse_str(name).map_err(|_| {

@@ -18,7 +18,7 @@ use designer::observe::discrete::{DiscreteModel, ResistanceSettings};
 use designer::sim::{simulate_sampled, Event, Limit, Measurement, Mode, Options, State};
 /// The sensorless design: `tests/data/sensorless-valve.toml` (the
 /// perfect-tracking valve with a 2.5 ms settling time and EKF/UKF at 10 µs),
-/// emitted by `tests/build.rs` through `codegen::compile`.
+/// emitted by `tests/build.rs` through `reldesign_build::compile`.
 #[allow(dead_code)] // the test uses the f64 code; the f32 code is checked elsewhere
 mod sensorless_valve {
     include!(concat!(env!("OUT_DIR"), "/sensorless_valve.rs"));

@@ -1,6 +1,6 @@
 //! Emits the EKF and UKF of examples/perfect-tracking-valve.toml (T_s = 50 µs,
 //! σ_v = 15 mV, σ_i = 1 mA, the process noise of the observer tests) with
-//! `codegen::emit_ekf` / `codegen::emit_ukf` (and the file's `params!` and
+//! `reldesign_build::emit_ekf` / `reldesign_build::emit_ukf` (and the file's `params!` and
 //! `kalman!` they invoke) into one file, and a noisy record of the valve
 //! driven open loop (24 V on [0, 6 ms), 0 V, −24 V on [10, 10.4 ms), 0 V
 //! until 20 ms; 400 samples) simulated by the designer's hybrid simulator.
@@ -8,7 +8,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use codegen::{
+use reldesign_build::{
     emit_ekf, emit_kalman_macro, emit_observer_params, emit_ukf, wrap_module, Float, ObserverInput,
 };
 use designer::description::parse_file;
@@ -73,7 +73,7 @@ fn main() {
         discrete: &dm,
         floats: vec![Float::F64, Float::F32],
     };
-    let ok = |r: Result<String, codegen::ObserverError>| r.unwrap_or_else(|e| panic!("{e}"));
+    let ok = |r: Result<String, reldesign_build::ObserverError>| r.unwrap_or_else(|e| panic!("{e}"));
     let code = ok(emit_observer_params(&input))
         + &ok(emit_kalman_macro(&input))
         + &wrap_module("ekf", "The EKF.", &ok(emit_ekf(&input)))

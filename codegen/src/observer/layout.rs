@@ -10,9 +10,9 @@ use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
 use crate::emit::{function_tokens, FunctionSpec};
-use crate::param::Param;
 use crate::error::EmitError;
 use crate::float::Float;
+use crate::param::Param;
 
 use super::{lit, Kind, ObserverError};
 

@@ -33,11 +33,11 @@ use designer::observe::discrete::DiscreteModel;
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::param::Param;
 use crate::error::EmitError;
 use crate::float::Float;
 use crate::format::{comment_lets, format_items, space_items};
 use crate::names::const_name;
+use crate::param::Param;
 
 use layout::{state_names, vector_tokens, Layout};
 pub use settings::{emit_kalman_macro, emit_observer_params};

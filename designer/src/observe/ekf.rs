@@ -1,7 +1,7 @@
 //! The extended Kalman filter on the discretised model (84)–(87), with the
 //! Jacobians the symbolic core derives (`DiscreteModel::transition_jacobian`,
 //! `measurement_jacobian`): the f64 reference of the emitted EKF
-//! (`codegen::emit_ekf`). It is the runtime's filter
+//! (`reldesign_build::emit_ekf`). It is the runtime's filter
 //! (`reldesign_runtime::observe::Ekf`, where the algorithm and its docs
 //! live), the one the emitted code instantiates, on the model's tapes
 //! instead of straight-line code.

@@ -1,6 +1,6 @@
 //! The unscented Kalman filter on the discretised model (84)–(87), as in
 //! jiles-atherton-actuator-model §6.1: the f64 reference of the emitted UKF
-//! (`codegen::emit_ukf`). It is the runtime's filter
+//! (`reldesign_build::emit_ukf`). It is the runtime's filter
 //! (`reldesign_runtime::observe::Ukf`, where the algorithm and its docs
 //! live: sigma points, repaired factorisations), the one the emitted code
 //! instantiates, on the model's tapes instead of straight-line code.

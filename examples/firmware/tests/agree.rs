@@ -1,5 +1,5 @@
 //! The three ways to get the controller agree: the `design!` macro, the
-//! `build.rs` route (`codegen::compile`) and the checked-in output of
+//! `build.rs` route (`reldesign_build::compile`) and the checked-in output of
 //! `reldesign build` (`reldesign_generated`) give bit-identical control
 //! inputs for a grid of states, references and times, in f32 and in f64.
 
