@@ -233,8 +233,8 @@ impl Graph {
     pub fn pow(&mut self, base: Id, exponent: Id) -> Id {
         let e = self.as_const(exponent);
         match e {
-            Some(e) if e == 0.0 => return self.one(),
-            Some(e) if e == 1.0 => return base,
+            Some(0.0) => return self.one(),
+            Some(1.0) => return base,
             _ => {}
         }
         if let (Some(b), Some(e)) = (self.as_const(base), e) {

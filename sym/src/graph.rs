@@ -33,6 +33,17 @@ pub enum Func {
 }
 
 impl Func {
+    /// Every function, in declaration order.
+    pub const ALL: [Func; 7] = [
+        Func::Sqrt,
+        Func::Exp,
+        Func::Ln,
+        Func::Abs,
+        Func::Sign,
+        Func::Tanh,
+        Func::Coth,
+    ];
+
     pub fn name(self) -> &'static str {
         match self {
             Func::Sqrt => "sqrt",
@@ -88,6 +99,11 @@ pub enum Node {
     Select(Id, Id, Id),
 }
 
+/// [`Graph::fresh_symbol`]: the name is taken.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("the symbol `{0}` already exists")]
+pub struct SymbolTaken(pub String);
+
 /// The arena of hash-consed expression nodes and the symbol table.
 #[derive(Default, Clone)]
 pub struct Graph {
@@ -142,6 +158,16 @@ impl Graph {
             }
         };
         self.intern(Node::Sym(index))
+    }
+
+    /// The symbol `name`, which must not exist yet: for names that code built
+    /// from the graph declares itself, where reusing a symbol of the model
+    /// would silently bind two meanings to one name.
+    pub fn fresh_symbol(&mut self, name: &str) -> Result<Id, SymbolTaken> {
+        if self.symbol_index.contains_key(name) {
+            return Err(SymbolTaken(name.to_owned()));
+        }
+        Ok(self.symbol(name))
     }
 
     /// The symbol node called `name`, if it exists.

@@ -9,8 +9,10 @@
 //!
 //! | file | concept |
 //! | --- | --- |
-//! | `graph.rs` | nodes, ids, hash-consing, traversal |
+//! | `graph.rs` | nodes, ids, hash-consing, symbols, traversal |
 //! | `build.rs` | smart constructors = simplification rules |
+//! | `expr.rs` | expression handles with operators, over the constructors |
+//! | `parse.rs` | infix text to nodes (tests) |
 //! | `diff.rs` | differentiation, substitution |
 //! | `cse.rs` | common-subexpression elimination |
 //! | `factor.rs` | common factors out of sums |
@@ -20,12 +22,16 @@
 mod build;
 mod cse;
 mod diff;
+mod expr;
 mod factor;
 mod graph;
+mod parse;
 mod print;
 mod tape;
 
 pub use build::pow_value;
 pub use cse::Cse;
-pub use graph::{sign, Func, Graph, Id, Node};
+pub use expr::{Operand, Scope, E};
+pub use graph::{sign, Func, Graph, Id, Node, SymbolTaken};
+pub use parse::ParseError;
 pub use tape::{Instr, Tape, UnboundSymbol};

@@ -1,12 +1,13 @@
 //! Property tests of the symbolic core against independent oracles:
 //! - simplification, tape compilation and CSE against a direct f64 evaluation
 //!   of the same random recipe (which never touches the graph);
+//! - printing against parsing: the text parses back to the same node;
 //! - derivatives (first and second order) against central finite differences;
 //! - `factor_sums` (common factors out of sums) keeps the values of an
 //!   expression and of its derivatives, where sums share the most factors.
 
 use proptest::prelude::*;
-use reldesign_sym::{Graph, Id, Tape};
+use reldesign_sym::{Graph, Id, Scope, Tape, E};
 
 /// A random expression in x and y, evaluated two ways: directly in f64 and
 /// through the graph. Every operation is smooth and defined on all of R².
@@ -78,67 +79,28 @@ fn value(r: &Recipe, x: f64, y: f64) -> f64 {
 }
 
 fn build(g: &mut Graph, r: &Recipe) -> Id {
-    let one = g.one();
-    let sq1 = |g: &mut Graph, a: Id| {
-        let a2 = g.powi(a, 2);
-        g.add(one, a2)
-    };
+    g.with(|s| build_expr(s, r).id())
+}
+
+/// The recipe with the expression layer; `sq1(a)` is 1 + a².
+fn build_expr<'s>(s: &'s Scope, r: &Recipe) -> E<'s> {
+    let b = |r: &Recipe| build_expr(s, r);
+    let sq1 = |a: &Recipe| 1.0 + b(a).powi(2);
     match r {
-        Recipe::X => g.symbol("x"),
-        Recipe::Y => g.symbol("y"),
-        Recipe::Const(c) => g.constant(*c),
-        Recipe::Add(a, b) => {
-            let (a, b) = (build(g, a), build(g, b));
-            g.add(a, b)
-        }
-        Recipe::Sub(a, b) => {
-            let (a, b) = (build(g, a), build(g, b));
-            g.sub(a, b)
-        }
-        Recipe::Mul(a, b) => {
-            let (a, b) = (build(g, a), build(g, b));
-            g.mul(a, b)
-        }
-        Recipe::DivSafe(a, b) => {
-            let (a, b) = (build(g, a), build(g, b));
-            let d = sq1(g, b);
-            g.div(a, d)
-        }
-        Recipe::Powi(a, n) if *n >= 0 => {
-            let a = build(g, a);
-            g.powi(a, *n)
-        }
-        Recipe::Powi(a, n) => {
-            let a = build(g, a);
-            let d = sq1(g, a);
-            g.powi(d, *n)
-        }
-        Recipe::SqrtSafe(a) => {
-            let a = build(g, a);
-            let d = sq1(g, a);
-            g.sqrt(d)
-        }
-        Recipe::ExpTanh(a) => {
-            let a = build(g, a);
-            let t = g.tanh(a);
-            g.exp(t)
-        }
-        Recipe::LnSafe(a) => {
-            let a = build(g, a);
-            let d = sq1(g, a);
-            g.ln(d)
-        }
-        Recipe::PowReal(a, p) => {
-            let a = build(g, a);
-            let d = sq1(g, a);
-            let p = g.constant(*p);
-            g.pow(d, p)
-        }
-        Recipe::CothSafe(a) => {
-            let a = build(g, a);
-            let d = sq1(g, a);
-            g.coth(d)
-        }
+        Recipe::X => s.symbol("x"),
+        Recipe::Y => s.symbol("y"),
+        Recipe::Const(c) => s.constant(*c),
+        Recipe::Add(x, y) => b(x) + b(y),
+        Recipe::Sub(x, y) => b(x) - b(y),
+        Recipe::Mul(x, y) => b(x) * b(y),
+        Recipe::DivSafe(x, y) => b(x) / sq1(y),
+        Recipe::Powi(a, n) if *n >= 0 => b(a).powi(*n),
+        Recipe::Powi(a, n) => sq1(a).powi(*n),
+        Recipe::SqrtSafe(a) => sq1(a).sqrt(),
+        Recipe::ExpTanh(a) => b(a).tanh().exp(),
+        Recipe::LnSafe(a) => sq1(a).ln(),
+        Recipe::PowReal(a, p) => sq1(a).pow(*p),
+        Recipe::CothSafe(a) => sq1(a).coth(),
     }
 }
 
@@ -177,6 +139,20 @@ proptest! {
         let tape = eval_tape(&g, e, x, y);
         prop_assert!(close(tree, direct, 1e-9, 1e-12), "tree {tree} vs direct {direct}: {}", g.display(e));
         prop_assert!(close(tape, direct, 1e-9, 1e-12), "tape {tape} vs direct {direct}");
+    }
+
+    /// The printed text of an expression and of its derivative parses back
+    /// to the same node.
+    #[test]
+    fn printed_text_parses_back_to_the_same_node(r in recipe()) {
+        let mut g = Graph::new();
+        let e = build(&mut g, &r);
+        let x = g.symbol("x");
+        let d = g.diff(e, x);
+        for node in [e, d] {
+            let text = g.display(node);
+            prop_assert_eq!(g.parse(&text, &[]), Ok(node), "{}", text);
+        }
     }
 
     /// ∂/∂x and ∂/∂y against central differences of the direct evaluation.
