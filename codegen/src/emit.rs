@@ -2,6 +2,7 @@
 
 use std::collections::{HashMap, HashSet};
 
+use designer::description::schema;
 use designer::model::Model;
 use designer::sym::{Graph, Id};
 use proc_macro2::TokenStream;
@@ -107,7 +108,7 @@ pub fn params_macro(model: &Model) -> Result<String, EmitError> {
         if seen.contains(&cname) {
             return Err(EmitError::DuplicateName(cname));
         }
-        match doc {
+        match doc.map(str::to_owned).or_else(|| schema_doc(name)) {
             Some(doc) => body.push_str(&format!("        /// {doc}\n")),
             None if cname != name => body.push_str(&format!("        /// `{name}`\n")),
             None => {}
@@ -121,6 +122,17 @@ pub fn params_macro(model: &Model) -> Result<String, EmitError> {
          macro_rules! params {{\n    ($f:ident) => {{\n{body}    }};\n}}\n",
         d.name
     ))
+}
+
+/// The doc of a parameter const from the description schema: its TOML
+/// key, symbol, unit and meaning (`coil.resistance: R [Ω], coil resistance`).
+fn schema_doc(symbol: &str) -> Option<String> {
+    let key = schema::by_symbol(symbol)?;
+    let unit = match key.unit {
+        "-" | "" => String::new(),
+        u => format!(" [{u}]"),
+    };
+    Some(format!("`{}`: `{symbol}`{unit}, {}", key.path, key.meaning))
 }
 
 /// parameter symbol → const name; checks symbols and uniqueness.

@@ -7,28 +7,31 @@
 /// each float module as `params!(f64)` / `params!(f32)`.
 macro_rules! params {
     ($f:ident) => {
-        /// `k_gap`
+        /// `gap.slope`: `k_gap` [H⁻¹/m], R_gap = offset + slope·z
         pub const K_GAP: $f = 27000000000.0;
-        /// `R_gap0`
+        /// `gap.offset`: `R_gap0` [H⁻¹], R_gap at z = 0
         pub const R_GAP0: $f = 0.0;
-        /// `R_core0`
+        /// `core.r0`: `R_core0` [H⁻¹], core reluctance at φ = 0
         pub const R_CORE0: $f = 3250000.0;
-        /// `phi_sat`
+        /// `core.phi_sat`: `phi_sat` [Wb], saturation flux: R_core = r0 / (1 − |φ|/phi_sat) (Fröhlich–Kennelly)
         pub const PHI_SAT: $f = 2e-5;
+        /// `coil.turns`: `N` [turns], number of turns
         pub const N: $f = 1200.0;
+        /// `coil.resistance`: `R` [Ω], coil resistance
         pub const R: $f = 75.0;
-        /// `k_e`
+        /// `coil.eddy`: `k_e` [A/V], eddy-current constant: i_ec = −k_e·dφ/dt (0 = none)
         pub const K_E: $f = 0.0;
-        /// `m`
+        /// `mechanics.mass`: `m` [kg], moving mass
         pub const M: $f = 0.0016;
-        /// `k_s`
+        /// `mechanics.stiffness`: `k_s` [N/m], spring stiffness: passive force F(z, v) = k_s·z + c·v + F0
         pub const K_S: $f = 37.0;
-        /// `c`
+        /// `mechanics.damping`: `c` [N·s/m], viscous damping c
         pub const C: $f = 0.4;
+        /// `mechanics.preload`: `F0` [N], F0 of the passive force
         pub const F0: $f = -0.8325;
-        /// `z_min`
+        /// `mechanics.z_min`: `z_min` [m], the closed stop (z is the gap length; the force pulls towards z_min)
         pub const Z_MIN: $f = 0.0;
-        /// `z_max`
+        /// `mechanics.z_max`: `z_max` [m], the open stop
         pub const Z_MAX: $f = 0.0009;
     };
 }
