@@ -33,7 +33,7 @@
 //!   current and r̂ random-walks away (by up to 30 Ω over 300 noisy cycles of
 //!   the semera valve in f32). Correcting the l block, where the cancellation
 //!   happens, is enough: the f32 r̂ then stays within 3e-4 Ω of f64 on those
-//!   300 cycles (1e-4 relative on a relay-like record with Table V's
+//!   300 cycles (1e-4 relative on a relay-like record with [SE Table V]'s
 //!   parameters), as does the full Joseph form, at 8 more multiplications
 //!   instead of 15;
 //! - the confidence-interval detector: the a posteriori r and l are the
@@ -70,7 +70,7 @@ use crate::linalg::Scalar;
 use crate::math::Real;
 
 /// What [`Semera::new`] needs: the description's `[observer]` σ_v, σ_i, Δ,
-/// the coil's N and `[observer.semera]` (semera Table II / V), by TOML key.
+/// the coil's N and `[observer.semera]` ([SE Table II] / [SE Table V]), by TOML key.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Settings<T> {
     /// `observer.sample_period`: Δ [s].

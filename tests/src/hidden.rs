@@ -232,7 +232,7 @@ pub struct Noise {
 }
 
 impl Default for Noise {
-    /// σ_v = 15 mV, σ_i = 1 mA (semera paper, Table II), σ_z = 1 µm.
+    /// σ_v = 15 mV, σ_i = 1 mA (semera paper, [SE Table II]), σ_z = 1 µm.
     fn default() -> Self {
         Noise {
             voltage: 15e-3,

@@ -243,8 +243,8 @@ pub struct Observer {
     pub kalman: Option<KalmanSection>,
 }
 
-/// `[observer.semera]`: the filter parameters of semera Table II (valve) /
-/// Table V (relay), besides σ_v, σ_i and Δ of `[observer]`.
+/// `[observer.semera]`: the filter parameters of [SE Table II] (valve) /
+/// [SE Table V] (relay), besides σ_v, σ_i and Δ of `[observer]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SemeraSettings {
     /// r̄₀ [Ω] (> 0): expected initial resistance, [SE 25].

@@ -434,7 +434,7 @@ fn parse_observer(s: &Sect, supply: &Supply, core_sect: &Sect, core: &Core) -> R
     })
 }
 
-/// `[observer.semera]`: semera Table II / Table V.
+/// `[observer.semera]`: [SE Table II] / [SE Table V].
 fn parse_semera(s: &Sect) -> Res<SemeraSettings> {
     s.check_keys(None, "in [observer.semera]")?;
     Ok(SemeraSettings {

@@ -114,7 +114,7 @@ impl Observability {
 /// four currents lie outside ±n_σ·σ_i and |det O_[k,k+2]| exceeds n_σ times
 /// its noise standard deviation ([`noise_std`]).
 ///
-/// With σ_i = 1 mA and Δ = 50 µs (semera Table II), a 4-sample window sees
+/// With σ_i = 1 mA and Δ = 50 µs ([SE Table II]), a 4-sample window sees
 /// only the fastest transients above the noise; the rise of the current after
 /// a voltage step becomes visible at S ≈ 4 (200 µs), while a steady current
 /// stays blind at any S, as it should.

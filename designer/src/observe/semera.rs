@@ -27,7 +27,7 @@ pub struct SemeraConfig {
     pub current_noise: f64,
     /// N, the coil's turns (for φ = λ/N and R = N²/l).
     pub turns: f64,
-    /// Table II / V.
+    /// [SE Table II] / [SE Table V].
     pub filter: SemeraSettings,
 }
 
