@@ -1,11 +1,11 @@
 //! `reldesign fit MODEL.toml DATA.csv --param PATH[=LO:HI] …`: fits
 //! parameters of a description to a bench recording by replaying its
-//! voltage (jiles-atherton-actuator-model (80)); prints the fitted values,
-//! the |φ̇|-weighted errors (81) before and after, and which parameter
+//! voltage (jiles-atherton-actuator-model [JA 80]); prints the fitted values,
+//! the |φ̇|-weighted errors [JA 81] before and after, and which parameter
 //! combinations the data cannot separate.
 //!
 //! `reldesign fit MODEL.toml TABLE.csv --gap mclyman-fit|mclyman`: fits the
-//! gap model to a reluctance table (columns `z,r[,r_prime]`), (75)–(77).
+//! gap model to a reluctance table (columns `z,r[,r_prime]`), [JA 75–77].
 //!
 //! `--out` writes the description with the fitted values (comments and
 //! design sections kept, atomically); `--json` prints one JSON object.

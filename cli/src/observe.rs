@@ -1,11 +1,11 @@
 //! `reldesign observe MODEL.toml DATA.csv [--out OUT.csv] [--stride S]`: runs
 //! the description's model-free estimators (`[observer].estimators`:
-//! "semera", Algorithm 1, and/or "integral", Algorithm 2 of
+//! "semera", [SE Alg. 1], and/or "integral", [SE Alg. 2] of
 //! semera-electromagnetic-estimation) over a recording in the measured-data
 //! format (columns `t`, `v`, `i`; uniform sampling at `observer.sample_period`
 //! within 1 %), writes per sample `t` and, per estimator, r̂, l̂, λ̂, φ̂ and the
 //! CI detector's verdict, and reports where the recording is unobservable by
-//! the determinant (32) (`designer::observe::observability`).
+//! the determinant [SE 32] (`designer::observe::observability`).
 //!
 //! The CSV goes to `--out` (written atomically) or to stdout; the report goes
 //! to stdout with `--out`, else to stderr. On any error nothing is written.
@@ -31,7 +31,7 @@ pub struct Args {
     /// Output CSV (written atomically); stdout when absent
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Observability test (32) on every S-th sample (time scale S·Δ); 1 is the window of (31)
+    /// Observability test [SE 32] on every S-th sample (time scale S·Δ); 1 is the window of [SE 31]
     #[arg(long, default_value_t = 1)]
     stride: usize,
 }

@@ -1,5 +1,5 @@
 //! The perfect-tracking soft-landing controller as emitted Rust
-//! (perfect-tracking-soft-landing §3.2 and §4): a rendering of
+//! (perfect-tracking-soft-landing [PT §3.2] and [PT §4]): a rendering of
 //! `designer::design::ControllerDesign`, one module per float type
 //! (`pub mod f64 { … }` / `pub mod f32 { … }`) holding
 //!
@@ -10,13 +10,13 @@
 //!   landed band, press, creep);
 //! - the reference tables, one `[[f; 7]; N]` per operation, one row
 //!   `[t_k, z_k, v_k, c0, c1, c2, c3]` per line (`designer::design::Segments`);
-//! - the law (50): `law_terms` through the expression emitter, `law` and the
+//! - the law [PT 50]: `law_terms` through the expression emitter, `law` and the
 //!   guarded, saturated `guarded_law`;
 //! - `Operation`, `Design` (the runtime's `control::Law` over the consts,
 //!   tables and law) and `Controller = control::SoftLanding<Design, f…>`.
 //!
 //! The operation logic (pre-movement, table lookup, press and creep, the
-//! hold rules (43), the guard at φ → 0, saturation) is not emitted: it is
+//! hold rules [SM 43], the guard at φ → 0, saturation) is not emitted: it is
 //! `reldesign_runtime::control`, written once; its module docs state the
 //! rules. The emitted code has no `unwrap`, `expect`, indexing, `panic`,
 //! `as` or allocation, and depends only on `reldesign_runtime`.
@@ -121,16 +121,16 @@ struct LawSymbols {
     gains: [Id; 3],
     /// Symbols standing for the outputs ξ₃, L_f³h, β, w.
     staged: [Id; 4],
-    /// (41) ξ₃ = L_f²h, (31) L_f³h, (32) β: the linearization's expressions
+    /// [PT 41] ξ₃ = L_f²h, [PT 31] L_f³h, [PT 32] β: the linearization's expressions
     /// with common factors pulled out of their sums (`Graph::factor_sums`).
     xi3: Id,
     lf3h: Id,
     beta: Id,
-    /// (32) α = −L_f³h·β
+    /// [PT 32] α = −L_f³h·β
     alpha: Id,
-    /// (48) w = K·(ξ_r − T(x)) + j_r
+    /// [PT 48] w = K·(ξ_r − T(x)) + j_r
     w: Id,
-    /// (50) u = α + β·w = β·(w − L_f³h)
+    /// [PT 50] u = α + β·w = β·(w − L_f³h)
     u: Id,
     /// The model's named subexpressions (`Model::named`), factored like the law.
     named: Vec<(&'static str, Id)>,
@@ -171,7 +171,7 @@ impl LawSymbols {
         ];
         let [xi3, lf3h, beta, w_sym] = staged;
         let lin = &design.linearization;
-        // (41) T(x) = [z, v, ξ₃]
+        // [PT 41] T(x) = [z, v, ξ₃]
         let transform = [lin.transform[0], lin.transform[1], xi3];
         let mut terms = Vec::new();
         for i in 0..3 {
@@ -216,7 +216,7 @@ impl LawSymbols {
 /// (output, equation) of the `//` comments above the outputs' `let`s.
 type Comments = Vec<(&'static str, &'static str)>;
 
-/// `law_terms`, the law (50) through the expression emitter, inlined into
+/// `law_terms`, the law [PT 50] through the expression emitter, inlined into
 /// every caller (one call, no stored outputs).
 fn law_terms(
     graph: &Graph,
@@ -441,16 +441,16 @@ fn float_module(
 
             #law_fn
 
-            /// u of the tracking law (50), not saturated and not guarded.
+            /// u of the tracking law [PT 50], not saturated and not guarded.
             #[must_use]
             pub fn law(#law_args) -> #ty {
                 law_terms(z, v, phi, zr, vr, ar, jr).u
             }
 
-            /// The law (50) as applied (`reldesign_runtime::control::guarded_law`): if
+            /// The law [PT 50] as applied (`reldesign_runtime::control::guarded_law`): if
             /// φ ≤ `PHI_GUARD` (φ → 0, where β = 1/L_g L_f²h blows up and D₀⁺ is left) it
             /// is not evaluated and u = u_max drives the flux back into D₀⁺; otherwise u
-            /// of (50). Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
+            /// of [PT 50]. Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
             /// ±∞ to the bounds).
             #[must_use]
             pub fn guarded_law(#law_args) -> #ty {
@@ -463,7 +463,7 @@ fn float_module(
                 #variants
             }
 
-            /// This module's design (limits, timing, guards, tables, the law (50)) as the
+            /// This module's design (limits, timing, guards, tables, the law [PT 50]) as the
             /// runtime's soft-landing logic reads it.
             #[derive(Clone, Copy, Debug, PartialEq, Eq)]
             pub struct Design;
@@ -498,7 +498,7 @@ fn float_module(
             /// One operation of the actuator (`reldesign_runtime::control::SoftLanding`):
             /// pre-movement stage before t₀ (ξ_r = [z₀, 0, 0], which brings ξ₃ to 0 so the
             /// forces balance at takeoff), tracking of the table on [t₀, t_f], hold at z_f
-            /// after t_f with the expert rules of model-free-sliding-mode (43) at the end
+            /// after t_f with the expert rules of model-free-sliding-mode [SM 43] at the end
             /// stop; `new`, `start`, `reference`, `step`. Allocation- and panic-free.
             pub type Controller = control::SoftLanding<Design, #ty>;
         }

@@ -1,6 +1,6 @@
 //! The model-free estimators of semera-electromagnetic-estimation as emitted
-//! Rust: settings only. The algorithms (SEMERA, Algorithm 1; the integral
-//! estimator, Algorithm 2) are `reldesign_runtime::{semera, integral}`,
+//! Rust: settings only. The algorithms (SEMERA, [SE Alg. 1]; the integral
+//! estimator, [SE Alg. 2]) are `reldesign_runtime::{semera, integral}`,
 //! generic over the float; [`emit_semera`] writes what a description adds:
 //!
 //! - `macro_rules! settings`: the `[observer]`, `[observer.semera]` and

@@ -10,7 +10,7 @@
 //!
 //! - [`edges`] finds the steps and a first τ from the current, which changes
 //!   slope at τ (and jumps there by k_e·Δv/(N² + R·k_e) with eddy currents,
-//!   JA model eq. 41): cubics through the samples before and after meet at
+//!   [JA 41]): cubics through the samples before and after meet at
 //!   τ; where they are too noisy to place τ within 0.14 sample (RMS), or do
 //!   not meet inside the interval, the midpoint stays.
 //! - [`located`] refines τ with a reference model, edge after edge: the
@@ -87,7 +87,7 @@ impl CurrentJump {
         eddy: 0.0,
     };
 
-    /// Δi/Δv at time t: k_e/(N² + R(t)·k_e) (JA model eq. 41).
+    /// Δi/Δv at time t: k_e/(N² + R(t)·k_e) ([JA 41]).
     fn gain(&self, t: f64) -> f64 {
         let r = self.resistance + self.resistance_drift * t;
         let gain = self.eddy / (self.turns * self.turns + r * self.eddy);

@@ -1,5 +1,5 @@
-//! The electromagnetic fit of jiles-atherton-actuator-model §5.2: parameters
-//! of a description chosen to minimise (80),
+//! The electromagnetic fit of jiles-atherton-actuator-model [JA §5.2]: parameters
+//! of a description chosen to minimise [JA 80],
 //!
 //! ```text
 //! wNRMSE²(i) + wNRMSE²(φ) [+ NRMSE²(z)]
@@ -57,7 +57,7 @@ pub struct FitOptions {
     pub starts: usize,
     /// Levenberg–Marquardt iterations per start.
     pub max_iterations: usize,
-    /// Include the flux term of (80).
+    /// Include the flux term of [JA 80].
     pub use_flux: bool,
     /// Include NRMSE²(z) when the data has a `z` column.
     pub use_position: bool,
@@ -112,7 +112,7 @@ pub struct FitProgress {
     pub start: usize,
     pub starts: usize,
     pub iteration: usize,
-    /// The objective (80) at the current iterate.
+    /// The objective [JA 80] at the current iterate.
     pub objective: f64,
 }
 
@@ -122,13 +122,13 @@ pub struct FitReport {
     pub description: Description,
     /// (path, fitted value), in the order of the fitted parameters.
     pub values: Vec<(String, f64)>,
-    /// (81) for the current, after the fit.
+    /// [JA 81] for the current, after the fit.
     pub wnrmse_current: f64,
-    /// (81) for the flux, after the fit (when a flux reference exists).
+    /// [JA 81] for the flux, after the fit (when a flux reference exists).
     pub wnrmse_flux: Option<f64>,
     /// RMS position error over the stroke (when the data has `z`).
     pub nrmse_position: Option<f64>,
-    /// The objective (80) minimised: the sum of the squared errors used.
+    /// The objective [JA 80] minimised: the sum of the squared errors used.
     pub cost: f64,
     /// Solver iterations, all starts.
     pub iterations: usize,
@@ -191,7 +191,7 @@ pub enum FitError {
     Solver { file: String, message: String },
 }
 
-/// (81) of the current for one replay of `d` (the diagnose baseline).
+/// [JA 81] of the current for one replay of `d` (the diagnose baseline).
 pub fn current_wnrmse(d: &Description, data: &Measured) -> Result<f64, FitError> {
     let out = simulate_outputs(d, data)?;
     let w = flux_rate_weights(data, d.coil.turns, d.coil.resistance);
@@ -270,7 +270,7 @@ fn replay(d: &Description, data: &Measured, budget: &Budget) -> Result<Replay, F
     })
 }
 
-/// The measured references of (80) and their weights.
+/// The measured references of [JA 80] and their weights.
 struct Objective<'a> {
     data: &'a Measured,
     weights: Vec<f64>,
@@ -350,7 +350,7 @@ impl<'a> Objective<'a> {
         (norm > 0.0).then_some((phi, norm))
     }
 
-    /// Residuals √w·(sim − exp)/norm: ‖r‖² is the objective (80).
+    /// Residuals √w·(sim − exp)/norm: ‖r‖² is the objective [JA 80].
     fn residuals(&self, d: &Description) -> Result<Vec<f64>, FitError> {
         Ok(self.residuals_of(d, &simulate_with(d, self.data, &self.budget)?))
     }
@@ -603,7 +603,7 @@ pub fn sensitivity_at(
     ))
 }
 
-/// The residuals of (80) and their Jacobian ∂r/∂θ (forward differences)
+/// The residuals of [JA 80] and their Jacobian ∂r/∂θ (forward differences)
 /// at the description's values of `params` (no fit).
 pub fn linearisation(
     description: &Description,
@@ -638,7 +638,7 @@ fn linearised(
     })
 }
 
-/// The residuals of (80) at the description's values of `params`.
+/// The residuals of [JA 80] at the description's values of `params`.
 pub fn residuals_at(
     description: &Description,
     data: &Measured,
@@ -654,7 +654,7 @@ pub fn residuals_at(
         })
 }
 
-/// The checked start values, the objective (80) and the box of one fit.
+/// The checked start values, the objective [JA 80] and the box of one fit.
 struct Setup<'a> {
     x0: Vec<f64>,
     objective: Objective<'a>,
@@ -675,7 +675,7 @@ impl<'a> Setup<'a> {
         })
     }
 
-    /// The residuals of (80) at θ (none: invalid values or a failed replay).
+    /// The residuals of [JA 80] at θ (none: invalid values or a failed replay).
     fn residuals(
         &self,
         description: &Description,

@@ -1,10 +1,10 @@
 //! The gap model fitted to a reluctance table (z, R_gap[, R_gap']), as in
-//! jiles-atherton-actuator-model §5.1: minimise (76)
-//! NRMSE²(R_gap) + NRMSE²(R_gap'), each normalised as (77).
+//! jiles-atherton-actuator-model [JA §5.1]: minimise [JA 76]
+//! NRMSE²(R_gap) + NRMSE²(R_gap'), each normalised as [JA 77].
 //!
-//! Both analytic models have the form (11), R_gap = r0 + r0'·z/D(z) with
-//! D = 1 + k1·z·ln(k2/z) and (13) R_gap' = r0'·(1 + k1·z)/D²:
-//! `mclyman-fit` fits (r0, r0', k1, k2) directly; `mclyman` is (11) with
+//! Both analytic models have the form [JA 11], R_gap = r0 + r0'·z/D(z) with
+//! D = 1 + k1·z·ln(k2/z) and [JA 13] R_gap' = r0'·(1 + k1·z)/D²:
+//! `mclyman-fit` fits (r0, r0', k1, k2) directly; `mclyman` is [JA 11] with
 //! r0 = 0, r0' = 1/(μ0·A), k1 = 1/√A, k2 = 2·l_w and fits (A, l_w). The
 //! logarithm is regularised as the model's (`ln(k/(z + Z_EPS))`, see
 //! `model/gap.rs`); its derivative is then (1 + k1·z)/D² up to terms of
@@ -50,7 +50,7 @@ pub enum GapFitError {
     Solver { file: String, message: String },
 }
 
-/// The fitted gap and its errors (77).
+/// The fitted gap and its errors [JA 77].
 #[derive(Debug, Clone, PartialEq)]
 pub struct GapFit {
     pub gap: Gap,
@@ -106,7 +106,7 @@ impl GapTable {
     }
 }
 
-/// (11) and (13) with the regularised logarithm: (R_gap, R_gap').
+/// [JA 11] and [JA 13] with the regularised logarithm: (R_gap, R_gap').
 pub fn reluctance_and_slope(theta: [f64; 4], z: f64) -> (f64, f64) {
     let [r0, r0p, k1, k2] = theta;
     let ze = z + Z_EPS;
@@ -117,7 +117,7 @@ pub fn reluctance_and_slope(theta: [f64; 4], z: f64) -> (f64, f64) {
     (r0 + r0p * z / den, r0p * (den - z * dden) / (den * den))
 }
 
-/// The (11) parameters of a McLyman gap (A, l_w).
+/// The [JA 11] parameters of a McLyman gap (A, l_w).
 fn mclyman_theta(area: f64, winding_length: f64) -> [f64; 4] {
     [
         0.0,
@@ -127,14 +127,14 @@ fn mclyman_theta(area: f64, winding_length: f64) -> [f64; 4] {
     ]
 }
 
-/// √(Σ (sim − exp)²/Σ exp²), (77).
+/// √(Σ (sim − exp)²/Σ exp²), [JA 77].
 fn nrmse(sim: &[f64], exp: &[f64]) -> f64 {
     let num: f64 = sim.iter().zip(exp).map(|(s, e)| (s - e).powi(2)).sum();
     let den: f64 = exp.iter().map(|e| e * e).sum();
     (num / den).sqrt()
 }
 
-/// Fits `model` to `table` by minimising (76).
+/// Fits `model` to `table` by minimising [JA 76].
 pub fn fit_gap(table: &GapTable, model: GapModel) -> Result<GapFit, GapFitError> {
     let norm_r = table.r.iter().map(|r| r * r).sum::<f64>().sqrt();
     if !(norm_r > 0.0) {
@@ -151,7 +151,7 @@ pub fn fit_gap(table: &GapTable, model: GapModel) -> Result<GapFit, GapFitError>
         GapModel::McLymanFit => [x[0], x[1], x[2], x[3]],
         GapModel::McLyman => mclyman_theta(x[0], x[1]),
     };
-    // Residuals (R − R_exp)/‖R_exp‖ and (R' − R'_exp)/‖R'_exp‖: ‖r‖² is (76).
+    // Residuals (R − R_exp)/‖R_exp‖ and (R' − R'_exp)/‖R'_exp‖: ‖r‖² is [JA 76].
     let residual = |x: &[f64]| {
         let theta = to_theta(x);
         let mut r = Vec::with_capacity(2 * table.z.len());
@@ -288,7 +288,7 @@ mod tests {
                 "z = {z}: {slope} vs {fd}"
             );
         }
-        // (14): the limits at z → 0⁺.
+        // [JA 14]: the limits at z → 0⁺.
         let (r, rp) = reluctance_and_slope(theta, 0.0);
         assert_eq!(r, theta[0]);
         assert!((rp - theta[1]).abs() < 1e-12 * theta[1]);

@@ -9,9 +9,9 @@
 //! residual scale σ = ‖r‖/√(n − p) makes its standard error σ/s_k exceed
 //! [`WEAK_STD`] (a combination known only to ±10 %).
 //!
-//! **Reduced model.** jiles-atherton-actuator-model §4.1 shows that ten
+//! **Reduced model.** jiles-atherton-actuator-model [JA §4.1] shows that ten
 //! parameters of the full electromagnetic model enter the electrical
-//! behaviour only through seven auxiliary ones, (55), (57), (60):
+//! behaviour only through seven auxiliary ones, [JA 55], [JA 57], [JA 60]:
 //! k_e* = k_e/N², R*_g0 = (R_g0 + l_c/(μ0·A_c))/N², R'*_g0 = R'_g0/N²,
 //! M*_sat = M_sat·l_c/N, b* = b·N·A_c, κ* = κ·N·A_c,
 //! α* = (1 − α)·N²·A_c/l_c (with R, c, k_1, k_2 unchanged). Descriptions
@@ -176,38 +176,38 @@ impl fmt::Display for Sensitivity {
     }
 }
 
-/// The reduced model's parameters (55), (57), (60), plus those the
+/// The reduced model's parameters [JA 55], [JA 57], [JA 60], plus those the
 /// reduction keeps (R, c, k_1, k_2).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReducedParameters {
     pub resistance: f64,
-    /// (55) k_e* = k_e/N²
+    /// [JA 55] k_e* = k_e/N²
     pub k_e: f64,
-    /// (57) R*_g0 = (R_g0 + l_c/(μ0·A_c))/N²
+    /// [JA 57] R*_g0 = (R_g0 + l_c/(μ0·A_c))/N²
     pub r_g0: f64,
-    /// (57) R'*_g0 = R'_g0/N²
+    /// [JA 57] R'*_g0 = R'_g0/N²
     pub r_g0_prime: f64,
     pub k1: f64,
     pub k2: f64,
-    /// (60) M*_sat = M_sat·l_c/N
+    /// [JA 60] M*_sat = M_sat·l_c/N
     pub m_sat: f64,
-    /// (60) b* = b·N·A_c
+    /// [JA 60] b* = b·N·A_c
     pub b: f64,
     pub c: f64,
-    /// (60) κ* = κ·N·A_c
+    /// [JA 60] κ* = κ·N·A_c
     pub kappa: f64,
-    /// (60) α* = (1 − α)·N²·A_c/l_c
+    /// [JA 60] α* = (1 − α)·N²·A_c/l_c
     pub alpha: f64,
 }
 
 /// The reduced parameters of a Jiles–Atherton description with an analytic
-/// gap (`mclyman-fit`, `mclyman` or `linear`, all of the form (11)); `None`
+/// gap (`mclyman-fit`, `mclyman` or `linear`, all of the form [JA 11]); `None`
 /// otherwise.
 pub fn reduced_parameters(d: &Description) -> Option<ReducedParameters> {
     let Core::JilesAtherton(ja) = &d.core else {
         return None;
     };
-    // (11): R_g = R_g0 + R'_g0·z/(1 + k1·z·ln(k2/z)).
+    // [JA 11]: R_g = R_g0 + R'_g0·z/(1 + k1·z·ln(k2/z)).
     let (r0, r0_prime, k1, k2) = match d.gap {
         Gap::McLymanFit {
             r0,

@@ -1,6 +1,6 @@
 //! The path back from data: identification (`reldesign fit`: parameters of
 //! a description fitted to a bench recording, jiles-atherton-actuator-model
-//! §4–5), diagnosis (`reldesign diagnose`: what a model gets wrong on
+//! [JA §4–5]), diagnosis (`reldesign diagnose`: what a model gets wrong on
 //! measured data, and why) and the TOML editor that writes results back.
 //!
 //! Its own crate so that what a firmware crate's build script pulls in (the
@@ -8,18 +8,18 @@
 //! toml_edit live here.
 //!
 //! - [`measured`]: the recording (t, v, i and optional z, φ, λ).
-//! - [`weighted`]: the |φ̇|-weighted NRMSE (81), its weights and the flux
+//! - [`weighted`]: the |φ̇|-weighted NRMSE [JA 81], its weights and the flux
 //!   estimated from the data.
 //! - [`params`]: description parameters addressed by TOML key path.
 //! - [`lm`]: a bounded Levenberg–Marquardt least-squares solver.
 //! - [`edges`]: where inside its sample interval each voltage step fell
 //!   (the replays' input).
-//! - [`em_fit`]: the fit of (80) by replaying the measured voltage.
+//! - [`em_fit`]: the fit of [JA 80] by replaying the measured voltage.
 //! - [`sensitivity`]: forward parameter sensitivities of a replay (the
 //!   fit's analytic Jacobian).
 //! - [`identifiability`]: what the data can and cannot separate (SVD of the
-//!   scaled Jacobian), and the reduced model's parameters (55), (57), (60).
-//! - [`gap_fit`]: the gap model fitted to a reluctance table (75)–(77).
+//!   scaled Jacobian), and the reduced model's parameters [JA 55], [JA 57], [JA 60].
+//! - [`gap_fit`]: the gap model fitted to a reluctance table [JA 75–77].
 //! - [`diagnose`]: the diagnosis of a recording against a description.
 //! - [`edit`]: physics written back over the original TOML text, comments kept.
 

@@ -1,5 +1,5 @@
 //! The |φ̇|-weighted normalised RMS error of jiles-atherton-actuator-model
-//! (81), its weights estimated from the data, and the flux estimated from the
+//! [JA 81], its weights estimated from the data, and the flux estimated from the
 //! electrical signals when the recording has no flux column.
 //!
 //! **Weights.** |φ̇| comes from the measured flux (`phi`, or `lambda`/N) by a
@@ -15,7 +15,7 @@ use super::measured::Measured;
 /// Half-width m of the smoothing window (2·m + 1 samples).
 pub const SMOOTH_HALF_WIDTH: usize = 2;
 
-/// (81) wNRMSE = √(Σ w·(sim − exp)² / Σ w·exp²).
+/// [JA 81] wNRMSE = √(Σ w·(sim − exp)² / Σ w·exp²).
 ///
 /// A reference that is zero wherever the weight is non-zero has no scale:
 /// the result is then 0 for a perfect match and +∞ otherwise.

@@ -1,11 +1,11 @@
 //! The soft-landing controller's operation logic, written once for every
-//! design and both floats (perfect-tracking-soft-landing §3.2 and §4).
+//! design and both floats (perfect-tracking-soft-landing [PT §3.2] and [PT §4]).
 //!
-//! Generated code holds the model: the tracking law (50) ([`Law::law`]), the
+//! Generated code holds the model: the tracking law [PT 50] ([`Law::law`]), the
 //! design values ([`Settings`]) and one reference table per operation
 //! ([`Motion`]). [`SoftLanding`] runs one operation over them:
 //!
-//! - before t₀ (pre-movement stage, §4): ξ_r = [z₀, 0, 0], j_r = 0, so the law
+//! - before t₀ (pre-movement stage, [PT §4]): ξ_r = [z₀, 0, 0], j_r = 0, so the law
 //!   brings ξ₃ = a(x) to 0, i.e. the forces into balance at takeoff;
 //! - on [t₀, t_f]: ξ_r, j_r from the table ([`eval_segment`]), the segment
 //!   cursor advanced monotonically (lookup with `.get()`);
@@ -14,7 +14,7 @@
 //!   `creep_max`, so the loop closes whatever gap the tracking error left and
 //!   still lands where the plant differs from the model; once the armature is
 //!   at its end stop (within `landed_band`: contact, not proximity) the expert
-//!   rules of model-free-sliding-mode-soft-landing (43) apply: closing →
+//!   rules of model-free-sliding-mode-soft-landing [SM 43] apply: closing →
 //!   u = u_max·sgn φ (holds it closed; sgn 0 taken as +1, a NaN φ gives 0),
 //!   opening → u = 0;
 //! - guard at φ → 0: where φ ≤ `phi_guard` the law is not evaluated and
@@ -35,7 +35,7 @@ use crate::linalg::Scalar;
 /// τ = t − t_k, v and z its integrals from v_k and z_k.
 pub type Row<T> = [T; 7];
 
-/// Which end stop an operation lands on, which decides its hold rule (43).
+/// Which end stop an operation lands on, which decides its hold rule [SM 43].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Landing {
     /// Closing, z_max → z_min: at the stop u = u_max·sgn φ holds it closed.
@@ -44,7 +44,7 @@ pub enum Landing {
     Opening,
 }
 
-/// One designed operation (51): the reference on [t₀, t_f] and its rest positions.
+/// One designed operation [PT 51]: the reference on [t₀, t_f] and its rest positions.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Motion<T: 'static> {
     pub landing: Landing,
@@ -85,7 +85,7 @@ pub trait Law<T> {
     const SETTINGS: Settings<T>;
     /// The reference and rest positions of `operation`.
     fn motion(operation: Self::Operation) -> Motion<T>;
-    /// u of the tracking law (50) at the state x = [z, v, φ] and the reference
+    /// u of the tracking law [PT 50] at the state x = [z, v, φ] and the reference
     /// [z_r, v_r, a_r, j_r]: not guarded, not saturated.
     fn law(x: [T; 3], reference: [T; 4]) -> T;
 }
@@ -128,7 +128,7 @@ pub fn saturate<T: Scalar>(u: T, settings: &Settings<T>) -> T {
     }
 }
 
-/// The law (50) as applied: where φ ≤ `phi_guard` (φ → 0, where β = 1/L_g L_f²h
+/// The law [PT 50] as applied: where φ ≤ `phi_guard` (φ → 0, where β = 1/L_g L_f²h
 /// blows up and D₀⁺ is left) it is not evaluated and u = u_max drives the flux
 /// back into D₀⁺; otherwise [`Law::law`]. Saturated.
 #[inline]
@@ -178,7 +178,7 @@ impl<L: Law<T>, T: Scalar + From<u8> + 'static> SoftLanding<L, T> {
         self.operation
     }
 
-    /// [z_r, v_r, a_r, j_r] at `t` (51): z₀ at rest before t₀, the table on
+    /// [z_r, v_r, a_r, j_r] at `t` [PT 51]: z₀ at rest before t₀, the table on
     /// [t₀, t_f], after t_f just beyond z_f and creeping on (press, creep).
     /// Advances the segment cursor.
     pub fn reference(&mut self, t: T) -> [T; 4] {
@@ -217,7 +217,7 @@ impl<L: Law<T>, T: Scalar + From<u8> + 'static> SoftLanding<L, T> {
         }
     }
 
-    /// After t_f at the end stop: the expert rule (43), closing → u = u_max·sgn φ
+    /// After t_f at the end stop: the expert rule [SM 43], closing → u = u_max·sgn φ
     /// (sgn 0 = +1, NaN φ → 0), opening → u = 0; `None` elsewhere.
     fn hold(&self, time: T, z: T, phi: T) -> Option<T> {
         let settings = L::SETTINGS;

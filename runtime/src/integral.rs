@@ -1,16 +1,16 @@
-//! The integral estimator (semera-electromagnetic-estimation [SE] §II-D,
-//! Algorithm 2), generic over the float: the flux linkage as the running
-//! integral (46) of u − r̄·ι, reset at the start of each energizing operation,
-//! where the resistance is recomputed from the finished operation by (47);
-//! l̂ = λ̂/ι (48) under the same confidence-interval detector as SEMERA. The
+//! The integral estimator (semera-electromagnetic-estimation [SE §II-D],
+//! [SE Alg. 2]), generic over the float: the flux linkage as the running
+//! integral [SE 46] of u − r̄·ι, reset at the start of each energizing operation,
+//! where the resistance is recomputed from the finished operation by [SE 47];
+//! l̂ = λ̂/ι [SE 48] under the same confidence-interval detector as SEMERA. The
 //! emitted estimators and the designer's f64 reference are this code.
 //!
-//! Algorithm 2, one [`Integral::step`] per sample k:
+//! [SE Alg. 2], one [`Integral::step`] per sample k:
 //!
 //! - line 5: S_u += u_k, S_ι += ι_k;
 //! - line 6: λ̂_k = λ₀ + Δ·(S_u − r̄·S_ι);
 //! - lines 7–9: l̂_k = λ̂_k/ι_k if |ι_k| and |ι_{k−1}| exceed n_σ·σ_i, else l̄₀;
-//! - lines 10–11: at the start of an energizing operation, r̄ = S_u/S_ι (47)
+//! - lines 10–11: at the start of an energizing operation, r̄ = S_u/S_ι [SE 47]
 //!   and S_u = S_ι = 0;
 //! - line 12: r̂_k = r̄.
 //!
@@ -19,16 +19,16 @@
 //! - **The start of an energizing operation** is detected from the measured
 //!   voltage: it rises above `energize_threshold` between samples k − 1 and k
 //!   (u_k above, the previous finite sample not). In the backward difference
-//!   (2) u_k stands for the voltage over ((k−1)Δ, kΔ], so the operation
+//!   [SE 2] u_k stands for the voltage over ((k−1)Δ, kΔ], so the operation
 //!   started at sample k − 1, where the flux is still λ₀: that is Algorithm
 //!   2's reset sample, and the reset (lines 10–11 of k − 1) is done when the
 //!   rise is seen, before sample k is summed. Only r̂_{k−1} differs from
-//!   Algorithm 2 run with hindsight: it is reported at k. With data sampled at
+//!   [SE Alg. 2] run with hindsight: it is reported at k. With data sampled at
 //!   the instants of a step (u_k = v(kΔ), the edge sample already high) this
-//!   placement keeps (47) unbiased too and λ̂ exact after the voltage falls
+//!   placement keeps [SE 47] unbiased too and λ̂ exact after the voltage falls
 //!   (where l̂ = λ̂/ι is most sensitive); λ̂ is then one sample's u·Δ high
 //!   while the voltage is on.
-//! - **(47) needs a whole operation**: S_u/S_ι is used only when the summed
+//! - **[SE 47] needs a whole operation**: S_u/S_ι is used only when the summed
 //!   current lies outside its noise interval, S_ι > n_σ·σ_i·√m for the m
 //!   samples summed (the CI detector applied to the sum), and the quotient is
 //!   finite and positive. This skips the first reset of a record that starts
@@ -65,11 +65,11 @@ pub struct Settings<T> {
     pub current_noise: T,
     /// `coil.turns`: N, for φ = λ/N and R = N²/l.
     pub turns: T,
-    /// r̄₀ [Ω]: the resistance until the first update (47).
+    /// r̄₀ [Ω]: the resistance until the first update [SE 47].
     pub initial_resistance: T,
     /// l̄₀ [H]: the expert rule's l̂.
     pub initial_inductance: T,
-    /// λ₀ [Wb]: the flux linkage at each reset (46).
+    /// λ₀ [Wb]: the flux linkage at each reset [SE 46].
     pub initial_flux_linkage: T,
     /// n_σ: half-width of the current's noise interval in σ_i.
     pub ci_sigmas: T,
@@ -88,7 +88,7 @@ struct Constants<T> {
     l0: T,
     /// n_σ·σ_i: the CI detector's bound
     ci: T,
-    /// (n_σ·σ_i)²: (47) is used when S_ι² > (n_σ·σ_i)²·m
+    /// (n_σ·σ_i)²: [SE 47] is used when S_ι² > (n_σ·σ_i)²·m
     ci_sq: T,
     /// the energizing threshold [V]
     threshold: T,
@@ -98,7 +98,7 @@ struct Constants<T> {
     turns_sq: T,
 }
 
-/// The integral estimator (Algorithm 2).
+/// The integral estimator ([SE Alg. 2]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Integral<T> {
     c: Constants<T>,
@@ -117,7 +117,7 @@ pub struct Integral<T> {
 }
 
 impl<T: Scalar> Integral<T> {
-    /// At rest (Algorithm 2, lines 1–2): r̄ = r̄₀, S_u = S_ι = 0, ι₀ = 0.
+    /// At rest ([SE Alg. 2], lines 1–2): r̄ = r̄₀, S_u = S_ι = 0, ι₀ = 0.
     #[must_use]
     pub fn new(s: &Settings<T>) -> Self {
         let ci = s.ci_sigmas * s.current_noise;
@@ -147,9 +147,9 @@ impl<T: Scalar> Integral<T> {
     pub fn step(&mut self, v: T, i: T) -> Estimate<T> {
         let c = &self.c;
         // lines 10–11 of sample k − 1: the voltage rose between k − 1 and k, so
-        // the operation started at k − 1; reset (47) before sample k is summed
+        // the operation started at k − 1; reset [SE 47] before sample k is summed
         if v > c.threshold && self.v_prev <= c.threshold {
-            // (47) only when S_ι is more than noise: S_ι > n_σ·σ_i·√m
+            // [SE 47] only when S_ι is more than noise: S_ι > n_σ·σ_i·√m
             if self.sum_i > T::ZERO && self.sum_i * self.sum_i > c.ci_sq * self.count {
                 let r = self.sum_u / self.sum_i;
                 if r > T::ZERO && r.finite() {
@@ -167,9 +167,9 @@ impl<T: Scalar> Integral<T> {
             self.count = self.count + T::ONE;
             self.v_prev = v;
         }
-        // line 6: (46)
+        // line 6: [SE 46]
         let lambda = c.lambda0 + c.dt * (self.sum_u - self.r_bar * self.sum_i);
-        // lines 7–9: the CI detector, (48) or the expert rule
+        // lines 7–9: the CI detector, [SE 48] or the expert rule
         let valid = Real::abs(i) > c.ci && Real::abs(self.i_prev) > c.ci;
         let l = if valid { lambda / i } else { c.l0 };
         self.i_prev = i;
@@ -210,9 +210,9 @@ mod tests {
         }
     }
 
-    /// Algorithm 2 by hand (derivation in the designer's `observe_semera.rs`):
+    /// [SE Alg. 2] by hand (derivation in the designer's `observe_semera.rs`):
     /// λ̂ = 4.1, 6.1, 4.1; l̂ = 1 (ι₀ = 0), 6.1/3, 2.05; then the voltage rises
-    /// again: r̄ = 20/6 (47), reset, λ̂ = 0.1 + 0.5·(10 − 1/6), l̂ = l̄₀.
+    /// again: r̄ = 20/6 [SE 47], reset, λ̂ = 0.1 + 0.5·(10 − 1/6), l̂ = l̄₀.
     fn by_hand<T: Scalar + core::fmt::Debug>(t: fn(f64) -> T, back: fn(T) -> f64, tol: f64) {
         let close = |a: T, b: f64| (back(a) - b).abs() <= tol * b.abs().max(1.0);
         let mut g = Integral::new(&small(t));

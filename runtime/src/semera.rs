@@ -1,24 +1,24 @@
 //! SEMERA: stochastic electromagnetic estimation of the resistance r, the
 //! apparent inductance l and the flux linkage λ of a reluctance actuator from
 //! sampled coil voltage and current alone (semera-electromagnetic-estimation
-//! [SE], §II, Algorithm 1), generic over the float: the emitted estimators
+//! [SE §II], [SE Alg. 1]), generic over the float: the emitted estimators
 //! (`f32`, `f64`) and the designer's f64 reference are this code.
 //!
-//! The filter (Algorithm 1, one [`Semera::step`] per sample, every Δ):
+//! The filter ([SE Alg. 1], one [`Semera::step`] per sample, every Δ):
 //!
-//! - state x_k = [r_k, l_k, l_{k−1}] (10), observation z_k = u_k (9) with the
-//!   stochastic observation row H_k = [ι_k, ι_k/Δ, −ι_{k−1}/Δ] (11);
-//! - process model (16) with F of (21) (constant r, linear l; the prediction
-//!   (19) is garbled in the text, it reads l̂_{k+1/k} = 2·l̂_{k/k} − l̂_{k−1/k},
-//!   ERRATA), G of (23), Q = diag(σ_ṙ², σ_l̈²) (24), so
+//! - state x_k = [r_k, l_k, l_{k−1}] [SE 10], observation z_k = u_k [SE 9] with the
+//!   stochastic observation row H_k = [ι_k, ι_k/Δ, −ι_{k−1}/Δ] [SE 11];
+//! - process model [SE 16] with F of [SE 21] (constant r, linear l; the prediction
+//!   [SE 19] is garbled in the text, it reads l̂_{k+1/k} = 2·l̂_{k/k} − l̂_{k−1/k},
+//!   ERRATA), G of [SE 23], Q = diag(σ_ṙ², σ_l̈²) [SE 24], so
 //!   G·Q·Gᵀ = diag((σ_ṙ·Δ)², (σ_l̈·Δ²)², 0);
-//! - prior x̄₀ = [r̄₀, l̄₀, l̄₀] (25), P₀ of (26) with σ²_r0 in its first
+//! - prior x̄₀ = [r̄₀, l̄₀, l̄₀] [SE 25], P₀ of [SE 26] with σ²_r0 in its first
 //!   diagonal element (the text prints σ_r0, ERRATA);
-//! - the gain (43) K̂ = Σ Hᵀ (H Σ Hᵀ + σ_v²)⁻¹: the observation noise (12)–(15)
+//! - the gain [SE 43] K̂ = Σ Hᵀ (H Σ Hᵀ + σ_v²)⁻¹: the observation noise [SE 12–15]
 //!   depends on the state and on the current noise through H itself, so the
 //!   paper derives the gain from z_k = C_k x_k + v_v (only the voltage noise,
 //!   σ_v²) and evaluates it at H_k in place of the unknown C_k. The
-//!   state-dependent variance R_k of (15) therefore does not enter the step
+//!   state-dependent variance R_k of [SE 15] therefore does not enter the step
 //!   (it is [`Semera::observation_noise_variance`], a diagnostic);
 //! - Σ_{k/k} = (I − K̂ H) Σ (line 10). With g = Σ Hᵀ this is
 //!   B = Σ − K̂ gᵀ (symmetric in exact arithmetic: its upper triangle is
@@ -33,19 +33,19 @@
 //!   current and r̂ random-walks away (by up to 30 Ω over 300 noisy cycles of
 //!   the semera valve in f32). Correcting the l block, where the cancellation
 //!   happens, is enough: the f32 r̂ then stays within 3e-4 Ω of f64 on those
-//!   300 cycles (1e-4 relative on a relay-like record with Table V's
+//!   300 cycles (1e-4 relative on a relay-like record with [SE Table V]'s
 //!   parameters), as does the full Joseph form, at 8 more multiplications
 //!   instead of 15;
 //! - the confidence-interval detector: the a posteriori r and l are the
 //!   estimates only if |ι_k| and |ι_{k−1}| both lie outside [−n_σ σ_i, n_σ σ_i]
 //!   (and the sample was used, below); otherwise the expert rule
-//!   r̂_k = r̂_{k−1}, l̂_k = l̄₀ (the device at rest; lines 13–15 of Algorithm 1,
-//!   lost in the text, are read from §II-C);
-//! - λ̂_k = l̂_k·ι_k (line 16), φ̂ = λ̂/N and R̂ = N²/l̂ (§II-C, N known).
+//!   r̂_k = r̂_{k−1}, l̂_k = l̄₀ (the device at rest; lines 13–15 of [SE Alg. 1],
+//!   lost in the text, are read from [SE §II-C]);
+//! - λ̂_k = l̂_k·ι_k (line 16), φ̂ = λ̂/N and R̂ = N²/l̂ ([SE §II-C], N known).
 //!
 //! Choices the paper leaves open, made here:
 //!
-//! - Algorithm 1 registers ι₀ before its loop. [`Semera::new`] starts at rest
+//! - [SE Alg. 1] registers ι₀ before its loop. [`Semera::new`] starts at rest
 //!   with ι₀ = 0, so the first call of `step` is k = 1 (under the expert rule,
 //!   since |ι₀| is inside the interval).
 //! - A sample whose update would not be finite (a NaN or infinite v or i, or
@@ -70,28 +70,28 @@ use crate::linalg::Scalar;
 use crate::math::Real;
 
 /// What [`Semera::new`] needs: the description's `[observer]` σ_v, σ_i, Δ,
-/// the coil's N and `[observer.semera]` (semera Table II / V), by TOML key.
+/// the coil's N and `[observer.semera]` ([SE Table II] / [SE Table V]), by TOML key.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Settings<T> {
     /// `observer.sample_period`: Δ [s].
     pub sample_period: T,
-    /// `observer.voltage_noise`: σ_v [V], the gain's noise (43).
+    /// `observer.voltage_noise`: σ_v [V], the gain's noise [SE 43].
     pub voltage_noise: T,
     /// `observer.current_noise`: σ_i [A], the CI detector's unit.
     pub current_noise: T,
     /// `coil.turns`: N, for φ = λ/N and R = N²/l.
     pub turns: T,
-    /// r̄₀ [Ω]: expected initial resistance (25).
+    /// r̄₀ [Ω]: expected initial resistance [SE 25].
     pub initial_resistance: T,
-    /// σ_r0 [Ω] (26).
+    /// σ_r0 [Ω] [SE 26].
     pub initial_resistance_std: T,
-    /// l̄₀ [H]: inductance at rest (25); the expert rule's l̂.
+    /// l̄₀ [H]: inductance at rest [SE 25]; the expert rule's l̂.
     pub initial_inductance: T,
-    /// σ_l0 [H] (26).
+    /// σ_l0 [H] [SE 26].
     pub initial_inductance_std: T,
-    /// σ_ṙ [Ω/s] (24).
+    /// σ_ṙ [Ω/s] [SE 24].
     pub resistance_rate_std: T,
-    /// σ_l̈ [H/s²] (24).
+    /// σ_l̈ [H/s²] [SE 24].
     pub inductance_accel_std: T,
     /// n_σ: half-width of the current's noise interval in σ_i.
     pub ci_sigmas: T,
@@ -119,13 +119,13 @@ pub struct Estimate<T> {
 /// The step's constants, derived once from the [`Settings`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Constants<T> {
-    /// 1/Δ (11)
+    /// 1/Δ [SE 11]
     inv_dt: T,
-    /// σ_v² (43)
+    /// σ_v² [SE 43]
     sigma_v2: T,
-    /// (σ_ṙ·Δ)²: G Q Gᵀ (1, 1), (23)–(24)
+    /// (σ_ṙ·Δ)²: G Q Gᵀ (1, 1), [SE 23–24]
     q_r: T,
-    /// (σ_l̈·Δ²)²: G Q Gᵀ (2, 2), (23)–(24)
+    /// (σ_l̈·Δ²)²: G Q Gᵀ (2, 2), [SE 23–24]
     q_l: T,
     /// n_σ·σ_i: the CI detector's bound
     ci: T,
@@ -135,11 +135,11 @@ struct Constants<T> {
     inv_turns: T,
     /// N²
     turns_sq: T,
-    /// σ_i² (R_k of (15) only)
+    /// σ_i² (R_k of [SE 15] only)
     sigma_i2: T,
 }
 
-/// The SEMERA estimator (Algorithm 1).
+/// The SEMERA estimator ([SE Alg. 1]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Semera<T> {
     c: Constants<T>,
@@ -154,8 +154,8 @@ pub struct Semera<T> {
 }
 
 impl<T: Scalar> Semera<T> {
-    /// At rest (Algorithm 1, lines 1–3): x̂_{1/0} = x̄₀ = [r̄₀, l̄₀, l̄₀] (25),
-    /// Σ_{1/0} = P₀ (26), ι₀ = 0.
+    /// At rest ([SE Alg. 1], lines 1–3): x̂_{1/0} = x̄₀ = [r̄₀, l̄₀, l̄₀] [SE 25],
+    /// Σ_{1/0} = P₀ [SE 26], ι₀ = 0.
     #[must_use]
     pub fn new(s: &Settings<T>) -> Self {
         let dt = s.sample_period;
@@ -170,7 +170,7 @@ impl<T: Scalar> Semera<T> {
             turns_sq: s.turns * s.turns,
             sigma_i2: s.current_noise * s.current_noise,
         };
-        // (26): σ²_r0 (ERRATA), and the l block [[σ²_l0, σ²_l0], [σ²_l0, σ²_l0]] (l₋₁ = l₀)
+        // [SE 26]: σ²_r0 (ERRATA), and the l block [[σ²_l0, σ²_l0], [σ²_l0, σ²_l0]] (l₋₁ = l₀)
         let var_r0 = s.initial_resistance_std * s.initial_resistance_std;
         let var_l0 = s.initial_inductance_std * s.initial_inductance_std;
         Semera {
@@ -187,15 +187,15 @@ impl<T: Scalar> Semera<T> {
     }
 
     /// One sample k: the measured coil voltage u_k = `v` [V] and current
-    /// ι_k = `i` [A] (Algorithm 1, lines 5–16).
+    /// ι_k = `i` [A] ([SE Alg. 1], lines 5–16).
     #[must_use]
     pub fn step(&mut self, v: T, i: T) -> Estimate<T> {
         let c = &self.c;
-        // line 7: H_k (11)
+        // line 7: H_k [SE 11]
         let h1 = i;
         let h2 = i * c.inv_dt;
         let h3 = -(self.i_prev * c.inv_dt);
-        // line 8: K̂ (43) = g/s, g = Σ Hᵀ, s = H Σ Hᵀ + σ_v²
+        // line 8: K̂ [SE 43] = g/s, g = Σ Hᵀ, s = H Σ Hᵀ + σ_v²
         let [p11, p12, p13, p22, p23, p33] = self.p;
         let g1 = p11 * h1 + p12 * h2 + p13 * h3;
         let g2 = p12 * h1 + p22 * h2 + p23 * h3;
@@ -222,7 +222,7 @@ impl<T: Scalar> Semera<T> {
             let d3 = b13 * h1 + b23 * h2 + b33 * h3 - c.sigma_v2 * k3;
             q = [b11, b12, b13, b22 - d2 * k2, b23 - d2 * k3, b33 - d3 * k3];
         }
-        // lines 11–12: x̂_{k+1/k} = F x̂_{k/k}, Σ_{k+1/k} = F Σ Fᵀ + G Q Gᵀ (21), (23), (24)
+        // lines 11–12: x̂_{k+1/k} = F x̂_{k/k}, Σ_{k+1/k} = F Σ Fᵀ + G Q Gᵀ [SE 21], [SE 23], [SE 24]
         let [q11, q12, q13, q22, q23, q33] = q;
         let two = T::ONE + T::ONE;
         self.x = [r, two * l - lp, l];
@@ -239,7 +239,7 @@ impl<T: Scalar> Semera<T> {
         let (r_hat, l_hat) = if valid { (r, l) } else { (self.r_hat, c.l0) };
         self.r_hat = r_hat;
         self.i_prev = i;
-        // line 16 and §II-C: λ = l·ι, φ = λ/N, R = N²/l
+        // line 16 and [SE §II-C]: λ = l·ι, φ = λ/N, R = N²/l
         let lambda = l_hat * i;
         Estimate {
             r: r_hat,
@@ -264,9 +264,9 @@ impl<T: Scalar> Semera<T> {
         [[a, b, c], [b, d, e], [c, e, f]]
     }
 
-    /// R_k of (15) at the a priori state for the next sample: the variance of
-    /// the observation noise (12), σ_v² + σ_i²·((r + l/Δ)² + (l_prev/Δ)²).
-    /// Not used by the step (the gain (43) takes σ_v² alone, see the module
+    /// R_k of [SE 15] at the a priori state for the next sample: the variance of
+    /// the observation noise [SE 12], σ_v² + σ_i²·((r + l/Δ)² + (l_prev/Δ)²).
+    /// Not used by the step (the gain [SE 43] takes σ_v² alone, see the module
     /// docs); a diagnostic of how much the current noise weighs.
     #[must_use]
     pub fn observation_noise_variance(&self) -> T {
@@ -299,7 +299,7 @@ mod tests {
         }
     }
 
-    /// Algorithm 1 by hand (the derivation is in the designer's
+    /// [SE Alg. 1] by hand (the derivation is in the designer's
     /// `observe_semera.rs`): k = 1 (u = 3, ι = 1) under the expert rule, then
     /// k = 2 (u = 2, ι = 2) valid with r̂ = 5/6, l̂ = 2/3, λ̂ = 4/3, φ̂ = 2/3,
     /// R̂ = 6 and Σ_{3/2}(1,1) = 1/2; in both floats.
@@ -358,7 +358,7 @@ mod tests {
         }
     }
 
-    /// R_k of (15): σ_v² + σ_i²·((r + l/Δ)² + (l_prev/Δ)²) at x̄₀ = [2, 1, 1].
+    /// R_k of [SE 15]: σ_v² + σ_i²·((r + l/Δ)² + (l_prev/Δ)²) at x̄₀ = [2, 1, 1].
     #[test]
     fn observation_noise_variance_is_15() {
         let s = Semera::new(&small(|x| x));

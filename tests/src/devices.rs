@@ -136,7 +136,7 @@ fn pick(rng: &mut Rng, values: &[f64]) -> f64 {
     values[k]
 }
 
-/// McLyman (perfect-tracking-soft-landing (6)): R(z) and R′(z).
+/// McLyman (perfect-tracking-soft-landing [PT 6]): R(z) and R′(z).
 fn mclyman(area: f64, lw: f64, z: f64) -> (f64, f64) {
     let r = |z: f64| {
         if z <= 0.0 {

@@ -10,7 +10,7 @@
 //! comments, rewritten by `description::edit::write_physics`), the data as
 //! CSV, and the truth. [`visibility`] says whether the effect stands out of
 //! the noise in the current's |φ̇|-weighted NRMSE (jiles-atherton-actuator-
-//! model eq. 81), as the diagnosis needs.
+//! model [JA 81]), as the diagnosis needs.
 //!
 //! The plant is driven by the piecewise-linear interpolation of the clean
 //! voltage samples — what a replay of the measured `v` column reconstructs —
@@ -72,7 +72,7 @@ impl Excitation {
         }
     }
 
-    /// Three pulses as in the JA paper's measurements (§5.2): on for one
+    /// Three pulses as in the JA paper's measurements ([JA §5.2]): on for one
     /// square-wave half period, off for two.
     pub fn pulses(desc: &Description) -> Excitation {
         let (amplitude, half) = drive_levels(desc);
@@ -232,7 +232,7 @@ pub struct Noise {
 }
 
 impl Default for Noise {
-    /// σ_v = 15 mV, σ_i = 1 mA (semera paper, Table II), σ_z = 1 µm.
+    /// σ_v = 15 mV, σ_i = 1 mA (semera paper, [SE Table II]), σ_z = 1 µm.
     fn default() -> Self {
         Noise {
             voltage: 15e-3,
@@ -300,7 +300,7 @@ fn linear_r0(core: &Core) -> f64 {
 /// The linear core of a Jiles–Atherton core: R = l_c/(μ0·(1 + χ)·A_c) with
 /// the initial anhysteretic susceptibility of the mean-field model,
 /// χ = χ_an/(1 − α·χ_an), χ_an = μ0·M_sat/(3b) (the slope of M_an(B_e) =
-/// M_sat·L(B_e/b), eqs. 21–23, at the origin; L'(0) = 1/3). The mean-field
+/// M_sat·L(B_e/b), [JA 21–23], at the origin; L'(0) = 1/3). The mean-field
 /// gain is capped at 20 (α·χ_an ≤ 0.95) where the model is near its
 /// instability.
 pub fn ja_linear_r0(ja: &JilesAtherton) -> f64 {
@@ -344,7 +344,7 @@ fn gap_reluctance(gap: &Gap, z: f64) -> f64 {
                 .eval(z)
                 .0
         }
-        // (6) McLyman and its fitted form, with the z → 0⁺ limit.
+        // [PT 6] McLyman and its fitted form, with the z → 0⁺ limit.
         Gap::McLyman {
             area,
             winding_length,
@@ -469,7 +469,7 @@ fn draw_saturation(d: &mut Description, ctx: &Context, rng: &mut Rng) -> Drawn {
     vec![("core.phi_sat", phi_sat)]
 }
 
-/// A steel like the JA paper's (Table 2: μ0·M_sat = 1.822 T, b = 2.45 mT,
+/// A steel like the JA paper's ([JA Table 2]: μ0·M_sat = 1.822 T, b = 2.45 mT,
 /// c = 0.736, κ = 943 A/m, α·χ_an = 0.907) on this actuator: c ∈ [0.6, 0.85],
 /// κ ∈ [700, 1200] A/m, b/(μ0·M_sat) within ×[0.8, 1.25] of the paper's,
 /// α·χ_an ∈ [0.85, 0.93]; the pole area is the linear gap's
@@ -512,7 +512,7 @@ fn draw_hysteresis(d: &mut Description, ctx: &Context, rng: &mut Rng) -> Drawn {
 
 /// McLyman's gap with A = 1/(μ0·slope) (the linear gap's slope at z → 0) and
 /// l_w such that fringing lowers R_gap at z_max by a fraction r ∈ [0.15, 0.4]
-/// (the perfect-tracking valve's Table 1 gives 43 %):
+/// (the perfect-tracking valve's [PT Table 1] gives 43 %):
 /// 1 + z_max/√A·ln(2·l_w/z_max) = 1/(1 − r). Below 15 % the semera valve's
 /// baseline misses its data by less than 3× the noise.
 fn draw_fringing(d: &mut Description, rng: &mut Rng) -> Drawn {
@@ -744,7 +744,7 @@ impl Visibility {
 
 /// Replays the baseline and the truth on the measured voltage (as the
 /// diagnosis does: its edges placed by the baseline) and compares their
-/// currents with the measured one by (81), weighted by |φ̇| estimated from
+/// currents with the measured one by [JA 81], weighted by |φ̇| estimated from
 /// the data as (v − R·i)/N (the coil equation, baseline R and N).
 pub fn visibility(case: &HiddenCase) -> Visibility {
     let record = designer::record::Record::parse(&case.data_csv, "data.csv")

@@ -1,15 +1,15 @@
 //! The generated controller (generated/, f64 and f32) in closed loop with the
 //! hybrid simulator on the perfect-tracking valve: closing and opening,
 //! t₀ = 1 ms, t_f = 6 ms, u ∈ [−24, 24] V, trajectory bound 20 V, 1 ms
-//! settling time (perfect-tracking-soft-landing §5).
+//! settling time (perfect-tracking-soft-landing [PT §5]).
 
 use designer::model::{Model, ModelPlant};
 use designer::sim::{simulate_sampled, Limit, Measurement, Mode, Options};
 use reldesign_generated::perfect_tracking_valve::{f32 as c32, f64 as c64};
 use reldesign_tests::{example, impacts};
 
-/// RMSE of z during the motion (perfect-tracking-soft-landing (69), with the
-/// square root of the errata), the equivalent impact velocity v_eq (70), the
+/// RMSE of z during the motion (perfect-tracking-soft-landing [PT 69], with the
+/// square root of the errata), the equivalent impact velocity v_eq [PT 70], the
 /// largest landing speed and the number of bounces at the destination.
 #[derive(Debug)]
 pub struct Outcome {
@@ -26,7 +26,7 @@ pub enum Law {
     Generated64,
     /// The same, f32.
     Generated32,
-    /// The paper's comparison (67)–(68): u = −U·sgn(s), s = (d/dt + λ)²(z_r − z).
+    /// The paper's comparison [PT 67–68]: u = −U·sgn(s), s = (d/dt + λ)²(z_r − z).
     SlidingMode,
 }
 
@@ -39,7 +39,7 @@ fn run(closing: bool, ts: f64, law: Law) -> Outcome {
     let plant = ModelPlant::new(&mut model);
     let (z_min, z_max) = (d.mechanics.z_min, d.mechanics.z_max);
     // Closing starts at rest at z_max with no flux; opening starts held at z_min
-    // with 20 % more flux than the force balance needs (an initial ξ₃ error, §5.1).
+    // with 20 % more flux than the force balance needs (an initial ξ₃ error, [PT §5.1]).
     let mu0_a = 4e-7 * std::f64::consts::PI * 20e-6;
     let hold_flux = (2.0 * -(d.mechanics.preload + d.mechanics.stiffness * z_min) * mu0_a).sqrt();
     let (x0, mode0) = if closing {
@@ -63,7 +63,7 @@ fn run(closing: bool, ts: f64, law: Law) -> Outcome {
             f64::from(k32.step(t as f32, m.x[0] as f32, m.x[1] as f32, m.x[2] as f32))
         }
         Law::SlidingMode => {
-            // the paper's reference (51): z_f at rest after t_f
+            // the paper's reference [PT 51]: z_f at rest after t_f
             let [zr, vr, ar, _] = if t > TF {
                 [z_f, 0.0, 0.0, 0.0]
             } else {
@@ -71,9 +71,9 @@ fn run(closing: bool, ts: f64, law: Law) -> Outcome {
             };
             let mut dx = [0.0; 4];
             designer::sim::Plant::deriv(&plant, t, &m.x, 0.0, &mut dx);
-            // (67) s = (ä_r − a) + 2λ(v_r − v) + λ²(z_r − z), a = T₃(x) (41)
+            // [PT 67] s = (ä_r − a) + 2λ(v_r − v) + λ²(z_r − z), a = T₃(x) [PT 41]
             let s = (ar - dx[1]) + 2.0 * lambda * (vr - m.x[1]) + lambda * lambda * (zr - m.x[0]);
-            -u_sm * s.signum() // (68)
+            -u_sm * s.signum() // [PT 68]
         }
     };
     let options = Options {
@@ -135,8 +135,8 @@ fn generated_controller_soft_lands_nominally() {
     }
 }
 
-/// The sampling sweep of Fig. 7: feedback linearization beats the sliding-mode
-/// controller (67)–(68) in RMSE_z at every sampling period, and in v_eq
+/// The sampling sweep of [PT Fig. 7]: feedback linearization beats the sliding-mode
+/// controller [PT 67–68] in RMSE_z at every sampling period, and in v_eq
 /// wherever the sliding mode lands at all (at Ts ≤ 5 µs its closing hovers
 /// nanometres above the stop and never completes: v_eq = 0 there means "did
 /// not land", and the test requires FL to land instead).

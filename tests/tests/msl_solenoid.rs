@@ -3,7 +3,7 @@
 //!
 //! - The gap of `examples/msl-solenoid.toml` is re-derived from the quasi-static
 //!   FEA table (R = N·i/φ − R_core, R' = −2·F/φ² from F = −½·R_gap'·φ²) and refitted
-//!   (`gap_fit`, (76)–(77)): the example cannot drift from its source.
+//!   (`gap_fit`, [JA 76–77]): the example cannot drift from its source.
 //! - The 12 V pull-in is simulated and compared with the FEA transient: current
 //!   NRMSE, first arrival at the 0.25 mm stopper, the back-EMF current dip.
 //! - `diagnose` runs on the FEA transient written as a measured-data CSV.
@@ -142,7 +142,7 @@ fn measured(fea: &Transient, dt: f64) -> Measured {
     }
 }
 
-/// √(Σ (sim − exp)²/Σ exp²), as (77).
+/// √(Σ (sim − exp)²/Σ exp²), as [JA 77].
 fn nrmse(sim: &[f64], exp: &[f64]) -> f64 {
     let num: f64 = sim.iter().zip(exp).map(|(s, e)| (s - e).powi(2)).sum();
     let den: f64 = exp.iter().map(|e| e * e).sum();

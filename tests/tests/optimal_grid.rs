@@ -44,7 +44,7 @@ struct Case {
     polynomial_feasible: bool,
     bounds: (f64, f64),
     result: Result<OptimalTrajectory, OptimalError>,
-    /// The design's reference passes (54), (56), (57) on the description's model.
+    /// The design's reference passes [PT 54], [PT 56], [PT 57] on the description's model.
     reference_feasible: bool,
     /// The feasibility report of the design's reference (when it is not).
     report: String,

@@ -1,5 +1,5 @@
 //! Physical invariants of the model, checked on every bundled example:
-//! - symmetry (jiles-atherton-actuator-model eqs. 44–46): the mechanics are
+//! - symmetry (jiles-atherton-actuator-model [JA 44–46]): the mechanics are
 //!   even and the electrical states odd in (φ, H_c, u);
 //! - the Jacobian against central finite differences;
 //! - the z → 0⁺ limits: R_gap and R_gap' reach their limits, every derivative
@@ -113,7 +113,7 @@ fn gap_limits_at_zero_and_finite_third_derivatives() {
     let r_dz2 = model.graph.diff(model.r_gap_dz, z);
     let tape = model.compile(&[model.r_gap, model.r_gap_dz, r_dz2]);
     let at = |z: f64| eval(&tape, &[z, 0.0, 0.0], 0.0, 0.0);
-    // McLyman (6), (13): R_gap(0) = 0, R_gap'(0) = 1/(μ0·A)
+    // McLyman [PT 6], [PT 13]: R_gap(0) = 0, R_gap'(0) = 1/(μ0·A)
     let r0 = at(0.0);
     assert_eq!(r0[0], 0.0);
     let expected = 1.0 / (MU0 * 20e-6);

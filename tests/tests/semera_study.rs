@@ -1,42 +1,42 @@
-//! The simulation study of semera-electromagnetic-estimation §III-B: the valve
-//! of Table I (`examples/semera-valve.toml`) driven by a 0/30 V square wave
+//! The simulation study of semera-electromagnetic-estimation [SE §III-B]: the valve
+//! of [SE Table I] (`examples/semera-valve.toml`) driven by a 0/30 V square wave
 //! with 20 ms cycles (50 % duty) from rest, measured every Δ = 50 µs with
 //! σ_v = 15 mV and σ_i = 1 mA of Gaussian noise, estimated by SEMERA
-//! (Algorithm 1) and the integral estimator (Algorithm 2) with the filter
-//! parameters of Table II (the example's `[observer]`), which start from
+//! ([SE Alg. 1]) and the integral estimator ([SE Alg. 2]) with the filter
+//! parameters of [SE Table II] (the example's `[observer]`), which start from
 //! r̄₀ = 77.5 Ω while the simulated coil has another resistance.
 //!
-//! The paper does not print the simulated resistance. Table III gives it
+//! The paper does not print the simulated resistance. [SE Table III] gives it
 //! away: during the first operation the integral estimator keeps r̄ = r̄₀, so
 //! its RMSE(r̂) = 1.500 Ω is |r̄₀ − r|, i.e. r = 76 Ω (or 79 Ω; "less than
 //! 2 %" fits both); 76 Ω is used here instead of the example's chosen 75 Ω.
 //!
 //! True values, as the paper defines them: r = 76 Ω; λ = N·φ of the
 //! simulation; l = λ/i the apparent inductance, which with this model (no
-//! eddy currents, N²i = λR (49)) is N²/R(z, φ) = N²/(k_air·z + R_iron(φ)),
+//! eddy currents, N²i = λR [SE 49]) is N²/R(z, φ) = N²/(k_air·z + R_iron(φ)),
 //! defined also at i = 0 (where λ/i is 0/0 and the expert rule's l̄₀ is meant
 //! to approximate it).
 //!
 //! Measurements. The voltage sample u_k is the voltage over ((k−1)Δ, kΔ],
-//! as the backward difference (2) reads it (the square wave's edges lie on
+//! as the backward difference [SE 2] reads it (the square wave's edges lie on
 //! the grid). Sampled instead at the instant of each rising edge, u_k would
 //! claim 30 V over an interval in which none was applied; SEMERA's first
-//! step then explains it by a jump of l̂ to ~0.9 H, and Table III's SEMERA
+//! step then explains it by a jump of l̂ to ~0.9 H, and [SE Table III]'s SEMERA
 //! RMSE(r̂) becomes 2.8 Ω (1.25 Ω here, 1.244 Ω in the paper). The current
 //! ι_k is the coil current at kΔ ("instant" sampling, what an ADC reads),
 //! or, in the "average" variant, its mean over ((k−1)Δ, kΔ], computed
-//! exactly as (u_k − (λ_k − λ_{k−1})/Δ)/r, with which the data satisfy (2)
+//! exactly as (u_k − (λ_k − λ_{k−1})/Δ)/r, with which the data satisfy [SE 2]
 //! exactly.
 //!
 //! The RMSE of each estimate over the samples of the first operation
-//! (t < 20 ms, Table III) and after it (t > 20 ms, Table IV) is printed in
+//! (t < 20 ms, [SE Table III]) and after it (t > 20 ms, [SE Table IV]) is printed in
 //! the paper's layout. Asserted (instant sampling unless said):
 //!
-//! - Table III, both samplings, every seed: SEMERA beats the integral
+//! - [SE Table III], both samplings, every seed: SEMERA beats the integral
 //!   estimator in r̂, l̂ and λ̂ (the paper: ratios 0.83, 0.41, 0.78; here
 //!   about 0.83, 0.43–0.53, 0.78).
-//! - Table IV, both samplings: every seed-mean error at least 10× (λ̂: 5×)
-//!   below Table III's. Instant sampling: SEMERA's seed-mean RMSE(r̂) below
+//! - [SE Table IV], both samplings: every seed-mean error at least 10× (λ̂: 5×)
+//!   below [SE Table III]'s. Instant sampling: SEMERA's seed-mean RMSE(r̂) below
 //!   the integral estimator's (ratio 0.76; the paper's 0.41); l̂ and λ̂ at
 //!   parity (seed-mean ratio within 0.8–1.25; here 1.10 and 1.03).
 //!
@@ -45,13 +45,13 @@
 //! realisation). Here, over seeds, the two estimators share those errors:
 //! both have the same expert rule at rest (l̄₀ = 50 mH against the true
 //! 52.3 mH), and with instant sampling both carry the O(Δ) bias of the
-//! backward difference (2), r·Δ/2·i ≈ 0.75 mWb on a 0.4 A steady current,
-//! which is why Table IV's RMSE(λ̂) is ~0.5 mWb here against the paper's
+//! backward difference [SE 2], r·Δ/2·i ≈ 0.75 mWb on a 0.4 A steady current,
+//! which is why [SE Table IV]'s RMSE(λ̂) is ~0.5 mWb here against the paper's
 //! 0.11–0.14 mWb; the "average" variant, free of it, gives 0.09–0.10 mWb,
 //! the paper's magnitude, so the paper's simulated data presumably
-//! satisfied (2) (e.g. a simulation stepped at Δ). SEMERA's l̂ is noisier as
+//! satisfied [SE 2] (e.g. a simulation stepped at Δ). SEMERA's l̂ is noisier as
 //! the current decays below ~30 mA (SNR_ι < 30 dB, which the paper notes in
-//! §III-B), which costs it its small edge in l̂ on some seeds.
+//! [SE §III-B]), which costs it its small edge in l̂ on some seeds.
 
 use designer::description::{Core, Description, Gap};
 use designer::model::Model;
@@ -361,7 +361,7 @@ fn semera_beats_the_integral_estimator_like_tables_iii_and_iv() {
     }
 }
 
-/// The observability utility (32) on the study's measured current: at rest
+/// The observability utility [SE 32] on the study's measured current: at rest
 /// and where the current is steady the record is blind; the rise of the
 /// current is observable at a 4-sample stride.
 #[test]
@@ -399,7 +399,7 @@ fn the_study_current_is_blind_where_it_is_steady() {
     let obs = run(4);
     let rise = share(&obs, 20.1e-3, 22e-3, Status::Observable);
     assert!(rise > 0.3, "rise at stride 4: {rise}");
-    // the noise-free current: (32) is exactly ~0 where it is steady
+    // the noise-free current: [SE 32] is exactly ~0 where it is steady
     let exact =
         observability::determinant([truth.i[190], truth.i[191], truth.i[192], truth.i[193]], dt);
     let scale = truth.i[190].powi(3) / (dt * dt);

@@ -8,7 +8,7 @@
 //! The design is `tests/data/sensorless-valve.toml`: the example's valve and
 //! trajectories with a slower tracking loop (2.5 ms settling instead of 1 ms).
 //! With the example's 1 ms loop the observer's velocity, a difference quotient
-//! of estimated positions (84)–(85), drives u into the ±24 V limits and the
+//! of estimated positions [JA 84–85], drives u into the ±24 V limits and the
 //! loop oscillates (measured); the slower loop is the sensorless design.
 
 use designer::description::parse_str;

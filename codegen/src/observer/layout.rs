@@ -120,7 +120,7 @@ pub(super) struct Layout {
     pub(super) y: String,
     pub(super) transition: Function,
     pub(super) measurement: Function,
-    /// f_v of (87) alone, for the estimate at the posterior.
+    /// f_v of [JA 87] alone, for the estimate at the posterior.
     pub(super) acceleration: Function,
     /// UKF: g = ∂F/∂u (none if every entry is constant).
     pub(super) input_gain: Option<Function>,

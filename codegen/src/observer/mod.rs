@@ -1,6 +1,6 @@
 //! The model-based observers as emitted code: the extended and the unscented
 //! Kalman filter on the discretised model of jiles-atherton-actuator-model
-//! §6.1 (eqs. 84–87), built by `designer::observe::discrete::DiscreteModel`.
+//! [JA §6.1] ([JA 84–87]), built by `designer::observe::discrete::DiscreteModel`.
 //!
 //! The filters themselves are the runtime's (`reldesign_runtime::observe`:
 //! `Ekf`, `Ukf`, generic over the float and the model), written once; the
@@ -14,7 +14,7 @@
 //!   [`emit_kalman_macro`]);
 //! - the model functions, written by the expression emitter as straight-line
 //!   code with CSE'd `let`s and equation numbers in comments: `transition`
-//!   (84)–(85) with the acceleration f_v of (87) (the EKF's also returns the
+//!   [JA 84–85] with the acceleration f_v of [JA 87] (the EKF's also returns the
 //!   symbolic Jacobian ∂F/∂x and g = ∂F/∂u), `measurement` h and ∂h/∂u (and
 //!   ∂h/∂x for the EKF), `acceleration`, `input_gain` g (UKF);
 //! - the zero-sized `Model` implementing the runtime's model traits with

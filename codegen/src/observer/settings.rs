@@ -219,7 +219,7 @@ fn settings_const(
         })
         .collect::<Result<Vec<_>, ObserverError>>()?;
     Ok(quote! {
-        /// The filters' settings. Mode band of (86): 3·q_z. Q = diag(q_z², 0, q_φ²(, q_Hc²)) +
+        /// The filters' settings. Mode band of [JA 86]: 3·q_z. Q = diag(q_z², 0, q_φ²(, q_Hc²)) +
         /// σ_u²·g·gᵀ (g = ∂F/∂u: the measured input's noise), measurement variance
         /// σ_y² + σ_u²·(∂h/∂u)². x₀: at rest at z_max, φ = 0(, H_c = 0). P₀: z and z_prev share
         /// the initial σ (at rest: v = 0 is known), each with q_z² added so that P₀ is positive

@@ -99,7 +99,7 @@ pub struct JilesAtherton {
     pub kappa: f64,
     /// α [-]
     pub alpha: f64,
-    /// ε of eq. 52 (default 1e-3)
+    /// ε of [JA 52] (default 1e-3)
     pub epsilon: f64,
 }
 
@@ -148,9 +148,9 @@ pub enum Operation {
 /// Shape of the motion z_m(t) on [takeoff, landing].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Shape {
-    /// 5th-degree polynomial (perfect-tracking-soft-landing eqs. 52–53).
+    /// 5th-degree polynomial (perfect-tracking-soft-landing [PT 52–53]).
     Polynomial,
-    /// Minimum ∫u² dt with |u| ≤ u_bound (eqs. 58–66).
+    /// Minimum ∫u² dt with |u| ≤ u_bound ([PT 58–66]).
     EnergyOptimal,
 }
 
@@ -169,7 +169,7 @@ pub struct Trajectory {
     pub u_bound: f64,
 }
 
-/// How the gains K of the tracking law (48) are given.
+/// How the gains K of the tracking law [PT 48] are given.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Gains {
     /// 5 % settling time [s] of the error dynamics with a triple real pole.
@@ -188,7 +188,7 @@ pub enum FloatType {
 /// `[controller]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Controller {
-    /// Only "feedback-linearization" (eq. 50) for now.
+    /// Only "feedback-linearization" ([PT 50]) for now.
     pub law: Law,
     pub gains: Gains,
     /// T_s [s] (> 0): the controller runs every sample period.
@@ -204,16 +204,16 @@ pub struct Controller {
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Law {
-    /// u = α + β·(K·(ξ_r − T(x)) + z_r⁽³⁾), perfect-tracking-soft-landing (50).
+    /// u = α + β·(K·(ξ_r − T(x)) + z_r⁽³⁾), perfect-tracking-soft-landing [PT 50].
     FeedbackLinearization,
 }
 
 /// An estimator of `[observer].estimators`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Estimator {
-    /// SEMERA, model-free Kalman estimation of r, l, λ (semera Algorithm 1).
+    /// SEMERA, model-free Kalman estimation of r, l, λ ([SE Alg. 1]).
     Semera,
-    /// The integral estimator with resistance update (semera Algorithm 2, (47)).
+    /// The integral estimator with resistance update ([SE Alg. 2], [SE 47]).
     Integral,
     /// Extended Kalman filter on the actuator model.
     Ekf,
@@ -243,30 +243,30 @@ pub struct Observer {
     pub kalman: Option<KalmanSection>,
 }
 
-/// `[observer.semera]`: the filter parameters of semera Table II (valve) /
-/// Table V (relay), besides σ_v, σ_i and Δ of `[observer]`.
+/// `[observer.semera]`: the filter parameters of [SE Table II] (valve) /
+/// [SE Table V] (relay), besides σ_v, σ_i and Δ of `[observer]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SemeraSettings {
-    /// r̄₀ [Ω] (> 0): expected initial resistance, (25).
+    /// r̄₀ [Ω] (> 0): expected initial resistance, [SE 25].
     pub initial_resistance: f64,
-    /// σ_r0 [Ω] (> 0): its standard deviation, (26).
+    /// σ_r0 [Ω] (> 0): its standard deviation, [SE 26].
     pub initial_resistance_std: f64,
-    /// l̄₀ [H] (> 0): expected inductance at rest, (25); also the expert rule's value.
+    /// l̄₀ [H] (> 0): expected inductance at rest, [SE 25]; also the expert rule's value.
     pub initial_inductance: f64,
-    /// σ_l0 [H] (> 0): its standard deviation, (26).
+    /// σ_l0 [H] (> 0): its standard deviation, [SE 26].
     pub initial_inductance_std: f64,
-    /// σ_ṙ [Ω/s] (≥ 0): standard deviation of dr/dt, (24).
+    /// σ_ṙ [Ω/s] (≥ 0): standard deviation of dr/dt, [SE 24].
     pub resistance_rate_std: f64,
-    /// σ_l̈ [H/s²] (≥ 0): standard deviation of d²l/dt², (24).
+    /// σ_l̈ [H/s²] (≥ 0): standard deviation of d²l/dt², [SE 24].
     pub inductance_accel_std: f64,
     /// n_σ (> 0): half-width of the current's noise confidence interval in σ_i.
     pub ci_sigmas: f64,
 }
 
-/// `[observer.integral]`: what semera Algorithm 2 needs besides σ_i and Δ.
+/// `[observer.integral]`: what [SE Alg. 2] needs besides σ_i and Δ.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IntegralSettings {
-    /// r̄₀ [Ω] (> 0): resistance used until the first update (47).
+    /// r̄₀ [Ω] (> 0): resistance used until the first update [SE 47].
     pub initial_resistance: f64,
     /// l̄₀ [H] (> 0): the inductance of the expert rule.
     pub initial_inductance: f64,

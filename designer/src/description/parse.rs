@@ -434,7 +434,7 @@ fn parse_observer(s: &Sect, supply: &Supply, core_sect: &Sect, core: &Core) -> R
     })
 }
 
-/// `[observer.semera]`: semera Table II / Table V.
+/// `[observer.semera]`: [SE Table II] / [SE Table V].
 fn parse_semera(s: &Sect) -> Res<SemeraSettings> {
     s.check_keys(None, "in [observer.semera]")?;
     Ok(SemeraSettings {
@@ -448,7 +448,7 @@ fn parse_semera(s: &Sect) -> Res<SemeraSettings> {
     })
 }
 
-/// `[observer.integral]`: what semera Algorithm 2 needs.
+/// `[observer.integral]`: what [SE Alg. 2] needs.
 fn parse_integral(s: &Sect, supply: &Supply) -> Res<IntegralSettings> {
     s.check_keys(None, "in [observer.integral]")?;
     let initial_resistance = s.req("initial_resistance")?;
@@ -562,7 +562,7 @@ fn parse_resistance_estimate(s: &Sect, ja: bool) -> Res<Option<ResistanceEstimat
     }))
 }
 
-/// K of eq. 48: exactly one of `settling_time` and `poles`.
+/// K of [PT 48]: exactly one of `settling_time` and `poles`.
 fn parse_gains(s: &Sect) -> Res<Gains> {
     let settling = s.opt("settling_time")?;
     let poles = s.opt_numbers("poles")?;

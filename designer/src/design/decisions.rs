@@ -1,6 +1,6 @@
-//! The controller's design decisions as plain data: the gains K of (48), the
+//! The controller's design decisions as plain data: the gains K of [PT 48], the
 //! guard at φ → 0, the landed band, the press and the creep after t_f
-//! (perfect-tracking-soft-landing §3.2 and §4). Code generation only renders
+//! (perfect-tracking-soft-landing [PT §3.2] and [PT §4]). Code generation only renders
 //! a [`ControllerDesign`]; the runtime's `control` module applies it.
 
 use crate::description::{Gains, Operation};
@@ -50,7 +50,7 @@ pub fn triple_pole_settling_product() -> f64 {
     0.5 * (lo + hi)
 }
 
-/// K = [k1, k2, k3] of (48): the error dynamics (49) ξ̃' = (A − BK)ξ̃ of the
+/// K = [k1, k2, k3] of [PT 48]: the error dynamics [PT 49] ξ̃' = (A − BK)ξ̃ of the
 /// triple integrator have the characteristic polynomial
 /// s³ + k3·s² + k2·s + k1 = Π(s − p_i).
 ///
@@ -75,9 +75,9 @@ pub fn gains(g: &Gains) -> [f64; 3] {
 #[derive(Debug, Clone)]
 pub struct DesignedOperation {
     pub operation: Operation,
-    /// Rest position before t₀ (z₀ of (51)).
+    /// Rest position before t₀ (z₀ of [PT 51]).
     pub z0: f64,
-    /// Rest position after t_f (z_f of (51)); the end stop of the hold.
+    /// Rest position after t_f (z_f of [PT 51]); the end stop of the hold.
     pub zf: f64,
     pub feasibility: Feasibility,
     /// z_m on [t₀, t_f], times from the operation's start.
@@ -108,7 +108,7 @@ pub struct ControllerSpec {
 #[derive(Debug, Clone)]
 pub struct ControllerDesign {
     pub linearization: Linearization,
-    /// K = [k1, k2, k3] of (48).
+    /// K = [k1, k2, k3] of [PT 48].
     pub gains: [f64; 3],
     /// T_s [s]: the controller runs once per sample period.
     pub sample_period: f64,
@@ -232,7 +232,7 @@ fn round_down_1sig(x: f64) -> f64 {
 }
 
 /// min over the reference (rest positions and samples of every segment) of
-/// the flux T⁻¹ needs, √((ξ₃ − a₀)/c₂) (42), over the samples where it is
+/// the flux T⁻¹ needs, √((ξ₃ − a₀)/c₂) [PT 42], over the samples where it is
 /// positive and finite.
 fn smallest_reference_flux(
     model: &Model,

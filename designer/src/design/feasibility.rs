@@ -1,13 +1,13 @@
 //! Feasibility of a reference for perfect tracking
-//! (perfect-tracking-soft-landing §4; model-free-sliding-mode §3.1).
+//! (perfect-tracking-soft-landing [PT §4]; model-free-sliding-mode [SM §3.1]).
 //!
-//! Along the motion, with ξ_r = [z_r, ż_r, z̈_r] and x_r = T⁻¹(ξ_r) (55):
-//! - (57) z_min ≤ z_r ≤ z_max;
-//! - (56) the state stays in the linearizable region: the flux the reference
+//! Along the motion, with ξ_r = [z_r, ż_r, z̈_r] and x_r = T⁻¹(ξ_r) [PT 55]:
+//! - [PT 57] z_min ≤ z_r ≤ z_max;
+//! - [PT 56] the state stays in the linearizable region: the flux the reference
 //!   needs, φ_r² = −2(m·z̈_r + F(z_r, ż_r))/R_gap'(z_r), is positive — the
-//!   magnetic force can only attract (sliding-mode paper (13)) — and below
-//!   φ_sat² for a saturating core (its (14));
-//! - (54) the input u_r = α(x_r) + β(x_r)·z_r⁽³⁾ stays within the bounds.
+//!   magnetic force can only attract (sliding-mode paper [SM 13]) — and below
+//!   φ_sat² for a saturating core (its [SM 14]);
+//! - [PT 54] the input u_r = α(x_r) + β(x_r)·z_r⁽³⁾ stays within the bounds.
 //!
 //! The report says which condition fails, where, by how much, and what to try.
 
@@ -21,7 +21,7 @@ use super::reference::Reference;
 /// One condition evaluated along the reference.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Condition {
-    /// Equation number and statement, e.g. "(54) u_min ≤ α + β·z⁽³⁾ ≤ u_max".
+    /// Equation number and statement, e.g. "[PT 54] u_min ≤ α + β·z⁽³⁾ ≤ u_max".
     pub name: &'static str,
     /// First and last violating instants, if any.
     pub violated: Option<(f64, f64)>,
@@ -128,7 +128,7 @@ impl Tracker {
     }
 }
 
-/// Evaluates (54), (56), (57) on `samples` + 1 instants of the motion.
+/// Evaluates [PT 54], [PT 56], [PT 57] on `samples` + 1 instants of the motion.
 pub fn check(
     model: &mut Model,
     lin: &Linearization,

@@ -4,7 +4,7 @@
 //! For ẋ = f(x) + g(x)·u and an output y = h(x):
 //! L_f h = ∇h·f, L_f^k h = L_f(L_f^{k−1} h), L_g L_f^k h = ∇(L_f^k h)·g.
 //! The relative degree r is the first k + 1 with L_g L_f^k h ≢ 0
-//! (perfect-tracking-soft-landing eqs. 23–25).
+//! (perfect-tracking-soft-landing [PT 23–25]).
 
 use crate::sym::{Graph, Id, Node};
 

@@ -2,9 +2,9 @@
 //! shortest motion the energy-optimal solver finds within the input bounds,
 //! its peak current and flux, and the energy J against the motion time.
 //!
-//! - **Shortest motion.** The free arc (58)–(66) between the rest states, its
+//! - **Shortest motion.** The free arc [PT 58–66] between the rest states, its
 //!   duration bisected to 0.5 %: an arc exists if the collocation converges
-//!   with the arc inside the stroke (57) and the flux positive (56, the
+//!   with the arc inside the stroke [PT 57] and the flux positive ([PT 56], the
 //!   linearizable region). Near the limit the polynomial guess leaves the
 //!   domain of T⁻¹ before the optimal motion stops existing, so each shorter
 //!   arc is warm-started from the last one found (continuation in τ).

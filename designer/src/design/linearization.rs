@@ -1,13 +1,13 @@
 //! Exact feedback linearization of the actuator for the output y = z
-//! (perfect-tracking-soft-landing §3.1), derived by the symbolic core from the
+//! (perfect-tracking-soft-landing [PT §3.1]), derived by the symbolic core from the
 //! model's own f(x, u): nothing here is typed in from the paper.
 //!
-//! - (30) z⁽³⁾ = L_f³h + L_g L_f²h · u, relative degree 3 away from φ = 0;
-//! - (32) α = −L_f³h / L_g L_f²h, β = 1 / L_g L_f²h (the paper's (34)–(35));
-//! - (41) T(x) = [z, v, L_f²h] = [z, v, a];
-//! - (42) T⁻¹(ξ): a is quadratic in φ (a = a₀(z, v) + c₂(z)·φ²), checked
+//! - [PT 30] z⁽³⁾ = L_f³h + L_g L_f²h · u, relative degree 3 away from φ = 0;
+//! - [PT 32] α = −L_f³h / L_g L_f²h, β = 1 / L_g L_f²h (the paper's [PT 34–35]);
+//! - [PT 41] T(x) = [z, v, L_f²h] = [z, v, a];
+//! - [PT 42] T⁻¹(ξ): a is quadratic in φ (a = a₀(z, v) + c₂(z)·φ²), checked
 //!   symbolically, so φ = √((ξ₃ − a₀)/c₂) on D₀⁺ (φ > 0);
-//! - model-free-sliding-mode-soft-landing (25)–(26): jerk j = f_j − B_j·u with
+//! - model-free-sliding-mode-soft-landing [SM 25–26]: jerk j = f_j − B_j·u with
 //!   f_j = L_f³h and B_j = −L_g L_f²h.
 //!
 //! Parameters stay symbolic. The Jiles–Atherton core is excluded: its branch
@@ -24,26 +24,26 @@ use super::lie::{vanishing_factors, AffineSystem};
 #[derive(Debug, Clone, PartialEq)]
 pub struct Linearization {
     pub system: AffineSystem,
-    /// T(x) = [z, v, a] (41)
+    /// T(x) = [z, v, a] [PT 41]
     pub transform: [Id; 3],
     /// L_f³h
     pub lf3h: Id,
     /// L_g L_f²h
     pub lglf2h: Id,
-    /// α(x) (32)
+    /// α(x) [PT 32]
     pub alpha: Id,
-    /// β(x) (32)
+    /// β(x) [PT 32]
     pub beta: Id,
-    /// f_j (25)
+    /// f_j [SM 25]
     pub jerk_drift: Id,
-    /// B_j (26)
+    /// B_j [SM 26]
     pub jerk_gain: Id,
     /// The linearizing coordinates ξ₁, ξ₂, ξ₃ (symbols `xi1`, `xi2`, `xi3`).
     pub xi: [Id; 3],
-    /// T⁻¹(ξ) (42), on D₀⁺.
+    /// T⁻¹(ξ) [PT 42], on D₀⁺.
     pub inverse: [Id; 3],
     /// φ² required by ξ: (ξ₃ − a₀(ξ₁, ξ₂))/c₂(ξ₁), the radicand of T⁻¹.
-    /// (56) asks 0 < φ² < φ_sat².
+    /// [PT 56] asks 0 < φ² < φ_sat².
     pub flux_squared: Id,
     /// States whose zero makes L_g L_f²h vanish (relative degree lost), e.g. φ.
     pub singular_at: Vec<Id>,
@@ -80,11 +80,11 @@ impl Linearization {
             });
         }
         let (accel, lf3h, lglf2h) = (chain.lf[2], chain.lf[3], chain.gain);
-        // (32)
+        // [PT 32]
         let ratio = g.div(lf3h, lglf2h);
         let alpha = g.neg(ratio);
         let beta = g.recip(lglf2h);
-        // (26)
+        // [SM 26]
         let jerk_gain = g.neg(lglf2h);
         let xi = [g.symbol("xi1"), g.symbol("xi2"), g.symbol("xi3")];
         let (inverse, flux_squared) = inverse_transform(g, &states, accel, xi)?;
@@ -123,7 +123,7 @@ impl Linearization {
     }
 }
 
-/// (42): x = T⁻¹(ξ) from a = a₀(z, v) + c₂(z)·φ², and the radicand φ².
+/// [PT 42]: x = T⁻¹(ξ) from a = a₀(z, v) + c₂(z)·φ², and the radicand φ².
 fn inverse_transform(
     g: &mut Graph,
     states: &[Id],

@@ -4,11 +4,11 @@
 //! - `linearization.rs`: exact feedback linearization for y = z: α, β, T, T⁻¹,
 //!   the jerk terms;
 //! - `reference.rs`: soft-landing position references (polynomial);
-//! - `feasibility.rs`: conditions (54), (56), (57) along a reference;
+//! - `feasibility.rs`: conditions [PT 54], [PT 56], [PT 57] along a reference;
 //! - `bvp.rs`: a collocation two-point BVP solver (generic);
-//! - `optimal.rs`: the energy-optimal reference (Pontryagin, eqs. 58–66);
+//! - `optimal.rs`: the energy-optimal reference (Pontryagin, [PT 58–66]);
 //! - `optimal_guess.rs`: rest states and the polynomial initial guess of an arc;
-//! - `optimal_search.rs`: rest, move, rest: the optimum within the stroke (57);
+//! - `optimal_search.rs`: rest, move, rest: the optimum within the stroke [PT 57];
 //! - `limits.rs`: the shortest motion and J against the motion time (`limits`);
 //! - `segments.rs`: a reference as a compact table of polynomial segments;
 //! - `decisions.rs`: the controller's design decisions (gains, guard, landed

@@ -1,12 +1,12 @@
-//! Energy-optimal soft-landing trajectory (perfect-tracking-soft-landing §4,
-//! eqs. 58–66), by Pontryagin's principle and collocation.
+//! Energy-optimal soft-landing trajectory (perfect-tracking-soft-landing [PT §4],
+//! [PT 58–66]), by Pontryagin's principle and collocation.
 //!
 //! Minimise J = ∫ u² dt subject to ẋ = f(x, u), u_min ≤ u ≤ u_max,
 //! x(t₀) = T⁻¹([z₀, 0, 0]), x(t_f) = T⁻¹([z_f, 0, 0]) (rest at both ends).
 //! With H = u² + pᵀf(x, u) and f = f₀(x) + g(x)·u input-affine:
 //!
-//! - u* = clamp(−pᵀg/2, u_min, u_max) (H is convex in u; eq. 65);
-//! - ẋ = ∂H/∂p = f(x, u*), ṗ = −∂H/∂x = −(∂f/∂x)ᵀp at u = u* (eq. 66): the
+//! - u* = clamp(−pᵀg/2, u_min, u_max) (H is convex in u; [PT 65]);
+//! - ẋ = ∂H/∂p = f(x, u*), ṗ = −∂H/∂x = −(∂f/∂x)ᵀp at u = u* ([PT 66]): the
 //!   term ∂H/∂u·∂u*/∂x vanishes (∂H/∂u = 0 where u* is interior, ∂u*/∂x = 0
 //!   where it is clamped).
 //!
@@ -16,7 +16,7 @@
 //! selects). The two-point BVP is solved by [`solve_bvp`] with per-component
 //! scaling (metres, m/s, webers and the costates differ by ~10 orders).
 //!
-//! **Limits of the stroke** (57): a slow motion's free extremal arrives early
+//! **Limits of the stroke** [PT 57]: a slow motion's free extremal arrives early
 //! and hovers at the stop; the optimum is then a shorter free arc with rest at
 //! the cheaper end (`optimal_search.rs`). **Initial guess**: the polynomial
 //! reference through T⁻¹ (`optimal_guess.rs`).
@@ -32,7 +32,7 @@
 //! input's cost where the motion rests.
 //!
 //! **Reference for the controller.** z_r = z, ż_r = v, z̈_r = T₃(x) and the
-//! jerk exactly from state and input: L_f³z(x) + L_g L_f²z(x)·u* (eq. 30).
+//! jerk exactly from state and input: L_f³z(x) + L_g L_f²z(x)·u* ([PT 30]).
 
 // `!(x > 0)` is deliberate: it is also true for NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
@@ -502,8 +502,8 @@ fn gauss5(a: f64, b: f64, f: &mut dyn FnMut(f64) -> f64) -> f64 {
     GL5.iter().map(|&(x, w)| w * f(c + h * x)).sum::<f64>() * h
 }
 
-/// Solves the energy-optimal problem (eqs. 58–66) for `model`, within the
-/// stroke (57): a free arc, with rest at one end where that costs less.
+/// Solves the energy-optimal problem ([PT 58–66]) for `model`, within the
+/// stroke [PT 57]: a free arc, with rest at one end where that costs less.
 /// Where no solution exists, the error says which bound or duration it needs
 /// ([`OptimalError::BoundTooLow`], [`OptimalError::TooShort`]).
 pub fn energy_optimal(

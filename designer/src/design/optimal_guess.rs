@@ -3,13 +3,13 @@
 //! one motion arc from the 5th-degree polynomial (flat parametrisation).
 //!
 //! **Guess.** z_r is the polynomial of the arc, x_r = T⁻¹(z_r, ż_r, z̈_r)
-//! (42), u_r = α(x_r) + β(x_r)·z_r⁽³⁾ (50 with perfect tracking); the costate
-//! is the minimum-norm p with pᵀg = −2u_r (H stationary in u, (65)),
-//! completed with [`CostateGuess::Chain`]: the costate equations (66) solved
+//! [PT 42], u_r = α(x_r) + β(x_r)·z_r⁽³⁾ ([PT 50] with perfect tracking); the costate
+//! is the minimum-norm p with pᵀg = −2u_r (H stationary in u, [PT 65]),
+//! completed with [`CostateGuess::Chain`]: the costate equations [PT 66] solved
 //! backwards along the integrator chain (the φ row gives p₂, the v row p₁,
 //! with ṗ by finite differences on the mesh), or zero ([`CostateGuess::Zero`]).
 //!
-//! **Rest.** T⁻¹([z, 0, 0]) is the state at rest at z (61)–(62); α there is the
+//! **Rest.** T⁻¹([z, 0, 0]) is the state at rest at z [PT 61–62]; α there is the
 //! input that holds it (jerk 0), whose square is the cost rate of resting.
 
 // `!(x > 0)` is deliberate: it is also true for NaN.
@@ -70,7 +70,7 @@ impl GuessTapes {
         x
     }
 
-    /// Rest state T⁻¹([z, 0, 0]) (61)–(62).
+    /// Rest state T⁻¹([z, 0, 0]) [PT 61–62].
     pub fn rest_state(&self, z: f64, which: &'static str) -> Result<[f64; 3], OptimalError> {
         let x = self.inverse([z, 0.0, 0.0]);
         if !(x[3] > 0.0) || !x[3].is_finite() {
@@ -195,7 +195,7 @@ fn stationary_costate(p: &Point) -> [f64; 3] {
     ]
 }
 
-/// p₃ from pᵀg = −2u_r, then (66) along the chain: the φ row gives p₂, the v
+/// p₃ from pᵀg = −2u_r, then [PT 66] along the chain: the φ row gives p₂, the v
 /// row p₁. Falls back to the stationary costate where the chain breaks.
 fn chain_costates(t: &[f64], points: &[Point], p_from_u: &[[f64; 3]]) -> Vec<[f64; 3]> {
     let m = t.len();

@@ -1,7 +1,7 @@
 //! The energy-optimal motion under the stroke limits: rest, move, rest.
 //!
-//! Pontryagin's two-point problem (58)–(66) knows nothing of the stops, but
-//! the motion must stay in [z_min, z_max] (57). For a slow motion the free
+//! Pontryagin's two-point problem [PT 58–66] knows nothing of the stops, but
+//! the motion must stay in [z_min, z_max] [PT 57]. For a slow motion the free
 //! extremal wants to arrive early and hover at the stop (holding there costs
 //! less than moving slowly): it leaves [z_min, z_max], or comes within the
 //! regularisation length of the gap's logarithm, and Newton fails. The optimum

@@ -3,9 +3,9 @@
 //! to (not including) code generation.
 //!
 //! description → model → feedback linearization (α, β, T, T⁻¹) → per
-//! operation a reference (polynomial or energy-optimal) → feasibility (54),
-//! (56), (57) → reference table → the decisions of `decisions.rs`; and the
-//! discretised model (84)–(87) of the EKF/UKF. An infeasible design is an
+//! operation a reference (polynomial or energy-optimal) → feasibility [PT 54],
+//! [PT 56], [PT 57] → reference table → the decisions of `decisions.rs`; and the
+//! discretised model [JA 84–87] of the EKF/UKF. An infeasible design is an
 //! error that says which condition fails, where, and what to try.
 
 use crate::description::{Description, Drive, Estimator, Operation, Shape};
@@ -216,7 +216,7 @@ pub fn design_controller(
     ControllerDesign::decide(model, linearization, &spec, operations)
 }
 
-/// `[observer.kalman]` → the discretised model (84)–(87) of the EKF/UKF.
+/// `[observer.kalman]` → the discretised model [JA 84–87] of the EKF/UKF.
 pub fn design_kalman(
     description: &Description,
     model: &Model,

@@ -1,7 +1,7 @@
-//! Position references for soft landing (perfect-tracking-soft-landing §4).
+//! Position references for soft landing (perfect-tracking-soft-landing [PT §4]).
 //!
-//! (51): z_r = z₀ before t₀, z_m(t) on [t₀, t_f], z_f after t_f, where z_m meets
-//! the soft-landing conditions (52)–(53): zero velocity and acceleration at
+//! [PT 51]: z_r = z₀ before t₀, z_m(t) on [t₀, t_f], z_f after t_f, where z_m meets
+//! the soft-landing conditions [PT 52–53]: zero velocity and acceleration at
 //! both ends. The simplest such z_m is the 5th-degree polynomial
 //! z₀ + (z_f − z₀)·(10τ³ − 15τ⁴ + 6τ⁵), τ = (t − t₀)/(t_f − t₀).
 
@@ -21,7 +21,7 @@ pub trait Reference {
     fn motion(&self) -> (f64, f64);
 }
 
-/// (51)–(53) with the 5th-degree polynomial motion.
+/// [PT 51–53] with the 5th-degree polynomial motion.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Polynomial {
     pub z0: f64,

@@ -2,10 +2,10 @@
 //! energy, and for the Jiles–Atherton core the dynamics of the field H_c.
 //!
 //! - linear: MMF = R_core0·φ
-//! - saturating (Fröhlich–Kennelly, perfect-tracking-soft-landing eq. 7):
+//! - saturating (Fröhlich–Kennelly, perfect-tracking-soft-landing [PT 7]):
 //!   MMF = R_core0·φ / (1 − |φ|/φ_sat)
 //! - jiles-atherton (inverse JA of Sadowski et al., jiles-atherton-actuator-
-//!   model eqs. 21–33 with the clamp 52): MMF = H_c·l_c, and dH_c/dt follows
+//!   model [JA 21–33] with the clamp [JA 52]): MMF = H_c·l_c, and dH_c/dt follows
 //!   from dφ/dt through the inverse differential permeability.
 
 use crate::description::{Core, JilesAtherton};
@@ -28,7 +28,7 @@ pub fn mmf(g: &mut Graph, params: &mut Params, core: &Core, phi: Id, hc: Option<
         Core::Saturating { r0, phi_sat } => {
             let r0 = params.key(g, "core.r0", *r0);
             let ps = params.key(g, "core.phi_sat", *phi_sat);
-            // (7) R_core = R_core0 / (1 − |φ|/φ_sat)
+            // [PT 7] R_core = R_core0 / (1 − |φ|/φ_sat)
             let abs = g.abs(phi);
             let frac = g.div(abs, ps);
             let one = g.one();
@@ -39,7 +39,7 @@ pub fn mmf(g: &mut Graph, params: &mut Params, core: &Core, phi: Id, hc: Option<
         Core::JilesAtherton(ja) => {
             let hc = hc.expect("the Jiles–Atherton core has the state H_c");
             let lc = params.key(g, "core.length", ja.length);
-            // (15) ∫_core H dl = H_c·l_c
+            // [JA 15] ∫_core H dl = H_c·l_c
             g.mul(hc, lc)
         }
     }
@@ -74,7 +74,7 @@ pub fn stored_energy(g: &mut Graph, params: &Params, core: &Core, phi: Id) -> Op
 }
 
 /// The Langevin function L(x) = coth x − 1/x and its derivative
-/// L'(x) = 1 − coth² x + 1/x² (ERRATA: the paper's (22) prints (B_e/b)²),
+/// L'(x) = 1 − coth² x + 1/x² (ERRATA: the paper's [JA 22] prints (B_e/b)²),
 /// with Taylor series near 0.
 fn langevin(g: &mut Graph, x: Id) -> (Id, Id) {
     let coth = g.coth(x);
@@ -135,7 +135,7 @@ fn odd_series(g: &mut Graph, x: Id, c: &[f64]) -> Id {
     g.mul(x, even)
 }
 
-/// (33) dH_c/dt = dH_c/dB_c(φ, H_c, φ̇) · φ̇ / A_c.
+/// [JA 33] dH_c/dt = dH_c/dB_c(φ, H_c, φ̇) · φ̇ / A_c.
 pub fn ja_field_rate(
     g: &mut Graph,
     params: &mut Params,
@@ -153,46 +153,46 @@ pub fn ja_field_rate(
     let eps = params.key(g, "core.epsilon", ja.epsilon);
     let mu0 = g.constant(MU0);
     let one = g.one();
-    // (32) B_c = φ/A_c, M_c = B_c/μ0 − H_c
+    // [JA 32] B_c = φ/A_c, M_c = B_c/μ0 − H_c
     let bc = g.div(phi, ac);
     let bc_mu = g.div(bc, mu0);
     let mc = g.sub(bc_mu, hc);
-    // (23) B_e = μ0·(H_c + α·M_c)
+    // [JA 23] B_e = μ0·(H_c + α·M_c)
     let amc = g.mul(alpha, mc);
     let h_eff = g.add(hc, amc);
     let be = g.mul(mu0, h_eff);
-    // (21), (22) M_an and dM_an/dB_e
+    // [JA 21], [JA 22] M_an and dM_an/dB_e
     let x = g.div(be, b);
     let (l, dl) = langevin(g, x);
     let m_an = g.mul(m_sat, l);
     let ms_b = g.div(m_sat, b);
     let dman = g.mul(ms_b, dl);
-    // (27) M_irr = (M_c − c·M_an)/(1 − c)
+    // [JA 27] M_irr = (M_c − c·M_an)/(1 − c)
     let c_man = g.mul(c, m_an);
     let num = g.sub(mc, c_man);
     let one_minus_c = g.sub(one, c);
     let m_irr = g.div(num, one_minus_c);
-    // (26) dM_irr/dB_e = δ·(M_an − M_irr)/(μ0·κ), δ = sgn(dB_c/dt) = sgn(φ̇)
+    // [JA 26] dM_irr/dB_e = δ·(M_an − M_irr)/(μ0·κ), δ = sgn(dB_c/dt) = sgn(φ̇)
     let delta = g.sign(phi_dot);
     let diff = g.sub(m_an, m_irr);
     let mu_kappa = g.mul(mu0, kappa);
     let ratio = g.div(diff, mu_kappa);
     let dmirr = g.mul(delta, ratio);
-    // (29) dM_c/dB_e = (1 − c)·dM_irr/dB_e + c·dM_an/dB_e
+    // [JA 29] dM_c/dB_e = (1 − c)·dM_irr/dB_e + c·dM_an/dB_e
     let t1 = g.mul(one_minus_c, dmirr);
     let t2 = g.mul(c, dman);
     let dmc = g.add(t1, t2);
-    // (30) with the clamp (52): dB_c/dB_e = max(1 + μ0(1 − α)·dM_c/dB_e, ε)
+    // [JA 30] with the clamp [JA 52]: dB_c/dB_e = max(1 + μ0(1 − α)·dM_c/dB_e, ε)
     let one_minus_alpha = g.sub(one, alpha);
     let k = g.mul(mu0, one_minus_alpha);
     let kd = g.mul(k, dmc);
     let raw = g.add(one, kd);
     let dbc = g.max(raw, eps);
-    // (28), (31) dH_c/dB_c = 1/μ0 − dM_c/dB_e / dB_c/dB_e
+    // [JA 28], [JA 31] dH_c/dB_c = 1/μ0 − dM_c/dB_e / dB_c/dB_e
     let inv_mu0 = g.recip(mu0);
     let dmc_dbc = g.div(dmc, dbc);
     let dh_db = g.sub(inv_mu0, dmc_dbc);
-    // (33)
+    // [JA 33]
     let rate = g.div(phi_dot, ac);
     g.mul(dh_db, rate)
 }

@@ -1,7 +1,7 @@
 //! Air-gap reluctance R_gap(z), symbolic, for every gap model of the spec.
 //!
-//! McLyman fringing (perfect-tracking-soft-landing eq. 6; jiles-atherton-
-//! actuator-model eq. 11) contains `z·ln(k/z)`. Its value and first derivative
+//! McLyman fringing (perfect-tracking-soft-landing [PT 6]; jiles-atherton-
+//! actuator-model [JA 11]) contains `z·ln(k/z)`. Its value and first derivative
 //! have finite limits at z → 0⁺, but R_gap'' diverges like ln z, and R_gap''
 //! enters the jerk, α(x) and the costate equations. We therefore use one smooth
 //! regularisation everywhere:
@@ -67,7 +67,7 @@ fn fringing_log(g: &mut Graph, k: Id, z: Id, names: &mut Names) -> Id {
     log
 }
 
-/// (6): R_gap = (z/(μ0·A)) / (1 + z/√A · ln(2·l_w/z)).
+/// [PT 6]: R_gap = (z/(μ0·A)) / (1 + z/√A · ln(2·l_w/z)).
 fn mclyman(
     g: &mut Graph,
     params: &mut Params,
@@ -93,7 +93,7 @@ fn mclyman(
     g.div(num, den)
 }
 
-/// jiles-atherton-actuator-model (11): R_gap = R_g0 + R'_g0·z / (1 + k1·z·ln(k2/z)).
+/// jiles-atherton-actuator-model [JA 11]: R_gap = R_g0 + R'_g0·z / (1 + k1·z·ln(k2/z)).
 fn mclyman_fit(
     g: &mut Graph,
     params: &mut Params,

@@ -7,14 +7,14 @@
 //!
 //! | quantity | equation |
 //! | --- | --- |
-//! | reluctance | R(z, φ) = R_gap(z) + R_core(φ) (perfect-tracking eq. 5) |
-//! | force | F_mag = −½·R_gap'(z)·φ² (eq. 11) |
-//! | passive force | F(z, v) = k_s·z + c·v + F0 (eq. 10) |
-//! | motion | ż = v, v̇ = (F_mag − F)/m (eqs. 15–16) |
-//! | flux, voltage drive | φ̇ = (N·u − R·(R_gap·φ + MMF_core))/(N² + R·k_e) (eq. 17; JA model eq. 17) |
-//! | flux, current drive | φ̇ = (N·u − (R_gap·φ + MMF_core))/k_e (JA model eq. 16) |
-//! | coil current | i = (N·(R_gap·φ + MMF_core) + k_e·u)/(N² + R·k_e) (JA model eq. 41) |
-//! | coil voltage (current drive) | v = R·u + N·φ̇ (eq. 1) |
+//! | reluctance | R(z, φ) = R_gap(z) + R_core(φ) (perfect-tracking [PT 5]) |
+//! | force | F_mag = −½·R_gap'(z)·φ² ([PT 11]) |
+//! | passive force | F(z, v) = k_s·z + c·v + F0 ([PT 10]) |
+//! | motion | ż = v, v̇ = (F_mag − F)/m ([PT 15–16]) |
+//! | flux, voltage drive | φ̇ = (N·u − R·(R_gap·φ + MMF_core))/(N² + R·k_e) ([PT 17]; [JA 17]) |
+//! | flux, current drive | φ̇ = (N·u − (R_gap·φ + MMF_core))/k_e ([JA 16]) |
+//! | coil current | i = (N·(R_gap·φ + MMF_core) + k_e·u)/(N² + R·k_e) ([JA 41]) |
+//! | coil voltage (current drive) | v = R·u + N·φ̇ ([PT 1]) |
 
 mod core;
 mod gap;
@@ -135,15 +135,15 @@ impl Model {
         let k_s = params.key(&mut g, "mechanics.stiffness", m.stiffness);
         let damping = params.key(&mut g, "mechanics.damping", m.damping);
         let f0 = params.key(&mut g, "mechanics.preload", m.preload);
-        // (10) F(z, v) = k_s·z + c·v + F0
+        // [PT 10] F(z, v) = k_s·z + c·v + F0
         let ksz = g.mul(k_s, z);
         let cv = g.mul(damping, v);
         let passive_force = g.sum(&[ksz, cv, f0]);
-        // (11) F_mag = −½·R_gap'·φ²
+        // [PT 11] F_mag = −½·R_gap'·φ²
         let phi2 = g.powi(phi, 2);
         let rp_phi2 = g.mul(r_gap_dz, phi2);
         let f_mag = g.scale(-0.5, rp_phi2);
-        // (16) v̇ = (F_mag − F)/m
+        // [PT 16] v̇ = (F_mag − F)/m
         let net = g.sub(f_mag, passive_force);
         let accel = g.div(net, mass);
         named.extend([

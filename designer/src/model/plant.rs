@@ -247,7 +247,7 @@ struct Locked {
 
 /// Replaces the first [`MAX_SWITCHES`] `sign(s)` nodes of f by branch
 /// symbols (any further ones stay live). Only signs: the held branch of a
-/// `max`/`min` clamp (the Jiles–Atherton (52)) is not a usable continuation
+/// `max`/`min` clamp (the Jiles–Atherton [JA 52]) is not a usable continuation
 /// beyond its switch (it heads for a division by zero), and the model's
 /// `select`s join smooth pieces or the two forms of one smooth function.
 fn lock_signs(model: &mut Model) -> Locked {

@@ -3,9 +3,9 @@
 //! point (the largest steady input at which it leaves z_min).
 //!
 //! At rest φ̇ = 0, so the eddy current vanishes and N·i = R_gap(z)·φ + MMF_core(φ)
-//! (perfect-tracking-soft-landing eq. 4). Lift-off at z_max happens when
+//! (perfect-tracking-soft-landing [PT 4]). Lift-off at z_max happens when
 //! ½·R_gap'(z_max)·φ² > −F(z_max, 0); release at z_min when
-//! ½·R_gap'(z_min)·φ² < −F(z_min, 0) (jiles-atherton-actuator-model eqs. 49–50).
+//! ½·R_gap'(z_min)·φ² < −F(z_min, 0) (jiles-atherton-actuator-model [JA 49–50]).
 //! The Jiles–Atherton core is evaluated on its anhysteretic curve.
 
 use crate::description::{Core, Drive};

@@ -1,4 +1,4 @@
-//! The extended Kalman filter on the discretised model (84)–(87), with the
+//! The extended Kalman filter on the discretised model [JA 84–87], with the
 //! Jacobians the symbolic core derives (`DiscreteModel::transition_jacobian`,
 //! `measurement_jacobian`): the f64 reference of the emitted EKF
 //! (`reldesign_build::emit_ekf`). It is the runtime's filter

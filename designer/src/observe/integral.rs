@@ -1,14 +1,14 @@
-//! The integral estimator (semera-electromagnetic-estimation §II-D,
-//! Algorithm 2), configured from a description: the flux linkage as the
-//! running integral (46) of u − r̄·ι, reset at the start of each energizing
+//! The integral estimator (semera-electromagnetic-estimation [SE §II-D],
+//! [SE Alg. 2]), configured from a description: the flux linkage as the
+//! running integral [SE 46] of u − r̄·ι, reset at the start of each energizing
 //! operation, where the resistance is recomputed from the finished operation
-//! by (47); l̂ = λ̂/ι (48) under the same confidence-interval detector as
+//! by [SE 47]; l̂ = λ̂/ι [SE 48] under the same confidence-interval detector as
 //! SEMERA.
 //!
 //! The algorithm is `reldesign_runtime::integral`, here in f64 (the emitted
-//! estimators are the same code). Its module docs give Algorithm 2 line by
+//! estimators are the same code). Its module docs give [SE Alg. 2] line by
 //! line and the choices the paper leaves open: where an energizing operation
-//! starts (the measured voltage rising above `energize_threshold`), when (47)
+//! starts (the measured voltage rising above `energize_threshold`), when [SE 47]
 //! is trusted (a whole operation, S_ι above its noise interval), and
 //! non-finite samples as missing.
 
@@ -59,12 +59,12 @@ impl IntegralConfig {
     }
 }
 
-/// The integral estimator (Algorithm 2) in f64.
+/// The integral estimator ([SE Alg. 2]) in f64.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Integral(algorithm::Integral<f64>);
 
 impl Integral {
-    /// Algorithm 2, lines 1–2: r̄ = r̄₀, S_u = S_ι = 0 (at rest).
+    /// [SE Alg. 2], lines 1–2: r̄ = r̄₀, S_u = S_ι = 0 (at rest).
     pub fn new(config: &IntegralConfig) -> Integral {
         Integral(algorithm::Integral::new(&config.runtime_settings()))
     }

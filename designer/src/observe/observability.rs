@@ -1,17 +1,17 @@
 //! Where SEMERA is blind: the observability of its model over a recorded
-//! current (semera-electromagnetic-estimation §II-B, (30)–(35)).
+//! current (semera-electromagnetic-estimation [SE §II-B], [SE 30–35]).
 //!
 //! The state x = [r, l, l_prev] is observable on [kΔ, (k+2)Δ] iff the
-//! observability matrix O_[k,k+2] of (31), built from i_{k−1}, i_k, i_{k+1},
-//! i_{k+2}, is regular. Its determinant (32), derived again from (31) (the
+//! observability matrix O_[k,k+2] of [SE 31], built from i_{k−1}, i_k, i_{k+1},
+//! i_{k+2}, is regular. Its determinant [SE 32], derived again from [SE 31] (the
 //! text prints the term −i_{k−1}·i_{k+1}·i_{k+2} twice; the second one is
-//! −i_{k−1}·i_k·i_{k+2}, without which (35) — a current linear in time is
+//! −i_{k−1}·i_k·i_{k+2}, without which [SE 35] — a current linear in time is
 //! unobservable — would not hold), with a = i_{k−1}, b = i_k, c = i_{k+1},
 //! d = i_{k+2}:
 //!
 //! det O_[k,k+2] = (2b²d − b²c − bc² − acd + 2ac² − abd)/Δ².
 //!
-//! It vanishes for a constant current, a current linear in time (35) and also
+//! It vanishes for a constant current, a current linear in time [SE 35] and also
 //! for a geometric one, i_k = A·ρᵏ (an exponential decay at zero voltage with
 //! constant l: r and l then only appear through l/r).
 //!
@@ -27,14 +27,14 @@
 //!   as uncorrelated; the cubic term's 32 is the sum of its squared
 //!   coefficients times the fourth and second moments).
 
-/// P(a, b, c, d) = Δ²·det O_[k,k+2] (32) of a = i_{k−1}, b = i_k, c = i_{k+1},
+/// P(a, b, c, d) = Δ²·det O_[k,k+2] [SE 32] of a = i_{k−1}, b = i_k, c = i_{k+1},
 /// d = i_{k+2} [A³].
 pub fn polynomial(i: [f64; 4]) -> f64 {
     let [a, b, c, d] = i;
     2.0 * b * b * d - b * b * c - b * c * c - a * c * d + 2.0 * a * c * c - a * b * d
 }
 
-/// det O_[k,k+2] of (31)–(32) from i_{k−1}, i_k, i_{k+1}, i_{k+2} and Δ.
+/// det O_[k,k+2] of [SE 31–32] from i_{k−1}, i_k, i_{k+1}, i_{k+2} and Δ.
 pub fn determinant(i: [f64; 4], sample_period: f64) -> f64 {
     polynomial(i) / (sample_period * sample_period)
 }
@@ -70,8 +70,8 @@ pub struct ObservabilitySettings {
     pub current_noise: f64,
     /// n_σ: the confidence of both tests.
     pub n_sigma: f64,
-    /// S ≥ 1: (32) is evaluated on i_{k−S}, i_k, i_{k+S}, i_{k+2S}, i.e. on
-    /// the record sampled every S·Δ. S = 1 is the window of (31); on noisy
+    /// S ≥ 1: [SE 32] is evaluated on i_{k−S}, i_k, i_{k+S}, i_{k+2S}, i.e. on
+    /// the record sampled every S·Δ. S = 1 is the window of [SE 31]; on noisy
     /// records the slow parts of a transient only rise above the noise over
     /// a few samples (the module docs of [`analyse`]).
     pub stride: usize,
@@ -86,7 +86,7 @@ pub enum Status {
     /// (SEMERA's expert rule holds; nothing can be observed).
     NoCurrent,
     /// The current is there, but det O_[k,k+2] is within what noise gives
-    /// (constant, linear or geometric current: (35)).
+    /// (constant, linear or geometric current: [SE 35]).
     NoExcitation,
     /// The window leaves the record (its first and last samples).
     Edge,
@@ -95,7 +95,7 @@ pub enum Status {
 /// The observability of each sample of a recorded current.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Observability {
-    /// det O_[k,k+2] (32) [A³/s²] per sample k (with Δ → S·Δ); NaN at the edges.
+    /// det O_[k,k+2] [SE 32] [A³/s²] per sample k (with Δ → S·Δ); NaN at the edges.
     pub determinant: Vec<f64>,
     /// Its noise standard deviation (same units); NaN at the edges.
     pub noise: Vec<f64>,
@@ -114,7 +114,7 @@ impl Observability {
 /// four currents lie outside ±n_σ·σ_i and |det O_[k,k+2]| exceeds n_σ times
 /// its noise standard deviation ([`noise_std`]).
 ///
-/// With σ_i = 1 mA and Δ = 50 µs (semera Table II), a 4-sample window sees
+/// With σ_i = 1 mA and Δ = 50 µs ([SE Table II]), a 4-sample window sees
 /// only the fastest transients above the noise; the rise of the current after
 /// a voltage step becomes visible at S ≈ 4 (200 µs), while a steady current
 /// stays blind at any S, as it should.

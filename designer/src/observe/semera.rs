@@ -1,12 +1,12 @@
 //! SEMERA: stochastic electromagnetic estimation of the resistance r, the
 //! apparent inductance l and the flux linkage λ of a reluctance actuator from
 //! sampled coil voltage and current alone (semera-electromagnetic-estimation,
-//! §II, Algorithm 1), configured from a description.
+//! [SE §II], [SE Alg. 1]), configured from a description.
 //!
 //! The algorithm is `reldesign_runtime::semera`, here in f64: the emitted
 //! estimators are the same code in f32/f64, so they agree with this reference
 //! by construction. Its module docs give the filter line by line (state
-//! [r, l, l_prev], H_k of (11), the gain (43), the l block's Joseph-form
+//! [r, l, l_prev], H_k of [SE 11], the gain [SE 43], the l block's Joseph-form
 //! update that keeps f32 stable, the CI detector and the expert rule) and
 //! the choices the paper leaves open (ι₀ = 0, non-finite samples as missing
 //! measurements).
@@ -27,7 +27,7 @@ pub struct SemeraConfig {
     pub current_noise: f64,
     /// N, the coil's turns (for φ = λ/N and R = N²/l).
     pub turns: f64,
-    /// Table II / V.
+    /// [SE Table II] / [SE Table V].
     pub filter: SemeraSettings,
 }
 
@@ -67,18 +67,18 @@ impl SemeraConfig {
 /// r̂, l̂, λ̂, φ̂ = λ̂/N, R̂ = N²/l̂ and the CI detector's `valid`.
 pub type Estimate = algorithm::Estimate<f64>;
 
-/// The SEMERA estimator (Algorithm 1) in f64.
+/// The SEMERA estimator ([SE Alg. 1]) in f64.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Semera(algorithm::Semera<f64>);
 
 impl Semera {
-    /// Algorithm 1, lines 1–3: x̂_{1/0} = x̄₀ (25), Σ_{1/0} = P₀ (26), ι₀ = 0.
+    /// [SE Alg. 1], lines 1–3: x̂_{1/0} = x̄₀ [SE 25], Σ_{1/0} = P₀ [SE 26], ι₀ = 0.
     pub fn new(config: &SemeraConfig) -> Semera {
         Semera(algorithm::Semera::new(&config.settings()))
     }
 
     /// One sample k: the measured voltage u_k = `v` [V] and current ι_k = `i`
-    /// [A] (Algorithm 1, lines 5–16).
+    /// [A] ([SE Alg. 1], lines 5–16).
     pub fn step(&mut self, v: f64, i: f64) -> Estimate {
         self.0.step(v, i)
     }
@@ -93,8 +93,8 @@ impl Semera {
         self.0.covariance()
     }
 
-    /// R_k of (15) at the a priori state for the next sample (a diagnostic:
-    /// the gain (43) takes σ_v² alone).
+    /// R_k of [SE 15] at the a priori state for the next sample (a diagnostic:
+    /// the gain [SE 43] takes σ_v² alone).
     pub fn observation_noise_variance(&self) -> f64 {
         self.0.observation_noise_variance()
     }

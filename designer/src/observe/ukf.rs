@@ -1,5 +1,5 @@
-//! The unscented Kalman filter on the discretised model (84)–(87), as in
-//! jiles-atherton-actuator-model §6.1: the f64 reference of the emitted UKF
+//! The unscented Kalman filter on the discretised model [JA 84–87], as in
+//! jiles-atherton-actuator-model [JA §6.1]: the f64 reference of the emitted UKF
 //! (`reldesign_build::emit_ukf`). It is the runtime's filter
 //! (`reldesign_runtime::observe::Ukf`, where the algorithm and its docs
 //! live: sigma points, repaired factorisations), the one the emitted code

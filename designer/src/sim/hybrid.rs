@@ -1,4 +1,5 @@
-//! Event-driven simulation of the three-mode hybrid automaton.
+//! Event-driven simulation of the three-mode hybrid automaton
+//! ([PT Fig. 3]: free motion, and at rest on either stop).
 //!
 //! Between events the continuous state is integrated by [`Dopri5`]; the mode
 //! decides the vector field (free motion, or stuck at a limit with `ż = v̇ = 0`

@@ -197,7 +197,7 @@ pub fn hysteresis_from_saturation(
 }
 
 /// The fitted Jiles–Atherton parameters around `ja` (α stays: the path
-/// length l_c takes its part of the reduced model's α*, eq. 60).
+/// length l_c takes its part of the reduced model's α*, [JA 60]).
 fn hysteresis_params(ja: &JilesAtherton) -> [FitParam; 5] {
     [
         param("core.m_sat", 0.05 * ja.m_sat, 20.0 * ja.m_sat),
@@ -229,10 +229,10 @@ fn linear_r0(d: &Description) -> f64 {
 /// saturation flux density `b_sat` = μ0·M_sat [T].
 ///
 /// The material's shape parameters (c, κ, α, and b relative to μ0·M_sat) are
-/// those the JA paper fitted for a valve's steel (Table 2); the path length
+/// those the JA paper fitted for a valve's steel ([JA Table 2]); the path length
 /// makes the initial reluctance l_c/(μ0·μ_i·A_c) equal to `r0`.
 fn jiles_atherton(area: f64, r0: f64, b_sat: f64) -> JilesAtherton {
-    // Table 2: μ0·M_sat = 1.822 T, b = 2.45 mT, c = 0.736, κ = 943 A/m, α = 3.66e-3.
+    // [JA Table 2]: μ0·M_sat = 1.822 T, b = 2.45 mT, c = 0.736, κ = 943 A/m, α = 3.66e-3.
     let m_sat = b_sat / MU0;
     let b = 2.45e-3 * b_sat / 1.822;
     let (c, kappa, alpha) = (0.736, 943.0, 3.66e-3);

@@ -37,7 +37,7 @@
 //! that really holds the residual. The top region is named as holding the
 //! residual when its concentration (residual share / time share) is at least
 //! 1.5 and its excess at least 15 %. Each region also reports its share of
-//! Σ |φ̇| r², the numerator of the eq. (81) error the diagnosis ranks by.
+//! Σ |φ̇| r², the numerator of the [JA 81] error the diagnosis ranks by.
 //!
 //! **Edge timing**: a voltage step falls anywhere inside its sample interval;
 //! where the replay places it off by δ, the current right after it is off by
@@ -104,7 +104,7 @@ pub struct Signals<'a> {
     pub i_measured: &'a [f64],
     /// Simulated coil current [A].
     pub i_simulated: &'a [f64],
-    /// |φ̇| estimated from the data: the weights of eq. (81).
+    /// |φ̇| estimated from the data: the weights of [JA 81].
     pub weight: &'a [f64],
     /// Simulated position (gap length) [m].
     pub z_simulated: &'a [f64],
@@ -155,7 +155,7 @@ pub struct RegionShare {
     pub time_share: f64,
     /// Fraction of Σ r² in the region.
     pub residual_share: f64,
-    /// Fraction of Σ |φ̇| r² in the region: its part of the numerator of eq. (81).
+    /// Fraction of Σ |φ̇| r² in the region: its part of the numerator of [JA 81].
     pub weighted_share: f64,
     /// residual_share / time_share (1 for a residual spread evenly; 0 when empty).
     pub concentration: f64,

@@ -1,6 +1,6 @@
 //! Model-discrepancy diagnosis (`reldesign diagnose`, `shared/spec/measured-data.md`):
 //! replay the measured voltage through the model, measure the |φ̇|-weighted
-//! current error (eq. 81), fit every extension of the vocabulary on the first
+//! current error ([JA 81]), fit every extension of the vocabulary on the first
 //! part of the record, rank them by BIC against the baseline's own best
 //! (its resistance refitted), and check the winner on the held-out rest.
 //! A cause is named only where the record identifies it (`record_lacks`,
@@ -159,7 +159,7 @@ pub struct Diagnosis {
     /// Replays of the baseline and of the extended model over the whole record.
     pub baseline_replay: SimOutputs,
     pub extended_replay: SimOutputs,
-    /// The |φ̇| weights of eq. 81, from the data.
+    /// The |φ̇| weights of [JA 81], from the data.
     pub weights: Vec<f64>,
     /// Samples of the record used by the fits (the rest is held out).
     pub fitted_samples: usize,

@@ -2,7 +2,7 @@
 //! (BIC), and the noise floor below which no extension is worth its
 //! parameters.
 //!
-//! The residual that a fit minimises is weighted by |φ̇| (eq. 81), so its
+//! The residual that a fit minimises is weighted by |φ̇| ([JA 81]), so its
 //! samples do not count equally: the BIC uses the effective sample count
 //! n_eff = (Σw)²/Σw² of the weights (Kish), which equals n for equal weights
 //! and is smaller when the weight concentrates in the transients.
@@ -98,7 +98,7 @@ pub fn with_noise(x: &[f64], sigma: f64, seed: u64) -> Vec<f64> {
         .collect()
 }
 
-/// The wNRMSE (81) that white current noise of standard deviation `sigma`
+/// The wNRMSE [JA 81] that white current noise of standard deviation `sigma`
 /// alone gives against the measured current `i` with weights `w`.
 pub fn noise_floor(sigma: f64, i: &[f64], w: &[f64]) -> f64 {
     let sw: f64 = w.iter().sum();

@@ -1,4 +1,4 @@
-//! The extended Kalman filter on the discretised model (84)–(87) with the
+//! The extended Kalman filter on the discretised model [JA 84–87] with the
 //! model's symbolic Jacobians ([`Linearised`]).
 //!
 //! One [`Ekf::step`] at sample k, with the input u held over the last
@@ -14,7 +14,7 @@
 //!    symmetric and positive semi-definite for any rounding of K). Skipped,
 //!    and counted in [`Ekf::skipped`], when u, y_k, S or the innovation is
 //!    not finite;
-//! 3. z, z_prev projected onto [z_min, z_max]; the estimate (85)–(87).
+//! 3. z, z_prev projected onto [z_min, z_max]; the estimate [JA 85–87].
 
 use crate::linalg::{self, Matrix, Scalar};
 

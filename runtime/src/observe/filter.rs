@@ -1,7 +1,7 @@
 //! What the EKF and the UKF share: the posterior (x, P) with its
 //! bookkeeping, and the steps around the two filters' own algebra — the held
 //! input, the stop rule of the prediction, the restart after a non-finite
-//! prediction, the correction, and the estimate (85)–(87) of the projected
+//! prediction, the correction, and the estimate [JA 85–87] of the projected
 //! posterior.
 
 use crate::linalg::{self, Matrix, Scalar};
@@ -13,9 +13,9 @@ use super::model::{DiscreteModel, Settings};
 pub struct Estimate<T> {
     /// z [m], in [z_min, z_max].
     pub z: T,
-    /// v [m/s] = (z − z_prev)/T_s (85).
+    /// v [m/s] = (z − z_prev)/T_s [JA 85].
     pub v: T,
-    /// a [m/s²] (87): f_v(z, v, φ) in mode 2, else 0.
+    /// a [m/s²] [JA 87]: f_v(z, v, φ) in mode 2, else 0.
     pub a: T,
     /// φ [Wb].
     pub phi: T,
@@ -23,12 +23,12 @@ pub struct Estimate<T> {
     pub hc: Option<T>,
     /// R [Ω], when the coil resistance is estimated.
     pub r: Option<T>,
-    /// q of (86): 1 at z_min, 2 moving, 3 at z_max (within the mode band of
+    /// q of [JA 86]: 1 at z_min, 2 moving, 3 at z_max (within the mode band of
     /// a stop).
     pub mode: u8,
 }
 
-/// (86) with the band: 1 within it of z_min, 3 within it of z_max, else 2
+/// [JA 86] with the band: 1 within it of z_min, 3 within it of z_max, else 2
 /// (also for a NaN z).
 #[inline]
 pub fn mode_of<T: Scalar, const N: usize>(z: T, s: &Settings<T, N>) -> u8 {
@@ -43,8 +43,8 @@ pub fn mode_of<T: Scalar, const N: usize>(z: T, s: &Settings<T, N>) -> u8 {
 
 /// The stop the estimate stays on over the next sample: the free
 /// acceleration points into a stop (the automaton's lift-off guard does not
-/// fire) and the estimate is on it by its mode (86), or reaches it within the
-/// sample (its own prediction (84a) `z_next` saturates there); the
+/// fire) and the estimate is on it by its mode [JA 86], or reaches it within the
+/// sample (its own prediction [JA 84a] `z_next` saturates there); the
 /// prediction then keeps z = the stop. A NaN acceleration stays nowhere.
 #[inline]
 pub fn resting_stop<T: Scalar, const N: usize>(
@@ -162,7 +162,7 @@ impl<T: Scalar, const N: usize> Posterior<T, N> {
     }
 
     /// Counts a skipped update; projects z, z_prev onto [z_min, z_max]; the
-    /// estimate (85)–(87) at that posterior, f_v of (87) only in mode 2; the
+    /// estimate [JA 85–87] at that posterior, f_v of [JA 87] only in mode 2; the
     /// clock moves on to the next sample.
     #[inline]
     pub fn estimate<M: DiscreteModel<T, N>>(

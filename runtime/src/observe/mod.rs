@@ -1,5 +1,5 @@
 //! Kalman filters on the discretised model of a single-coil actuator
-//! (jiles-atherton-actuator-model §6.1, (84)–(87)), written once for every
+//! (jiles-atherton-actuator-model [JA §6.1], [JA 84–87]), written once for every
 //! model and float type: the extended filter [`Ekf`] and the unscented
 //! filter [`Ukf`], generic over the float `T`, the number of states N and the
 //! model `M`. Generated code supplies the model (its functions on a
@@ -10,7 +10,7 @@
 //! | file | concept |
 //! | --- | --- |
 //! | `model.rs` | the model traits and the settings |
-//! | `filter.rs` | the posterior, the input, the stop rule, the estimate (85)–(87) |
+//! | `filter.rs` | the posterior, the input, the stop rule, the estimate [JA 85–87] |
 //! | `ekf.rs` | the extended Kalman filter (Joseph form) |
 //! | `ukf.rs` | the unscented Kalman filter (sigma points, repaired factorisations) |
 

@@ -1,5 +1,5 @@
 //! The discretised model as the filters see it (jiles-atherton-actuator-model
-//! §6.1, (84)–(87)): the traits a model implements (generated code with
+//! [JA §6.1], [JA 84–87]): the traits a model implements (generated code with
 //! straight-line functions on a zero-sized type, the designer with tapes)
 //! and the settings the filters read (noise, x₀, P₀, the stops, the
 //! unscented transform's weights) as plain data.
@@ -19,7 +19,7 @@ pub struct Settings<T, const N: usize> {
     pub z_min: T,
     /// z_max [m]: the upper stop.
     pub z_max: T,
-    /// (86): the estimate rests on a stop within this distance [m] of it.
+    /// [JA 86]: the estimate rests on a stop within this distance [m] of it.
     pub mode_band: T,
     /// σ_u²: variance of the measured input's noise (Q gets σ_u²·g·gᵀ,
     /// g = ∂F/∂u; the measurement σ_u²·(∂h/∂u)²).
@@ -57,12 +57,12 @@ pub struct Weights<T> {
     pub other: T,
 }
 
-/// F(x, u) of (84) and f_v of (87) at x: a prediction.
+/// F(x, u) of [JA 84] and f_v of [JA 87] at x: a prediction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Prediction<T, const N: usize> {
     /// x_{k+1} = F(x_k, u).
     pub next: [T; N],
-    /// (87) f_v(z, v, φ) at x_k, v of (85): where the armature is pushed.
+    /// [JA 87] f_v(z, v, φ) at x_k, v of [JA 85]: where the armature is pushed.
     pub accel: T,
 }
 
@@ -89,14 +89,14 @@ pub struct Reading<T> {
 /// x [s] from the first sample (only a model whose resistance drifts reads
 /// it).
 pub trait DiscreteModel<T: Scalar, const N: usize>: Configured<T, N> {
-    /// (87) f_v(z, v, φ) at x, v of (85): the estimate's acceleration.
+    /// [JA 87] f_v(z, v, φ) at x, v of [JA 85]: the estimate's acceleration.
     fn acceleration(&mut self, x: &[T; N], u: T, t: T) -> T;
 }
 
 /// The model functions of the extended Kalman filter: F and h with their
 /// symbolic Jacobians.
 pub trait Linearised<T: Scalar, const N: usize>: DiscreteModel<T, N> {
-    /// (84)–(85) with ∂F/∂x and ∂F/∂u at (x, u).
+    /// [JA 84–85] with ∂F/∂x and ∂F/∂u at (x, u).
     fn transition(&mut self, x: &[T; N], u: T, t: T) -> Linearisation<T, N>;
 
     /// h, ∂h/∂u and ∂h/∂x at (x, u).
@@ -106,7 +106,7 @@ pub trait Linearised<T: Scalar, const N: usize>: DiscreteModel<T, N> {
 /// The model functions of the unscented Kalman filter: F and h at the
 /// sigma points, and g = ∂F/∂u for the input's noise.
 pub trait Sampled<T: Scalar, const N: usize>: DiscreteModel<T, N> {
-    /// (84)–(85) at (x, u).
+    /// [JA 84–85] at (x, u).
     fn transition(&mut self, x: &[T; N], u: T, t: T) -> Prediction<T, N>;
 
     /// h and ∂h/∂u at (x, u).

@@ -1,5 +1,5 @@
-//! The unscented Kalman filter on the discretised model (84)–(87)
-//! ([`Sampled`]), as in jiles-atherton-actuator-model §6.1.
+//! The unscented Kalman filter on the discretised model [JA 84–87]
+//! ([`Sampled`]), as in jiles-atherton-actuator-model [JA §6.1].
 //!
 //! Sigma points χ₀ = x̄, χ_{1+j} = x̄ + γ·Lⱼ, χ_{1+N+j} = x̄ − γ·Lⱼ (Lⱼ the
 //! columns of the lower Cholesky factor of P; γ and the weights in
@@ -7,7 +7,7 @@
 //! input u held over the last sample and the output y_k measured now:
 //!
 //! 1. prediction with u (the last finite input if u is not): the last
-//!    posterior's sigma points through F (84), x̄ = Σ Wᵢᵐ·F(χᵢ),
+//!    posterior's sigma points through F [JA 84], x̄ = Σ Wᵢᵐ·F(χᵢ),
 //!    P = Σ Wᵢᶜ·(F(χᵢ) − x̄)(F(χᵢ) − x̄)ᵀ + Q, Q as in the EKF with g = ∂F/∂u
 //!    at the posterior mean; on a stop (or reaching it, f_v into it) every
 //!    point keeps z = the stop. A non-finite result restarts the filter from
@@ -17,7 +17,7 @@
 //!    P_xy = Σ Wᵢᶜ·(χᵢ − x̄)·(yᵢ − ŷ), K = P_xy/S, x̄ ← x̄ + K·(y_k − ŷ),
 //!    P ← P − S·K·Kᵀ (exactly symmetric). Skipped, and counted, when u, y_k,
 //!    S or the innovation is not finite;
-//! 3. z, z_prev projected onto [z_min, z_max]; the estimate (85)–(87).
+//! 3. z, z_prev projected onto [z_min, z_max]; the estimate [JA 85–87].
 //!
 //! Both steps factor P. When the factorisation fails (P not numerically
 //! positive definite) P is repaired, first by jitter on the diagonal,
@@ -117,7 +117,7 @@ impl<M: Sampled<T, N>, T: Jitter, const N: usize, const P: usize> Ukf<M, T, N, P
         self.post.estimate(&mut self.model, updated, held.u, &s)
     }
 
-    /// The last posterior's sigma points through (84), u held over the last
+    /// The last posterior's sigma points through [JA 84], u held over the last
     /// sample; the mean, and their covariance plus Q.
     fn predict(&mut self, u: T, t: T, s: &Settings<T, N>) {
         let w = s.unscented;

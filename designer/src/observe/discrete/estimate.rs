@@ -8,9 +8,9 @@ use crate::sim::Mode;
 pub struct Estimate {
     /// z [m]
     pub z: f64,
-    /// v [m/s] of (85)
+    /// v [m/s] of [JA 85]
     pub v: f64,
-    /// a [m/s²] of (87)
+    /// a [m/s²] of [JA 87]
     pub a: f64,
     /// φ [Wb]
     pub phi: f64,
@@ -18,12 +18,12 @@ pub struct Estimate {
     pub hc: Option<f64>,
     /// R [Ω] (when estimated)
     pub r: Option<f64>,
-    /// (86), with the band of [`super::DiscreteModel::mode_band`]
+    /// [JA 86], with the band of [`super::DiscreteModel::mode_band`]
     pub mode: Mode,
 }
 
 impl From<reldesign_runtime::observe::Estimate<f64>> for Estimate {
-    /// The runtime's estimate with its mode q of (86) as a [`Mode`].
+    /// The runtime's estimate with its mode q of [JA 86] as a [`Mode`].
     fn from(e: reldesign_runtime::observe::Estimate<f64>) -> Estimate {
         Estimate {
             z: e.z,

@@ -1,4 +1,4 @@
-//! The discretised model of jiles-atherton-actuator-model §6.1 (eqs. 84–87),
+//! The discretised model of jiles-atherton-actuator-model [JA §6.1] ([JA 84–87]),
 //! built by the symbolic core from the model's own expressions, with the
 //! measurement and the Jacobians the EKF needs.
 //!
@@ -9,23 +9,23 @@
 //!
 //! | quantity | expression |
 //! | --- | --- |
-//! | (85) velocity | v = (z − z_prev)/T_s |
-//! | (84a) position | z⁺ = sat_{z_min}^{z_max}(2z − z_prev + T_s²·f_v(z, v, φ)) |
-//! | (84b) previous position | z_prev⁺ = sat_{z_min}^{z_max}(z) (= z for every state (84a) produces) |
-//! | (84c) flux | φ⁺ = φ + T_s·f_φ(z, φ, H_c, u) |
-//! | (84d) core field | H_c⁺ = H_c + T_s·f_Hc(z, φ, H_c, u) |
+//! | [JA 85] velocity | v = (z − z_prev)/T_s |
+//! | [JA 84a] position | z⁺ = sat_{z_min}^{z_max}(2z − z_prev + T_s²·f_v(z, v, φ)) |
+//! | [JA 84b] previous position | z_prev⁺ = sat_{z_min}^{z_max}(z) (= z for every state [JA 84a] produces) |
+//! | [JA 84c] flux | φ⁺ = φ + T_s·f_φ(z, φ, H_c, u) |
+//! | [JA 84d] core field | H_c⁺ = H_c + T_s·f_Hc(z, φ, H_c, u) |
 //! | coil resistance (optional) | R⁺ = R (random walk: w_R of σ = σ_Ṙ·T_s, as semera's q_r) |
-//! | (86) mode | 1 if z ≤ z_min + band, 3 if z ≥ z_max − band, else 2 |
-//! | (87) acceleration | a = f_v(z, v, φ) in mode 2, else 0 |
+//! | [JA 86] mode | 1 if z ≤ z_min + band, 3 if z ≥ z_max − band, else 2 |
+//! | [JA 87] acceleration | a = f_v(z, v, φ) in mode 2, else 0 |
 //! | measurement | y = h(z, φ, H_c, u): the coil current (voltage drive), the coil voltage (current drive) |
 //!
 //! f_v, f_φ, f_Hc and h are the model's expressions (`Model::f`,
-//! `Model::current`/`Model::voltage`) with v replaced by (85). The model is
+//! `Model::current`/`Model::voltage`) with v replaced by [JA 85]. The model is
 //! defined on [z_min, z_max] (and |φ| < φ_sat for the saturating core): the
 //! filters evaluate it at z clamped to [z_min, z_max] (and φ clamped to
 //! ±(1 − 10⁻³)·φ_sat), so that sigma points and corrections that leave the
 //! domain give finite values (the McLyman logarithm is undefined below
-//! z_min, R_core is infinite at φ_sat); (84a) and (85) use z itself. (84b)
+//! z_min, R_core is infinite at φ_sat); [JA 84a] and [JA 85] use z itself. [JA 84b]
 //! saturates too: a sigma point beyond a stop (the UKF spreads them by
 //! ±γ·σ_z around an estimate that rests on it) would otherwise carry the
 //! spurious velocity (z_next − z)/T_s of its saturation into the next step,
@@ -42,7 +42,7 @@
 //! **Noise.** w_z, w_φ, w_Hc (, w_R) are independent with the standard deviations of
 //! [`KalmanSettings`] (per step). The measured input u (σ_u: the voltage
 //! noise, or the current noise with current drive) enters the transition
-//! through (84c)–(84d); its noise is mapped into the process noise to first
+//! through [JA 84c–84d]; its noise is mapped into the process noise to first
 //! order: Q = diag(q_z², 0, q_φ², q_Hc²) + σ_u²·g·gᵀ with g = ∂F/∂u at the
 //! estimate. The measured u also enters the measurement (the eddy term
 //! k_e·u of the current): R = σ_y² + σ_u²·(∂h/∂u)². The update at k and the
@@ -55,7 +55,7 @@
 //! over the last sample ((t_{k−1}, t_k], what the controller applied after the
 //! previous step) and y_k the output sampled at t_k, before the next input is
 //! applied. It predicts the prior x_{k|k−1} from the last posterior with u
-//! (zero-order hold, forward Euler (84c)), updates it with y_k (h at the same
+//! (zero-order hold, forward Euler [JA 84c]), updates it with y_k (h at the same
 //! held u: the eddy term k_e·u of the current) and reports the posterior,
 //! which the controller uses at once. (Updating first and predicting with the
 //! same u would use each input one sample late: in closed loop, where u
@@ -63,20 +63,20 @@
 //! for 10 V on the perfect-tracking valve, and biased the position estimate
 //! by 10–40 µm at the end of a stroke.)
 //!
-//! **Mode band.** (86) compares z with the limits; after a measurement update
+//! **Mode band.** [JA 86] compares z with the limits; after a measurement update
 //! the estimate of a resting armature sits within a few σ of w_z of its stop
-//! (the correction moves it, the saturation of (84a) puts it back). The
+//! (the correction moves it, the saturation of [JA 84a] puts it back). The
 //! estimate counts as resting when it is within [`MODE_BAND_SIGMAS`]·q_z of a
 //! limit. The posterior z and z_prev are projected onto [z_min, z_max].
 //!
 //! **At a stop.** When the estimate is on a stop (mode 1 or 3) or reaches it
-//! within the sample (its own prediction (84a) saturates there) and the free
+//! within the sample (its own prediction [JA 84a] saturates there) and the free
 //! acceleration f_v at the estimate points into that stop, the automaton's
 //! lift-off guard does not fire and the armature stays (or, arriving, sticks
-//! as (84a) has it): the prediction sets z⁺ = the stop for the estimate and
+//! as [JA 84a] has it): the prediction sets z⁺ = the stop for the estimate and
 //! for every sigma point, with a zero row of ∂F/∂x for z (the EKF: what the
-//! saturation (84a) of the estimate gives anyway); z_prev⁺ stays (84b), so
-//! that v of (85) is the arrival's average velocity for one more sample,
+//! saturation [JA 84a] of the estimate gives anyway); z_prev⁺ stays [JA 84b], so
+//! that v of [JA 85] is the arrival's average velocity for one more sample,
 //! then 0. Without it the UKF's sigma points below the stop (spread by the
 //! measurement noise) are pushed back by f_v only slowly, the clamped ones
 //! not at all, and the mean of the truncated spread hovers ≈ γ·σ_z off the
@@ -85,7 +85,7 @@
 //!
 //! | file | concept |
 //! | --- | --- |
-//! | `mod.rs` | the model (84)–(87) in the symbolic core, its Jacobians, the runtime filters' settings |
+//! | `mod.rs` | the model [JA 84–87] in the symbolic core, its Jacobians, the runtime filters' settings |
 //! | `settings.rs` | `[observer.kalman]`: [`KalmanSettings`], [`ResistanceSettings`], [`KalmanError`] |
 //! | `tapes.rs` | the model on tapes, and [`TapeModel`]: the runtime's model traits for the reference filters |
 //! | `estimate.rs` | the designer's [`Estimate`] |
@@ -131,7 +131,7 @@ pub enum StateKind {
     Resistance,
 }
 
-/// The discretised model (84)–(87) as expressions in a graph of its own
+/// The discretised model [JA 84–87] as expressions in a graph of its own
 /// (the model's graph plus the new symbols), parameters symbolic.
 #[derive(Clone)]
 pub struct DiscreteModel {
@@ -158,11 +158,11 @@ pub struct DiscreteModel {
     /// Whether any expression depends on t.
     pub uses_time: bool,
     pub drive: Drive,
-    /// (84): x_{k+1} = F(x_k, u_k), one expression per state.
+    /// [JA 84]: x_{k+1} = F(x_k, u_k), one expression per state.
     pub transition: Vec<Id>,
-    /// (85) v = (z − z_prev)/T_s.
+    /// [JA 85] v = (z − z_prev)/T_s.
     pub velocity: Id,
-    /// f_v(z, v, φ) with v of (85): the acceleration of (87) in mode 2.
+    /// f_v(z, v, φ) with v of [JA 85]: the acceleration of [JA 87] in mode 2.
     pub acceleration: Id,
     /// y = h(x, u): the measured coil quantity.
     pub measurement: Id,
@@ -176,7 +176,7 @@ pub struct DiscreteModel {
     pub measurement_input_gain: Id,
     pub z_min: f64,
     pub z_max: f64,
-    /// (86): the estimate rests on a stop within this distance of it.
+    /// [JA 86]: the estimate rests on a stop within this distance of it.
     pub mode_band: f64,
     /// σ of the input's noise (voltage noise, or current noise with current drive).
     pub input_noise: f64,
@@ -251,7 +251,7 @@ impl DiscreteModel {
         let hc = model.states.get(3).copied();
         let u = model.input;
 
-        // (85) v = (z − z_prev)/T_s
+        // [JA 85] v = (z − z_prev)/T_s
         let dz = g.sub(z, z_prev);
         let velocity = g.div(dz, ts);
         // the model's domain: z ∈ [z_min, z_max] (|φ| ≤ φ_lim)
@@ -273,18 +273,18 @@ impl DiscreteModel {
         let subst = g.substitute_all(&roots, &map);
         let (f_v, f_phi, measurement) = (subst[1], subst[2], subst[model.dim()]);
 
-        // (84a) z⁺ = sat(2z − z_prev + T_s²·f_v)
+        // [JA 84a] z⁺ = sat(2z − z_prev + T_s²·f_v)
         let two_z = g.scale(2.0, z);
         let ts2 = g.powi(ts, 2);
         let step = g.mul(ts2, f_v);
         let neg_prev = g.neg(z_prev);
         let raw = g.sum(&[two_z, neg_prev, step]);
         let z_next = clamp(&mut g, raw, z_lo, z_hi);
-        // (84c) φ⁺ = φ + T_s·f_φ
+        // [JA 84c] φ⁺ = φ + T_s·f_φ
         let dphi = g.mul(ts, f_phi);
         let phi_next = g.add(phi, dphi);
-        // (84b) z_prev⁺ = z, as sat(z): the same for every state (84a) gives,
-        // and no spurious velocity (85) from sigma points beyond a stop
+        // [JA 84b] z_prev⁺ = z, as sat(z): the same for every state [JA 84a] gives,
+        // and no spurious velocity [JA 85] from sigma points beyond a stop
         let mut states = vec![z, z_prev, phi];
         let mut kinds = vec![
             StateKind::Position,
@@ -293,7 +293,7 @@ impl DiscreteModel {
         ];
         let mut transition = vec![z_next, z_dom, phi_next];
         if let Some(hc) = hc {
-            // (84d) H_c⁺ = H_c + T_s·f_Hc
+            // [JA 84d] H_c⁺ = H_c + T_s·f_Hc
             let dh = g.mul(ts, subst[3]);
             states.push(hc);
             kinds.push(StateKind::CoreField);

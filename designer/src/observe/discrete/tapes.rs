@@ -21,7 +21,7 @@ pub struct DiscreteTapes {
     measurement: Tape,
     /// ∂F/∂u (n).
     input_gain: Tape,
-    /// f_v (87).
+    /// f_v [JA 87].
     acceleration: Tape,
     scratch: [Vec<f64>; 5],
     inputs: [f64; 6],
@@ -93,7 +93,7 @@ impl DiscreteTapes {
         n + 2
     }
 
-    /// (84), and f_v at x.
+    /// [JA 84], and f_v at x.
     pub fn predict(&mut self, x: &[f64; 4], u: f64, t: f64) -> Prediction {
         let m = self.set_inputs(x, u, t);
         let mut out = [0.0; 5];
@@ -137,7 +137,7 @@ impl DiscreteTapes {
         gain
     }
 
-    /// f_v(z, v, φ) of (87) at x (v of (85)).
+    /// f_v(z, v, φ) of [JA 87] at x (v of [JA 85]).
     pub fn acceleration(&mut self, x: &[f64; 4], u: f64, t: f64) -> f64 {
         let m = self.set_inputs(x, u, t);
         let mut out = [0.0; 1];
