@@ -70,7 +70,7 @@ macro_rules! kalman {
         /// φ_lim [Wb]: the filters evaluate the saturating core at |φ| ≤ φ_lim (R_core is
         /// infinite at φ_sat).
         pub const PHI_LIM: $f = (1.0 - 0.001) * PHI_SAT;
-        /// The filters' settings. Mode band of (86): 3·q_z. Q = diag(q_z², 0, q_φ²(, q_Hc²)) +
+        /// The filters' settings. Mode band of [JA 86]: 3·q_z. Q = diag(q_z², 0, q_φ²(, q_Hc²)) +
         /// σ_u²·g·gᵀ (g = ∂F/∂u: the measured input's noise), measurement variance
         /// σ_y² + σ_u²·(∂h/∂u)². x₀: at rest at z_max, φ = 0(, H_c = 0). P₀: z and z_prev share
         /// the initial σ (at rest: v = 0 is known), each with q_z² added so that P₀ is positive
@@ -336,16 +336,16 @@ pub mod f32 {
         }
     }
 
-    /// u of the tracking law (50), not saturated and not guarded.
+    /// u of the tracking law [PT 50], not saturated and not guarded.
     #[must_use]
     pub fn law(z: f32, v: f32, phi: f32, zr: f32, vr: f32, ar: f32, jr: f32) -> f32 {
         law_terms(z, v, phi, zr, vr, ar, jr).u
     }
 
-    /// The law (50) as applied (`reldesign_runtime::control::guarded_law`): if
+    /// The law [PT 50] as applied (`reldesign_runtime::control::guarded_law`): if
     /// φ ≤ `PHI_GUARD` (φ → 0, where β = 1/L_g L_f²h blows up and D₀⁺ is left) it
     /// is not evaluated and u = u_max drives the flux back into D₀⁺; otherwise u
-    /// of (50). Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
+    /// of [PT 50]. Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
     /// ±∞ to the bounds).
     #[must_use]
     pub fn guarded_law(
@@ -369,7 +369,7 @@ pub mod f32 {
         Opening,
     }
 
-    /// This module's design (limits, timing, guards, tables, the law (50)) as the
+    /// This module's design (limits, timing, guards, tables, the law [PT 50]) as the
     /// runtime's soft-landing logic reads it.
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
     pub struct Design;
@@ -418,7 +418,7 @@ pub mod f32 {
     /// One operation of the actuator (`reldesign_runtime::control::SoftLanding`):
     /// pre-movement stage before t₀ (ξ_r = [z₀, 0, 0], which brings ξ₃ to 0 so the
     /// forces balance at takeoff), tracking of the table on [t₀, t_f], hold at z_f
-    /// after t_f with the expert rules of model-free-sliding-mode (43) at the end
+    /// after t_f with the expert rules of model-free-sliding-mode [SM 43] at the end
     /// stop; `new`, `start`, `reference`, `step`. Allocation- and panic-free.
     pub type Controller = control::SoftLanding<Design, f32>;
 }
@@ -642,16 +642,16 @@ pub mod f64 {
         }
     }
 
-    /// u of the tracking law (50), not saturated and not guarded.
+    /// u of the tracking law [PT 50], not saturated and not guarded.
     #[must_use]
     pub fn law(z: f64, v: f64, phi: f64, zr: f64, vr: f64, ar: f64, jr: f64) -> f64 {
         law_terms(z, v, phi, zr, vr, ar, jr).u
     }
 
-    /// The law (50) as applied (`reldesign_runtime::control::guarded_law`): if
+    /// The law [PT 50] as applied (`reldesign_runtime::control::guarded_law`): if
     /// φ ≤ `PHI_GUARD` (φ → 0, where β = 1/L_g L_f²h blows up and D₀⁺ is left) it
     /// is not evaluated and u = u_max drives the flux back into D₀⁺; otherwise u
-    /// of (50). Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
+    /// of [PT 50]. Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
     /// ±∞ to the bounds).
     #[must_use]
     pub fn guarded_law(
@@ -675,7 +675,7 @@ pub mod f64 {
         Opening,
     }
 
-    /// This module's design (limits, timing, guards, tables, the law (50)) as the
+    /// This module's design (limits, timing, guards, tables, the law [PT 50]) as the
     /// runtime's soft-landing logic reads it.
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
     pub struct Design;
@@ -724,7 +724,7 @@ pub mod f64 {
     /// One operation of the actuator (`reldesign_runtime::control::SoftLanding`):
     /// pre-movement stage before t₀ (ξ_r = [z₀, 0, 0], which brings ξ₃ to 0 so the
     /// forces balance at takeoff), tracking of the table on [t₀, t_f], hold at z_f
-    /// after t_f with the expert rules of model-free-sliding-mode (43) at the end
+    /// after t_f with the expert rules of model-free-sliding-mode [SM 43] at the end
     /// stop; `new`, `start`, `reference`, `step`. Allocation- and panic-free.
     pub type Controller = control::SoftLanding<Design, f64>;
 }

@@ -1,5 +1,5 @@
 //! The expression layer: `Copy` handles with arithmetic operators, so that
-//! model code reads like the equation it cites, e.g. (30) with the clamp (52):
+//! model code reads like the equation it cites, e.g. a clamped derivative:
 //! `let dbc = (1.0 + MU0 * (1.0 - alpha) * dmc).max(eps);`.
 //!
 //! Every operator and method calls the one smart constructor of `build.rs`
