@@ -20,9 +20,8 @@ fn main() {
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("OUT_DIR"));
     let d = parse_file(&toml).unwrap_or_else(|e| panic!("{e}"));
     // the whole file `reldesign build` writes: `params!`, then `pub mod estimators`
-    let code = reldesign_build::Design::new(&d)
-        .and_then(|design| design.emit())
-        .unwrap_or_else(|e| panic!("{e}"));
+    let design = designer::design::Design::new(&d).unwrap_or_else(|e| panic!("{e}"));
+    let code = reldesign_build::emit(&design).unwrap_or_else(|e| panic!("{e}"));
     std::fs::write(out.join("semera.rs"), code).unwrap();
 
     let o = d.observer.as_ref().unwrap();
