@@ -2,12 +2,8 @@
 //! every model parameter and the stroke limits `Z_MIN`, `Z_MAX` on exactly
 //! one line, the file's one `params!` macro, whatever the number of float
 //! modules; changing one parameter changes that line and the source hash.
-//!
-//! Scope until the observer modules invoke `params!` too (helper OBSERVE's
-//! branch): the freshly emitted descriptions are controller-only, and in the
-//! checked-in `generated/src/perfect_tracking_valve.rs` the modules listed in
-//! [`NOT_YET_ON_PARAMS`] are left out. After the merge that list is empty
-//! and the observer sections stay in the descriptions.
+//! The controller, the filters and the estimators all invoke `params!`, so
+//! the whole file is checked, observer sections included.
 
 use std::path::{Path, PathBuf};
 
@@ -15,20 +11,16 @@ use designer::description::parse_str;
 use designer::design::Design;
 use reldesign_build::{const_name, emit};
 
-/// Top-level modules that still declare the parameters themselves.
-const NOT_YET_ON_PARAMS: &[&str] = &["ekf", "ukf"];
+/// Top-level modules that declare the parameters themselves: none.
+const NOT_YET_ON_PARAMS: &[&str] = &[];
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// A description's text, cut before its first `[observer` section.
-fn controller_only(path: &str) -> String {
-    let text = std::fs::read_to_string(root().join(path)).unwrap();
-    match text.find("\n[observer") {
-        Some(k) => text[..=k].to_owned(),
-        None => text,
-    }
+/// A description's whole text (controller and observer sections).
+fn description_text(path: &str) -> String {
+    std::fs::read_to_string(root().join(path)).unwrap()
 }
 
 /// The emitted file and the (const name, value text) of every parameter.
@@ -95,7 +87,7 @@ fn a_freshly_emitted_file_declares_each_parameter_once() {
         "examples/perfect-tracking-valve.toml",
         "tests/data/relay-12v.toml",
     ] {
-        let (code, params) = build(&controller_only(path), path);
+        let (code, params) = build(&description_text(path), path);
         assert!(code.contains("pub mod f32 {") && code.contains("pub mod f64 {"));
         assert_one_line_each(&code, &params, path);
     }
@@ -104,7 +96,7 @@ fn a_freshly_emitted_file_declares_each_parameter_once() {
 #[test]
 fn the_checked_in_file_declares_each_parameter_once() {
     let path = "examples/perfect-tracking-valve.toml";
-    let (_, params) = build(&controller_only(path), path);
+    let (_, params) = build(&description_text(path), path);
     let checked_in =
         std::fs::read_to_string(root().join("generated/src/perfect_tracking_valve.rs")).unwrap();
     let code = without_modules(&checked_in, NOT_YET_ON_PARAMS);
@@ -119,7 +111,7 @@ fn the_checked_in_file_declares_each_parameter_once() {
 fn one_parameter_change_is_one_changed_line_of_the_file() {
     let path = "tests/data/relay-12v.toml";
     let text =
-        controller_only(path).replacen("shape = \"energy-optimal\"", "shape = \"polynomial\"", 1);
+        description_text(path).replacen("shape = \"energy-optimal\"", "shape = \"polynomial\"", 1);
     assert!(text.contains("shape = \"polynomial\""));
     let changed = text.replacen("resistance = 160.0", "resistance = 161.5", 1);
     assert_ne!(text, changed);
