@@ -378,20 +378,20 @@ fn placeholder(table: &str) -> String {
     format!("__ROWS_OF_{table}__")
 }
 
-/// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.
-fn float_module(
-    graph: &Graph,
-    input: &ControllerInput,
-    law: &LawSymbols,
-    physical: &[Param],
-    float: Float,
-) -> Result<String, ControllerError> {
+/// The per-operation items of a float module.
+struct Operations {
+    /// The table consts, their rows left to [`splice_table`].
+    tables: TokenStream,
+    /// The `Operation` variants.
+    variants: TokenStream,
+    /// The match arms of `Law::motion`.
+    motions: TokenStream,
+}
+
+fn operations(input: &ControllerInput, float: Float) -> Result<Operations, ControllerError> {
     let ty = float.ty();
-    let module = format_ident!("{}", float.name());
-    let design = input.design;
-    let (law_fn, comments) = law_terms(graph, input, law, physical, float)?;
-    let consts = design_consts(design, float)?;
     let mech = &input.model.description.mechanics;
+    // the end stops by the names params! gives them
     let position = |name: &str, z: f64| -> Result<TokenStream, ControllerError> {
         Ok(if z == mech.z_min {
             quote!(Z_MIN)
@@ -401,10 +401,9 @@ fn float_module(
             lit(float, name, z)?
         })
     };
-
     let (mut tables, mut variants, mut motions) =
         (TokenStream::new(), TokenStream::new(), TokenStream::new());
-    for op in &design.operations {
+    for op in &input.design.operations {
         let (variant, table_name, landing, doc) = names(op.operation);
         let table = format_ident!("{table_name}");
         let n = Literal::usize_unsuffixed(op.table.segments.len());
@@ -426,7 +425,31 @@ fn float_module(
             },
         ));
     }
+    Ok(Operations {
+        tables,
+        variants,
+        motions,
+    })
+}
 
+/// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.
+fn float_module(
+    graph: &Graph,
+    input: &ControllerInput,
+    law: &LawSymbols,
+    physical: &[Param],
+    float: Float,
+) -> Result<String, ControllerError> {
+    let ty = float.ty();
+    let module = format_ident!("{}", float.name());
+    let design = input.design;
+    let (law_fn, comments) = law_terms(graph, input, law, physical, float)?;
+    let consts = design_consts(design, float)?;
+    let Operations {
+        tables,
+        variants,
+        motions,
+    } = operations(input, float)?;
     let law_args = quote!(z: #ty, v: #ty, phi: #ty, zr: #ty, vr: #ty, ar: #ty, jr: #ty);
     let tokens = quote! {
         #[doc = " The controller in this float type."]

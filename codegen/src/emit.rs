@@ -15,7 +15,7 @@ use crate::format::{comment_lets, format_items};
 use crate::lower::Lowerer;
 use crate::names::{camel, const_name, ident, Namer};
 use crate::param::Param;
-use crate::physical::{self, name_constants, Named};
+use crate::physical::{self, Constant, MU0_CONST, Z_EPS_CONST};
 use crate::plan::{plan, PlanRequest};
 
 /// What to emit as one function.
@@ -193,9 +193,9 @@ pub(crate) enum Inline {
     Always,
 }
 
-/// [`function_tokens`] with the given inlining attribute: physical
-/// constants named, parameter-only calls folded, then the plan (`plan.rs`),
-/// the lowering (`lower.rs`) and the function's tokens.
+/// [`function_tokens`] with the given inlining attribute: parameter-only
+/// calls folded (`fold.rs`), then the plan (`plan.rs`), the lowering
+/// (`lower.rs`, physical constants by name) and the function's tokens.
 pub(crate) fn function_tokens_inline(
     graph: &Graph,
     spec: &FunctionSpec,
@@ -209,15 +209,7 @@ pub(crate) fn function_tokens_inline(
         .map(|o| o.1)
         .chain(spec.named.iter().map(|n| n.1))
         .collect();
-    let named_consts = name_constants(graph, &roots, params);
     let mut all_params = params.to_vec();
-    let (graph, roots) = match &named_consts {
-        Some(n) => {
-            all_params.extend(n.local.iter().map(|(p, _)| *p));
-            (&n.graph, n.roots.clone())
-        }
-        None => (graph, roots),
-    };
     let folded = fold(graph, &all_params, &roots)?;
     let (graph, roots) = match &folded {
         Some(f) => {
@@ -243,19 +235,18 @@ pub(crate) fn function_tokens_inline(
         params: &param_ids,
         statics: HashMap::new(),
         defined: HashSet::new(),
+        available: [&MU0_CONST, &Z_EPS_CONST]
+            .into_iter()
+            .filter(|c| physical::available(c, params))
+            .collect(),
+        named: Vec::new(),
     };
-    let mut body = local_consts(
-        graph,
-        &roots,
-        named_consts.as_ref(),
-        folded.as_ref(),
-        spec.float,
-    )?;
+    let mut lets = TokenStream::new();
     for b in &plan.lets {
         let name = ident(&b.name);
         let rhs = lower.definition(b.id)?;
         lower.defined.insert(b.id);
-        body.extend(quote!(let #name = #rhs;));
+        lets.extend(quote!(let #name = #rhs;));
     }
     for (name, id) in &request.outputs {
         if plan.bound.get(id) == Some(name) {
@@ -263,11 +254,23 @@ pub(crate) fn function_tokens_inline(
         }
         let rhs = lower.operand(*id)?;
         let name = ident(name);
-        body.extend(quote!(let #name = #rhs;));
+        lets.extend(quote!(let #name = #rhs;));
     }
-    if lower.uses_real {
-        body = quote!(use reldesign_runtime::math::Real; #body);
-    }
+    let local: Vec<&Constant> = lower
+        .named
+        .iter()
+        .copied()
+        .filter(|c| !physical::provided(c, params))
+        .collect();
+    let mut body = if lower.uses_real {
+        quote!(
+            use reldesign_runtime::math::Real;
+        )
+    } else {
+        quote!()
+    };
+    body.extend(local_consts(&local, folded.as_ref(), spec.float)?);
+    body.extend(lets);
     Ok(assemble(spec, &request, &plan.input_used, body, inline))
 }
 
@@ -386,21 +389,17 @@ fn assemble(
     }
 }
 
-/// The function's own consts: the physical constants it uses (`physical.rs`),
-/// then its derived consts (`fold.rs`), each documented.
+/// The function's own consts: the physical constants it writes by name and
+/// nobody declared for it (`physical.rs`), then its derived consts
+/// (`fold.rs`), each documented.
 fn local_consts(
-    graph: &Graph,
-    roots: &[Id],
-    named: Option<&Named>,
+    physical: &[&Constant],
     folded: Option<&Folded>,
     float: Float,
 ) -> Result<TokenStream, EmitError> {
-    let reachable: HashSet<Id> = graph.postorder(roots).into_iter().collect();
-    let physical = named
-        .map_or(&[][..], |n| &n.local)
+    let physical = physical
         .iter()
-        .filter(|(p, _)| reachable.contains(&p.symbol))
-        .map(|(p, doc)| (p.name, p.value, (*doc).to_owned()));
+        .map(|c| (c.symbol, c.value, c.doc.to_owned()));
     let derived = folded.map_or(&[][..], |f| &f.derived).iter().map(|d| {
         let doc = format!(
             "{} (parameters only: evaluated when generated, so it changes with them)",

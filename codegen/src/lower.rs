@@ -11,7 +11,9 @@
 //!   are any (`inv_x * inv_x`), anything else as `Real::powf(x, e)`;
 //! - `select(c, a, b)` as `if c >= 0.0 { a } else { b }`;
 //! - functions, `min`, `max` through `reldesign_runtime::math::Real`, with
-//!   sign(0) = 0 (`Real::signum0`).
+//!   sign(0) = 0 (`Real::signum0`);
+//! - constants that are multiples of μ0, and Z_EPS, by name: `0.5 / MU0`
+//!   (`physical.rs`).
 //!
 //! Parentheses come from operator precedence, never from the tree shape.
 //! Bound nodes (inputs, parameter consts, earlier `let`s) print as names.
@@ -25,6 +27,7 @@ use quote::quote;
 use crate::error::EmitError;
 use crate::float::Float;
 use crate::names::ident;
+use crate::physical::{recognise, Constant, Named};
 
 /// Precedence of the printed form (higher binds tighter).
 const IF: u8 = 0;
@@ -76,6 +79,10 @@ pub(crate) struct Lowerer<'a> {
     pub statics: HashMap<Id, bool>,
     /// `let`s emitted so far (a node may be written through them).
     pub defined: HashSet<Id>,
+    /// Physical constants that may be written by name (`physical.rs`).
+    pub available: Vec<&'static Constant>,
+    /// Those written by name so far.
+    pub named: Vec<&'static Constant>,
 }
 
 impl Lowerer<'_> {
@@ -152,7 +159,14 @@ impl Lowerer<'_> {
             })
     }
 
-    fn constant(&self, value: f64) -> Result<Lowered, EmitError> {
+    fn constant(&mut self, value: f64) -> Result<Lowered, EmitError> {
+        if let Some(named) = self.named_constant(value.abs())? {
+            return Ok(if value < 0.0 {
+                Self::negate(named)
+            } else {
+                named
+            });
+        }
         let lit = self.literal(value)?;
         Ok(if value < 0.0 {
             Lowered {
@@ -163,6 +177,42 @@ impl Lowerer<'_> {
         } else {
             Lowered::new(lit, ATOM)
         })
+    }
+
+    /// `magnitude` (> 0) by name when it is k·μ0ᵉ or Z_EPS: `Z_EPS`,
+    /// `k / MU0`, `k * MU0 * MU0`, … (`physical.rs`).
+    fn named_constant(&mut self, magnitude: f64) -> Result<Option<Lowered>, EmitError> {
+        let Some(named) = recognise(magnitude) else {
+            return Ok(None);
+        };
+        let constant = named.constant();
+        if !self.available.contains(&constant) {
+            return Ok(None);
+        }
+        if !self.named.contains(&constant) {
+            self.named.push(constant);
+        }
+        let name = ident(constant.name);
+        Ok(Some(match named {
+            Named::ZEps { .. } => Lowered::new(quote!(#name), ATOM),
+            Named::Mu0 { k, e } => {
+                let power = match e.abs() {
+                    1 => Lowered::new(quote!(#name), ATOM),
+                    _ => Lowered::new(quote!(#name * #name), PRODUCT),
+                };
+                if e < 0 {
+                    Self::quotient(self.literal_lowered(k)?, vec![power])
+                } else if k == 1.0 {
+                    power
+                } else {
+                    Self::chain(vec![self.literal_lowered(k)?, power])
+                }
+            }
+        }))
+    }
+
+    fn literal_lowered(&self, value: f64) -> Result<Lowered, EmitError> {
+        Ok(Lowered::new(self.literal(value)?, ATOM))
     }
 
     fn call(&mut self, name: &str, args: &[Id]) -> Result<Lowered, EmitError> {

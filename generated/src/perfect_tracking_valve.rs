@@ -292,7 +292,6 @@ pub mod f32 {
         let f_passive = F0 + K_S * z + C * v;
         let inv_a_gap = 1.0_f32 / A_GAP;
         let phi_sq = phi * phi;
-        let inv_mu0 = 1.0_f32 / MU0;
         let z_reg = z + Z_EPS;
         let inv_z_reg = 1.0_f32 / z_reg;
         let fringe_log = Real::ln(2.0_f32 * L_W * inv_z_reg);
@@ -300,26 +299,26 @@ pub mod f32 {
         let inv_fringe_den = 1.0_f32 / fringe_den;
         let t0 = fringe_log - z * inv_z_reg;
         let t1 = 1.0_f32 - INV_SQRT_A_GAP * z * t0 * inv_fringe_den;
-        let f_mag = -0.5_f32 * inv_a_gap * inv_mu0 * phi_sq * inv_fringe_den * t1;
+        let f_mag = -0.5_f32 / MU0 * inv_a_gap * phi_sq * inv_fringe_den * t1;
         let f_net = f_mag - f_passive;
         // (41) ξ₃ = a(x) = L_f²h
         let xi3 = inv_m * f_net;
         let flux_den = N * N + R * K_E;
-        let r_gap = inv_a_gap * inv_mu0 * z * inv_fringe_den;
+        let r_gap = 1.0_f32 / MU0 * inv_a_gap * z * inv_fringe_den;
         // (31) L_f³h
         let lf3h = inv_m
             * (v
                 * (-K_S
-                    - 0.5_f32 * INV_SQRT_A_GAP * inv_a_gap * inv_mu0 * phi_sq
+                    - 0.5_f32 / MU0 * INV_SQRT_A_GAP * inv_a_gap * phi_sq
                         * (inv_fringe_den * inv_fringe_den)
                         * (2.0_f32 * INV_SQRT_A_GAP * z * (t0 * t0) * inv_fringe_den
                             - z * inv_z_reg * (z * inv_z_reg - 2.0_f32) - 2.0_f32 * t0))
                 - C * inv_m * f_net
-                + R * inv_a_gap * inv_mu0 / flux_den * phi_sq * inv_fringe_den * t1
+                + 1.0_f32 / MU0 * R * inv_a_gap / flux_den * phi_sq * inv_fringe_den * t1
                     * (R_CORE0 / (1.0_f32 - 1.0_f32 / PHI_SAT * Real::abs(phi))
                         + r_gap));
         // (32) β(x) = 1 / L_g L_f²h
-        let beta = -A_GAP * M * MU0 * flux_den / N * fringe_den / (phi * t1);
+        let beta = -MU0 * A_GAP * M * flux_den / N * fringe_den / (phi * t1);
         // (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
         let w = jr + GAIN_K1 * (zr - z) + GAIN_K2 * (vr - v) + GAIN_K3 * (ar - xi3);
         // (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
@@ -598,7 +597,6 @@ pub mod f64 {
         let f_passive = F0 + K_S * z + C * v;
         let inv_a_gap = 1.0_f64 / A_GAP;
         let phi_sq = phi * phi;
-        let inv_mu0 = 1.0_f64 / MU0;
         let z_reg = z + Z_EPS;
         let inv_z_reg = 1.0_f64 / z_reg;
         let fringe_log = Real::ln(2.0_f64 * L_W * inv_z_reg);
@@ -606,26 +604,26 @@ pub mod f64 {
         let inv_fringe_den = 1.0_f64 / fringe_den;
         let t0 = fringe_log - z * inv_z_reg;
         let t1 = 1.0_f64 - INV_SQRT_A_GAP * z * t0 * inv_fringe_den;
-        let f_mag = -0.5_f64 * inv_a_gap * inv_mu0 * phi_sq * inv_fringe_den * t1;
+        let f_mag = -0.5_f64 / MU0 * inv_a_gap * phi_sq * inv_fringe_den * t1;
         let f_net = f_mag - f_passive;
         // (41) ξ₃ = a(x) = L_f²h
         let xi3 = inv_m * f_net;
         let flux_den = N * N + R * K_E;
-        let r_gap = inv_a_gap * inv_mu0 * z * inv_fringe_den;
+        let r_gap = 1.0_f64 / MU0 * inv_a_gap * z * inv_fringe_den;
         // (31) L_f³h
         let lf3h = inv_m
             * (v
                 * (-K_S
-                    - 0.5_f64 * INV_SQRT_A_GAP * inv_a_gap * inv_mu0 * phi_sq
+                    - 0.5_f64 / MU0 * INV_SQRT_A_GAP * inv_a_gap * phi_sq
                         * (inv_fringe_den * inv_fringe_den)
                         * (2.0_f64 * INV_SQRT_A_GAP * z * (t0 * t0) * inv_fringe_den
                             - z * inv_z_reg * (z * inv_z_reg - 2.0_f64) - 2.0_f64 * t0))
                 - C * inv_m * f_net
-                + R * inv_a_gap * inv_mu0 / flux_den * phi_sq * inv_fringe_den * t1
+                + 1.0_f64 / MU0 * R * inv_a_gap / flux_den * phi_sq * inv_fringe_den * t1
                     * (R_CORE0 / (1.0_f64 - 1.0_f64 / PHI_SAT * Real::abs(phi))
                         + r_gap));
         // (32) β(x) = 1 / L_g L_f²h
-        let beta = -A_GAP * M * MU0 * flux_den / N * fringe_den / (phi * t1);
+        let beta = -MU0 * A_GAP * M * flux_den / N * fringe_den / (phi * t1);
         // (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
         let w = jr + GAIN_K1 * (zr - z) + GAIN_K2 * (vr - v) + GAIN_K3 * (ar - xi3);
         // (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
@@ -776,11 +774,11 @@ pub mod ekf {
         pub fn transition(z: f32, z_prev: f32, phi: f32, u: f32) -> TransitionOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f32 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f32 = 1.256637e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f32 = 223.6068;
@@ -794,16 +792,15 @@ pub mod ekf {
             let min = Real::min(max_2, PHI_LIM);
             let min_sq = min * min;
             let inv_a_gap = 1.0_f32 / A_GAP;
-            let inv_mu0 = 1.0_f32 / MU0;
-            let t0 = Z_EPS + zp_next;
+            let t0 = zp_next + Z_EPS;
             let inv_t0 = 1.0_f32 / t0;
             let ln = Real::ln(2.0_f32 * L_W * inv_t0);
             let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f32;
             let inv_t1 = 1.0_f32 / t1;
             let t2 = INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * inv_t0;
             let inv_t1_sq = inv_t1 * inv_t1;
-            let t3 = inv_a_gap * inv_mu0 * inv_t1
-                - inv_a_gap * inv_mu0 * zp_next * t2 * inv_t1_sq;
+            let t3 = 1.0_f32 / MU0 * inv_a_gap * inv_t1
+                - 1.0_f32 / MU0 * inv_a_gap * zp_next * t2 * inv_t1_sq;
             let t4 = -(F0 + K_S * zp_next + C * inv_t_s * (z - z_prev))
                 - 0.5_f32 * min_sq * t3;
             let t5 = inv_m * t_s_sq * t4;
@@ -817,19 +814,19 @@ pub mod ekf {
             let sel = if z - Z_MIN >= 0.0_f32 { 1.0_f32 } else { 0.0_f32 };
             // ∂z_prev_{k+1}/∂z
             let dzp_dz = if Z_MAX - max >= 0.0_f32 { sel } else { 0.0_f32 };
-            let t10 = INV_SQRT_A_GAP * dzp_dz * ln
-                - INV_SQRT_A_GAP * zp_next * dzp_dz * inv_t0;
+            let t10 = INV_SQRT_A_GAP * ln * dzp_dz
+                - INV_SQRT_A_GAP * zp_next * inv_t0 * dzp_dz;
             let sel_2 = if t9 >= 0.0_f32 {
                 inv_m * t_s_sq
                     * (-(K_S * dzp_dz + C * inv_t_s)
                         - 0.5_f32 * min_sq
-                            * (2.0_f32 * inv_a_gap * inv_mu0 * zp_next * t2 * t10
+                            * (2.0_f32 / MU0 * inv_a_gap * zp_next * t2 * t10
                                 * (inv_t1_sq * inv_t1)
-                                - inv_a_gap * inv_mu0 * inv_t1_sq * t10
-                                - inv_a_gap * inv_mu0 * dzp_dz * t2 * inv_t1_sq
-                                - inv_a_gap * inv_mu0 * zp_next * inv_t1_sq
+                                - 1.0_f32 / MU0 * inv_a_gap * inv_t1_sq * t10
+                                - 1.0_f32 / MU0 * inv_a_gap * dzp_dz * t2 * inv_t1_sq
+                                - 1.0_f32 / MU0 * inv_a_gap * zp_next * inv_t1_sq
                                     * (INV_SQRT_A_GAP * zp_next * dzp_dz * (inv_t0 * inv_t0)
-                                        - 2.0_f32 * INV_SQRT_A_GAP * dzp_dz * inv_t0))) + 2.0_f32
+                                        - 2.0_f32 * INV_SQRT_A_GAP * inv_t0 * dzp_dz))) + 2.0_f32
             } else {
                 0.0_f32
             };
@@ -849,7 +846,7 @@ pub mod ekf {
                     * (N * u
                         - R
                             * (R_CORE0 * min * inv_t7
-                                + inv_a_gap * inv_mu0 * zp_next * min * inv_t1));
+                                + 1.0_f32 / MU0 * inv_a_gap * zp_next * min * inv_t1));
             // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
             let accel = inv_m * t4;
             // ∂z_{k+1}/∂z
@@ -860,15 +857,15 @@ pub mod ekf {
             let dz_dphi = if t8 >= 0.0_f32 { sel_6 } else { 0.0_f32 };
             // ∂φ_{k+1}/∂z
             let dphi_dz = -R * T_S * t6
-                * (inv_a_gap * inv_mu0 * min * dzp_dz * inv_t1
-                    - inv_a_gap * inv_mu0 * zp_next * min * inv_t1_sq * t10);
+                * (1.0_f32 / MU0 * inv_a_gap * min * dzp_dz * inv_t1
+                    - 1.0_f32 / MU0 * inv_a_gap * zp_next * min * inv_t1_sq * t10);
             // ∂φ_{k+1}/∂φ
             let dphi_dphi = 1.0_f32
                 - R * T_S * t6
                     * (R_CORE0 * inv_t7 * sel_5
                         + R_CORE0 * inv_phi_sat * min * sel_5 * Real::signum0(min)
                             * (inv_t7 * inv_t7)
-                        + inv_a_gap * inv_mu0 * zp_next * sel_5 * inv_t1);
+                        + 1.0_f32 / MU0 * inv_a_gap * zp_next * sel_5 * inv_t1);
             // g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
             let dphi_du = N * T_S * t6;
             TransitionOutput {
@@ -906,11 +903,11 @@ pub mod ekf {
         pub fn measurement(z: f32, _z_prev: f32, phi: f32, u: f32) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f32 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f32 = 1.256637e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f32 = 223.6068;
@@ -923,8 +920,7 @@ pub mod ekf {
             let inv_a_gap = 1.0_f32 / A_GAP;
             let max_2 = Real::max(z, Z_MIN);
             let min_2 = Real::min(max_2, Z_MAX);
-            let inv_mu0 = 1.0_f32 / MU0;
-            let t2 = 1.0_f32 / (Z_EPS + min_2);
+            let t2 = 1.0_f32 / (min_2 + Z_EPS);
             let ln = Real::ln(2.0_f32 * L_W * t2);
             let t3 = INV_SQRT_A_GAP * min_2 * ln + 1.0_f32;
             let inv_t3 = 1.0_f32 / t3;
@@ -937,20 +933,21 @@ pub mod ekf {
                 * (K_E * u
                     + N
                         * (R_CORE0 * min * inv_t1
-                            + inv_a_gap * inv_mu0 * min_2 * min * inv_t3));
+                            + 1.0_f32 / MU0 * inv_a_gap * min_2 * min * inv_t3));
             // ∂i/∂u (the input's noise in the measurement variance)
             let di_du = K_E * t0;
             // H = ∂i/∂z
             let di_dz = N * t0
-                * (inv_a_gap * inv_mu0 * min * sel_2 * inv_t3
-                    - inv_a_gap * inv_mu0 * min_2 * min * (inv_t3 * inv_t3)
-                        * (INV_SQRT_A_GAP * sel_2 * ln
-                            - INV_SQRT_A_GAP * min_2 * sel_2 * t2));
+                * (1.0_f32 / MU0 * inv_a_gap * min * sel_2 * inv_t3
+                    - 1.0_f32 / MU0 * inv_a_gap * min_2 * min * (inv_t3 * inv_t3)
+                        * (INV_SQRT_A_GAP * ln * sel_2
+                            - INV_SQRT_A_GAP * min_2 * t2 * sel_2));
             // H = ∂i/∂φ
             let di_dphi = N * t0
                 * (R_CORE0 * inv_t1 * sel_4
                     + R_CORE0 * inv_phi_sat * min * sel_4 * Real::signum0(min)
-                        * (inv_t1 * inv_t1) + inv_a_gap * inv_mu0 * min_2 * sel_4 * inv_t3);
+                        * (inv_t1 * inv_t1)
+                    + 1.0_f32 / MU0 * inv_a_gap * min_2 * sel_4 * inv_t3);
             MeasurementOutput {
                 i,
                 di_du,
@@ -973,27 +970,26 @@ pub mod ekf {
         pub fn acceleration(z: f32, z_prev: f32, phi: f32, _u: f32) -> AccelerationOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f32 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f32 = 1.256637e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f32 = 223.6068;
             let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
             let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
             let inv_a_gap = 1.0_f32 / A_GAP;
-            let inv_mu0 = 1.0_f32 / MU0;
-            let t0 = 1.0_f32 / (Z_EPS + min);
+            let t0 = 1.0_f32 / (min + Z_EPS);
             let ln = Real::ln(2.0_f32 * L_W * t0);
             let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f32;
             // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
             let accel = 1.0_f32 / M
                 * (-(F0 + K_S * min + C / T_S * (z - z_prev))
                     - 0.5_f32 * (min_2 * min_2)
-                        * (inv_a_gap * inv_mu0 / t1
-                            - inv_a_gap * inv_mu0 * min
+                        * (1.0_f32 / MU0 * inv_a_gap / t1
+                            - 1.0_f32 / MU0 * inv_a_gap * min
                                 * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
                                 / (t1 * t1)));
             AccelerationOutput { accel }
@@ -1107,11 +1103,11 @@ pub mod ekf {
         pub fn transition(z: f64, z_prev: f64, phi: f64, u: f64) -> TransitionOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f64 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f64 = 1.2566370614359173e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f64 = 223.60679774997894;
@@ -1125,16 +1121,15 @@ pub mod ekf {
             let min = Real::min(max_2, PHI_LIM);
             let min_sq = min * min;
             let inv_a_gap = 1.0_f64 / A_GAP;
-            let inv_mu0 = 1.0_f64 / MU0;
-            let t0 = Z_EPS + zp_next;
+            let t0 = zp_next + Z_EPS;
             let inv_t0 = 1.0_f64 / t0;
             let ln = Real::ln(2.0_f64 * L_W * inv_t0);
             let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f64;
             let inv_t1 = 1.0_f64 / t1;
             let t2 = INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * inv_t0;
             let inv_t1_sq = inv_t1 * inv_t1;
-            let t3 = inv_a_gap * inv_mu0 * inv_t1
-                - inv_a_gap * inv_mu0 * zp_next * t2 * inv_t1_sq;
+            let t3 = 1.0_f64 / MU0 * inv_a_gap * inv_t1
+                - 1.0_f64 / MU0 * inv_a_gap * zp_next * t2 * inv_t1_sq;
             let t4 = -(F0 + K_S * zp_next + C * inv_t_s * (z - z_prev))
                 - 0.5_f64 * min_sq * t3;
             let t5 = inv_m * t_s_sq * t4;
@@ -1148,19 +1143,19 @@ pub mod ekf {
             let sel = if z - Z_MIN >= 0.0_f64 { 1.0_f64 } else { 0.0_f64 };
             // ∂z_prev_{k+1}/∂z
             let dzp_dz = if Z_MAX - max >= 0.0_f64 { sel } else { 0.0_f64 };
-            let t10 = INV_SQRT_A_GAP * dzp_dz * ln
-                - INV_SQRT_A_GAP * zp_next * dzp_dz * inv_t0;
+            let t10 = INV_SQRT_A_GAP * ln * dzp_dz
+                - INV_SQRT_A_GAP * zp_next * inv_t0 * dzp_dz;
             let sel_2 = if t9 >= 0.0_f64 {
                 inv_m * t_s_sq
                     * (-(K_S * dzp_dz + C * inv_t_s)
                         - 0.5_f64 * min_sq
-                            * (2.0_f64 * inv_a_gap * inv_mu0 * zp_next * t2 * t10
+                            * (2.0_f64 / MU0 * inv_a_gap * zp_next * t2 * t10
                                 * (inv_t1_sq * inv_t1)
-                                - inv_a_gap * inv_mu0 * inv_t1_sq * t10
-                                - inv_a_gap * inv_mu0 * dzp_dz * t2 * inv_t1_sq
-                                - inv_a_gap * inv_mu0 * zp_next * inv_t1_sq
+                                - 1.0_f64 / MU0 * inv_a_gap * inv_t1_sq * t10
+                                - 1.0_f64 / MU0 * inv_a_gap * dzp_dz * t2 * inv_t1_sq
+                                - 1.0_f64 / MU0 * inv_a_gap * zp_next * inv_t1_sq
                                     * (INV_SQRT_A_GAP * zp_next * dzp_dz * (inv_t0 * inv_t0)
-                                        - 2.0_f64 * INV_SQRT_A_GAP * dzp_dz * inv_t0))) + 2.0_f64
+                                        - 2.0_f64 * INV_SQRT_A_GAP * inv_t0 * dzp_dz))) + 2.0_f64
             } else {
                 0.0_f64
             };
@@ -1180,7 +1175,7 @@ pub mod ekf {
                     * (N * u
                         - R
                             * (R_CORE0 * min * inv_t7
-                                + inv_a_gap * inv_mu0 * zp_next * min * inv_t1));
+                                + 1.0_f64 / MU0 * inv_a_gap * zp_next * min * inv_t1));
             // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
             let accel = inv_m * t4;
             // ∂z_{k+1}/∂z
@@ -1191,15 +1186,15 @@ pub mod ekf {
             let dz_dphi = if t8 >= 0.0_f64 { sel_6 } else { 0.0_f64 };
             // ∂φ_{k+1}/∂z
             let dphi_dz = -R * T_S * t6
-                * (inv_a_gap * inv_mu0 * min * dzp_dz * inv_t1
-                    - inv_a_gap * inv_mu0 * zp_next * min * inv_t1_sq * t10);
+                * (1.0_f64 / MU0 * inv_a_gap * min * dzp_dz * inv_t1
+                    - 1.0_f64 / MU0 * inv_a_gap * zp_next * min * inv_t1_sq * t10);
             // ∂φ_{k+1}/∂φ
             let dphi_dphi = 1.0_f64
                 - R * T_S * t6
                     * (R_CORE0 * inv_t7 * sel_5
                         + R_CORE0 * inv_phi_sat * min * sel_5 * Real::signum0(min)
                             * (inv_t7 * inv_t7)
-                        + inv_a_gap * inv_mu0 * zp_next * sel_5 * inv_t1);
+                        + 1.0_f64 / MU0 * inv_a_gap * zp_next * sel_5 * inv_t1);
             // g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
             let dphi_du = N * T_S * t6;
             TransitionOutput {
@@ -1237,11 +1232,11 @@ pub mod ekf {
         pub fn measurement(z: f64, _z_prev: f64, phi: f64, u: f64) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f64 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f64 = 1.2566370614359173e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f64 = 223.60679774997894;
@@ -1254,8 +1249,7 @@ pub mod ekf {
             let inv_a_gap = 1.0_f64 / A_GAP;
             let max_2 = Real::max(z, Z_MIN);
             let min_2 = Real::min(max_2, Z_MAX);
-            let inv_mu0 = 1.0_f64 / MU0;
-            let t2 = 1.0_f64 / (Z_EPS + min_2);
+            let t2 = 1.0_f64 / (min_2 + Z_EPS);
             let ln = Real::ln(2.0_f64 * L_W * t2);
             let t3 = INV_SQRT_A_GAP * min_2 * ln + 1.0_f64;
             let inv_t3 = 1.0_f64 / t3;
@@ -1268,20 +1262,21 @@ pub mod ekf {
                 * (K_E * u
                     + N
                         * (R_CORE0 * min * inv_t1
-                            + inv_a_gap * inv_mu0 * min_2 * min * inv_t3));
+                            + 1.0_f64 / MU0 * inv_a_gap * min_2 * min * inv_t3));
             // ∂i/∂u (the input's noise in the measurement variance)
             let di_du = K_E * t0;
             // H = ∂i/∂z
             let di_dz = N * t0
-                * (inv_a_gap * inv_mu0 * min * sel_2 * inv_t3
-                    - inv_a_gap * inv_mu0 * min_2 * min * (inv_t3 * inv_t3)
-                        * (INV_SQRT_A_GAP * sel_2 * ln
-                            - INV_SQRT_A_GAP * min_2 * sel_2 * t2));
+                * (1.0_f64 / MU0 * inv_a_gap * min * sel_2 * inv_t3
+                    - 1.0_f64 / MU0 * inv_a_gap * min_2 * min * (inv_t3 * inv_t3)
+                        * (INV_SQRT_A_GAP * ln * sel_2
+                            - INV_SQRT_A_GAP * min_2 * t2 * sel_2));
             // H = ∂i/∂φ
             let di_dphi = N * t0
                 * (R_CORE0 * inv_t1 * sel_4
                     + R_CORE0 * inv_phi_sat * min * sel_4 * Real::signum0(min)
-                        * (inv_t1 * inv_t1) + inv_a_gap * inv_mu0 * min_2 * sel_4 * inv_t3);
+                        * (inv_t1 * inv_t1)
+                    + 1.0_f64 / MU0 * inv_a_gap * min_2 * sel_4 * inv_t3);
             MeasurementOutput {
                 i,
                 di_du,
@@ -1304,27 +1299,26 @@ pub mod ekf {
         pub fn acceleration(z: f64, z_prev: f64, phi: f64, _u: f64) -> AccelerationOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f64 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f64 = 1.2566370614359173e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f64 = 223.60679774997894;
             let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
             let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
             let inv_a_gap = 1.0_f64 / A_GAP;
-            let inv_mu0 = 1.0_f64 / MU0;
-            let t0 = 1.0_f64 / (Z_EPS + min);
+            let t0 = 1.0_f64 / (min + Z_EPS);
             let ln = Real::ln(2.0_f64 * L_W * t0);
             let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f64;
             // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
             let accel = 1.0_f64 / M
                 * (-(F0 + K_S * min + C / T_S * (z - z_prev))
                     - 0.5_f64 * (min_2 * min_2)
-                        * (inv_a_gap * inv_mu0 / t1
-                            - inv_a_gap * inv_mu0 * min
+                        * (1.0_f64 / MU0 * inv_a_gap / t1
+                            - 1.0_f64 / MU0 * inv_a_gap * min
                                 * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
                                 / (t1 * t1)));
             AccelerationOutput { accel }
@@ -1426,11 +1420,11 @@ pub mod ukf {
         pub fn transition(z: f32, z_prev: f32, phi: f32, u: f32) -> TransitionOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f32 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f32 = 1.256637e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f32 = 223.6068;
@@ -1439,15 +1433,14 @@ pub mod ukf {
             let zp_next = Real::min(Real::max(z, Z_MIN), Z_MAX);
             let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
             let inv_a_gap = 1.0_f32 / A_GAP;
-            let inv_mu0 = 1.0_f32 / MU0;
-            let t0 = 1.0_f32 / (Z_EPS + zp_next);
+            let t0 = 1.0_f32 / (zp_next + Z_EPS);
             let ln = Real::ln(2.0_f32 * L_W * t0);
             let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f32;
             let inv_t1 = 1.0_f32 / t1;
             let t2 = -(F0 + K_S * zp_next + C / T_S * (z - z_prev))
                 - 0.5_f32 * (min * min)
-                    * (inv_a_gap * inv_mu0 * inv_t1
-                        - inv_a_gap * inv_mu0 * zp_next
+                    * (1.0_f32 / MU0 * inv_a_gap * inv_t1
+                        - 1.0_f32 / MU0 * inv_a_gap * zp_next
                             * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * t0)
                             * (inv_t1 * inv_t1));
             // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
@@ -1461,7 +1454,7 @@ pub mod ukf {
                     * (N * u
                         - R
                             * (R_CORE0 * min / (1.0_f32 - 1.0_f32 / PHI_SAT * Real::abs(min))
-                                + inv_a_gap * inv_mu0 * zp_next * min * inv_t1));
+                                + 1.0_f32 / MU0 * inv_a_gap * zp_next * min * inv_t1));
             // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
             let accel = inv_m * t2;
             TransitionOutput {
@@ -1487,11 +1480,11 @@ pub mod ukf {
         pub fn measurement(z: f32, _z_prev: f32, phi: f32, u: f32) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f32 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f32 = 1.256637e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f32 = 223.6068;
@@ -1503,9 +1496,9 @@ pub mod ukf {
                 * (K_E * u
                     + N
                         * (R_CORE0 * min / (1.0_f32 - 1.0_f32 / PHI_SAT * Real::abs(min))
-                            + 1.0_f32 / (A_GAP * MU0) * min_2 * min
+                            + 1.0_f32 / MU0 / A_GAP * min_2 * min
                                 / (INV_SQRT_A_GAP * min_2
-                                    * Real::ln(2.0_f32 * L_W / (Z_EPS + min_2)) + 1.0_f32)));
+                                    * Real::ln(2.0_f32 * L_W / (min_2 + Z_EPS)) + 1.0_f32)));
             // ∂i/∂u (the input's noise in the measurement variance)
             let di_du = K_E * t0;
             MeasurementOutput { i, di_du }
@@ -1525,27 +1518,26 @@ pub mod ukf {
         pub fn acceleration(z: f32, z_prev: f32, phi: f32, _u: f32) -> AccelerationOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f32 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f32 = 1.256637e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f32 = 223.6068;
             let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
             let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
             let inv_a_gap = 1.0_f32 / A_GAP;
-            let inv_mu0 = 1.0_f32 / MU0;
-            let t0 = 1.0_f32 / (Z_EPS + min);
+            let t0 = 1.0_f32 / (min + Z_EPS);
             let ln = Real::ln(2.0_f32 * L_W * t0);
             let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f32;
             // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
             let accel = 1.0_f32 / M
                 * (-(F0 + K_S * min + C / T_S * (z - z_prev))
                     - 0.5_f32 * (min_2 * min_2)
-                        * (inv_a_gap * inv_mu0 / t1
-                            - inv_a_gap * inv_mu0 * min
+                        * (1.0_f32 / MU0 * inv_a_gap / t1
+                            - 1.0_f32 / MU0 * inv_a_gap * min
                                 * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
                                 / (t1 * t1)));
             AccelerationOutput { accel }
@@ -1649,11 +1641,11 @@ pub mod ukf {
         pub fn transition(z: f64, z_prev: f64, phi: f64, u: f64) -> TransitionOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f64 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f64 = 1.2566370614359173e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f64 = 223.60679774997894;
@@ -1662,15 +1654,14 @@ pub mod ukf {
             let zp_next = Real::min(Real::max(z, Z_MIN), Z_MAX);
             let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
             let inv_a_gap = 1.0_f64 / A_GAP;
-            let inv_mu0 = 1.0_f64 / MU0;
-            let t0 = 1.0_f64 / (Z_EPS + zp_next);
+            let t0 = 1.0_f64 / (zp_next + Z_EPS);
             let ln = Real::ln(2.0_f64 * L_W * t0);
             let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f64;
             let inv_t1 = 1.0_f64 / t1;
             let t2 = -(F0 + K_S * zp_next + C / T_S * (z - z_prev))
                 - 0.5_f64 * (min * min)
-                    * (inv_a_gap * inv_mu0 * inv_t1
-                        - inv_a_gap * inv_mu0 * zp_next
+                    * (1.0_f64 / MU0 * inv_a_gap * inv_t1
+                        - 1.0_f64 / MU0 * inv_a_gap * zp_next
                             * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * t0)
                             * (inv_t1 * inv_t1));
             // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
@@ -1684,7 +1675,7 @@ pub mod ukf {
                     * (N * u
                         - R
                             * (R_CORE0 * min / (1.0_f64 - 1.0_f64 / PHI_SAT * Real::abs(min))
-                                + inv_a_gap * inv_mu0 * zp_next * min * inv_t1));
+                                + 1.0_f64 / MU0 * inv_a_gap * zp_next * min * inv_t1));
             // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
             let accel = inv_m * t2;
             TransitionOutput {
@@ -1710,11 +1701,11 @@ pub mod ukf {
         pub fn measurement(z: f64, _z_prev: f64, phi: f64, u: f64) -> MeasurementOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f64 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f64 = 1.2566370614359173e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f64 = 223.60679774997894;
@@ -1726,9 +1717,9 @@ pub mod ukf {
                 * (K_E * u
                     + N
                         * (R_CORE0 * min / (1.0_f64 - 1.0_f64 / PHI_SAT * Real::abs(min))
-                            + 1.0_f64 / (A_GAP * MU0) * min_2 * min
+                            + 1.0_f64 / MU0 / A_GAP * min_2 * min
                                 / (INV_SQRT_A_GAP * min_2
-                                    * Real::ln(2.0_f64 * L_W / (Z_EPS + min_2)) + 1.0_f64)));
+                                    * Real::ln(2.0_f64 * L_W / (min_2 + Z_EPS)) + 1.0_f64)));
             // ∂i/∂u (the input's noise in the measurement variance)
             let di_du = K_E * t0;
             MeasurementOutput { i, di_du }
@@ -1748,27 +1739,26 @@ pub mod ukf {
         pub fn acceleration(z: f64, z_prev: f64, phi: f64, _u: f64) -> AccelerationOutput {
             use reldesign_runtime::math::Real;
 
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
             /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
             const Z_EPS: f64 = 1e-9;
+
+            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+            const MU0: f64 = 1.2566370614359173e-6;
 
             /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
             const INV_SQRT_A_GAP: f64 = 223.60679774997894;
             let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
             let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
             let inv_a_gap = 1.0_f64 / A_GAP;
-            let inv_mu0 = 1.0_f64 / MU0;
-            let t0 = 1.0_f64 / (Z_EPS + min);
+            let t0 = 1.0_f64 / (min + Z_EPS);
             let ln = Real::ln(2.0_f64 * L_W * t0);
             let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f64;
             // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
             let accel = 1.0_f64 / M
                 * (-(F0 + K_S * min + C / T_S * (z - z_prev))
                     - 0.5_f64 * (min_2 * min_2)
-                        * (inv_a_gap * inv_mu0 / t1
-                            - inv_a_gap * inv_mu0 * min
+                        * (1.0_f64 / MU0 * inv_a_gap / t1
+                            - 1.0_f64 / MU0 * inv_a_gap * min
                                 * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
                                 / (t1 * t1)));
             AccelerationOutput { accel }

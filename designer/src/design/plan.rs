@@ -129,80 +129,14 @@ pub fn design_controller(
         return Err(PlanError::NothingToBuild);
     };
     let linearization = Linearization::derive(model)?;
-    let mech = &description.mechanics;
-    let bounds = (
-        description.supply.u_min.max(-trajectory.u_bound),
-        trajectory.u_bound,
-    );
     let mut operations = Vec::new();
     for &operation in &trajectory.operations {
-        let (z0, zf) = match operation {
-            Operation::Closing => (mech.z_max, mech.z_min),
-            Operation::Opening => (mech.z_min, mech.z_max),
-        };
-        let name = operation.name();
-        let polynomial = Polynomial {
-            z0,
-            zf,
-            t0: trajectory.takeoff,
-            tf: trajectory.landing,
-        };
-        let (reference, optimal): (Box<dyn Reference>, Option<OptimalTrajectory>) =
-            match trajectory.shape {
-                Shape::Polynomial => (Box::new(polynomial), None),
-                Shape::EnergyOptimal => {
-                    let spec = OptimalSpec {
-                        u_max_limit: description.supply.u_max,
-                        ..OptimalSpec::new(
-                            z0,
-                            zf,
-                            trajectory.takeoff,
-                            trajectory.landing,
-                            bounds.0,
-                            bounds.1,
-                        )
-                    };
-                    let solution = energy_optimal(model, &linearization, &spec).map_err(|e| {
-                        PlanError::Optimal {
-                            operation: name,
-                            message: optimal_message(&e, description),
-                        }
-                    })?;
-                    (Box::new(solution.clone()), Some(solution))
-                }
-            };
-        let feasibility =
-            check_feasibility(model, &linearization, reference.as_ref(), bounds, 4000);
-        if !feasibility.is_feasible() {
-            let mut report = feasibility.report();
-            if optimal.is_none() {
-                report.push_str(&polynomial_remedy(
-                    model,
-                    &linearization,
-                    &polynomial,
-                    bounds,
-                ));
-            }
-            return Err(PlanError::Infeasible {
-                operation: name,
-                report,
-            });
-        }
-        let breaks: Vec<f64> = optimal.iter().flat_map(|o| o.breaks()).collect();
-        let fit = fit_segments(reference.as_ref(), &breaks, &SegmentTolerance::default()).map_err(
-            |e| PlanError::Table {
-                operation: name,
-                message: e.to_string(),
-            },
-        )?;
-        operations.push(DesignedOperation {
+        operations.push(design_operation(
+            description,
+            model,
+            &linearization,
             operation,
-            z0,
-            zf,
-            feasibility,
-            table: fit.table,
-            optimal,
-        });
+        )?);
     }
     let spec = ControllerSpec {
         gains: gains(&controller.gains),
@@ -214,6 +148,91 @@ pub fn design_controller(
         creep_speed: controller.creep_speed,
     };
     ControllerDesign::decide(model, linearization, &spec, operations)
+}
+
+/// One operation of `[trajectory]`: its reference (polynomial or
+/// energy-optimal), feasibility and table.
+fn design_operation(
+    description: &Description,
+    model: &mut Model,
+    linearization: &Linearization,
+    operation: Operation,
+) -> Result<DesignedOperation, PlanError> {
+    let Some(trajectory) = &description.trajectory else {
+        return Err(PlanError::NothingToBuild);
+    };
+    let mech = &description.mechanics;
+    let bounds = (
+        description.supply.u_min.max(-trajectory.u_bound),
+        trajectory.u_bound,
+    );
+    let (z0, zf) = match operation {
+        Operation::Closing => (mech.z_max, mech.z_min),
+        Operation::Opening => (mech.z_min, mech.z_max),
+    };
+    let name = operation.name();
+    let polynomial = Polynomial {
+        z0,
+        zf,
+        t0: trajectory.takeoff,
+        tf: trajectory.landing,
+    };
+    let (reference, optimal): (Box<dyn Reference>, Option<OptimalTrajectory>) = match trajectory
+        .shape
+    {
+        Shape::Polynomial => (Box::new(polynomial), None),
+        Shape::EnergyOptimal => {
+            let spec = OptimalSpec {
+                u_max_limit: description.supply.u_max,
+                ..OptimalSpec::new(
+                    z0,
+                    zf,
+                    trajectory.takeoff,
+                    trajectory.landing,
+                    bounds.0,
+                    bounds.1,
+                )
+            };
+            let solution =
+                energy_optimal(model, linearization, &spec).map_err(|e| PlanError::Optimal {
+                    operation: name,
+                    message: optimal_message(&e, description),
+                })?;
+            (Box::new(solution.clone()), Some(solution))
+        }
+    };
+    let feasibility = check_feasibility(model, linearization, reference.as_ref(), bounds, 4000);
+    if !feasibility.is_feasible() {
+        let mut report = feasibility.report();
+        if optimal.is_none() {
+            report.push_str(&polynomial_remedy(
+                model,
+                linearization,
+                &polynomial,
+                bounds,
+            ));
+        }
+        return Err(PlanError::Infeasible {
+            operation: name,
+            report,
+        });
+    }
+    let breaks: Vec<f64> = optimal.iter().flat_map(|o| o.breaks()).collect();
+    let fit =
+        fit_segments(reference.as_ref(), &breaks, &SegmentTolerance::default()).map_err(|e| {
+            PlanError::Table {
+                operation: name,
+                message: e.to_string(),
+            }
+        })?;
+    Ok(DesignedOperation {
+        operation,
+        z0,
+        zf,
+        feasibility,
+        table: fit.table,
+        optimal,
+    })
 }
 
 /// `[observer.kalman]` → the discretised model [JA 84–87] of the EKF/UKF.
