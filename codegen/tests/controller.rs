@@ -176,14 +176,7 @@ fn one_parameter_change_is_one_params_line_and_the_hash_line() {
         emit(&valve(&text), &floats),
         emit(&valve(&changed), &floats),
     );
-    let (la, lb): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
-    assert_eq!(la.len(), lb.len());
-    let diff: Vec<(&str, &str)> = la
-        .iter()
-        .zip(&lb)
-        .filter(|(x, y)| x != y)
-        .map(|(x, y)| (*x, *y))
-        .collect();
+    let diff = support::changed_lines(&a, &b);
     assert_eq!(diff.len(), 2, "{diff:#?}");
     assert!(diff[0].0.starts_with("// source sha256: "), "{diff:?}");
     assert_eq!(

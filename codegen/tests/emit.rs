@@ -62,15 +62,13 @@ fn one_parameter_change_is_one_changed_line() {
         let (p0, f0) = alpha_beta_code(&text, float);
         let (p1, f1) = alpha_beta_code(&changed, float);
         assert_eq!(f0, f1, "parameters must stay symbolic in the function");
-        let (a, b): (Vec<&str>, Vec<&str>) = (p0.lines().collect(), p1.lines().collect());
-        assert_eq!(a.len(), b.len());
-        let diff: Vec<(&&str, &&str)> = a.iter().zip(&b).filter(|(x, y)| x != y).collect();
+        let diff = support::changed_lines(&p0, &p1);
         let ty = if float == Float::F64 { "f64" } else { "f32" };
         assert_eq!(
             diff,
             [(
-                &format!("pub const R: {ty} = 75.0;").as_str(),
-                &format!("pub const R: {ty} = 80.5;").as_str()
+                format!("pub const R: {ty} = 75.0;").as_str(),
+                format!("pub const R: {ty} = 80.5;").as_str()
             )]
         );
     }

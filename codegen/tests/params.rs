@@ -116,14 +116,7 @@ fn one_parameter_change_is_one_changed_line_of_the_file() {
     let changed = text.replacen("resistance = 160.0", "resistance = 161.5", 1);
     assert_ne!(text, changed);
     let ((a, _), (b, _)) = (build(&text, path), build(&changed, path));
-    let (la, lb): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
-    assert_eq!(la.len(), lb.len());
-    let diff: Vec<(&str, &str)> = la
-        .iter()
-        .zip(&lb)
-        .filter(|(x, y)| x != y)
-        .map(|(x, y)| (*x, *y))
-        .collect();
+    let diff = support::changed_lines(&a, &b);
     assert_eq!(diff.len(), 2, "{diff:#?}");
     assert!(diff[0].0.starts_with("// source sha256: "), "{diff:?}");
     assert_eq!(

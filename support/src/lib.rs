@@ -10,12 +10,14 @@
 
 pub mod cli;
 pub mod close;
+pub mod lines;
 pub mod paths;
 pub mod scratch;
 pub mod temp;
 
 pub use cli::{assert_no_panic, squeeze, Cli, Run};
 pub use close::{assert_close, close, Tol};
+pub use lines::changed_lines;
 pub use paths::{example_path, example_paths, root, toml_files};
 pub use scratch::ScratchCrate;
 pub use temp::{files_in, TempDir};
