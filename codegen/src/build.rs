@@ -45,8 +45,10 @@ pub enum BuildError {
 }
 
 /// The emitted module (deterministic bytes): the header, the `params!`
-/// macro when a module uses it, the controller (if any), then `pub mod
-/// estimators` (SEMERA, integral), `pub mod ekf`, `pub mod ukf`.
+/// macro when a module uses it, `kalman!` with filters, the controller (its
+/// `law!` macro and float modules, if any), then `pub mod estimators`
+/// (SEMERA, integral), `pub mod ekf`, `pub mod ukf` (each with its
+/// `model!`).
 pub fn emit(design: &Design) -> Result<String, BuildError> {
     let d = &design.description;
     let file = || d.source.file_name.clone();

@@ -1,17 +1,19 @@
 //! The perfect-tracking soft-landing controller as emitted Rust
 //! (perfect-tracking-soft-landing [PT §3.2] and [PT §4]): a rendering of
-//! `designer::design::ControllerDesign`, one module per float type
-//! (`pub mod f64 { … }` / `pub mod f32 { … }`) holding
+//! `designer::design::ControllerDesign`. The law's functions are written
+//! once, in `macro_rules! law { ($f:ty) => { … } }` over the float type:
+//! `law_terms` (the law [PT 50] through the expression emitter, with
+//! unsuffixed literals that `$f` types, see `float::Scalar`), `law` and the
+//! guarded, saturated `guarded_law`. Then one module per float type (`pub mod
+//! f64 { … }` / `pub mod f32 { … }`) holds
 //!
 //! - `params!(f…)`: the model parameters, the stroke limits `Z_MIN`,
 //!   `Z_MAX` and the physical constants `MU0`, `Z_EPS`, from the file's one
-//!   `params!` macro (`emit::params_macro`);
+//!   `params!` macro (`emit::params_macro`), and `law!(f…)`;
 //! - the design constants (gains, supply bounds, timing, guard threshold,
-//!   landed band, press, creep);
+//!   landed band, press, creep), in literals of the float type;
 //! - the reference tables, one `[[f; 7]; N]` per operation, one row
 //!   `[t_k, z_k, v_k, c0, c1, c2, c3]` per line (`designer::design::Segments`);
-//! - the law [PT 50]: `law_terms` through the expression emitter, `law` and the
-//!   guarded, saturated `guarded_law`;
 //! - `Operation`, `Design` (the runtime's `control::Law` over the consts,
 //!   tables and law) and `Controller = control::SoftLanding<Design, f…>`.
 //!
@@ -28,10 +30,10 @@ use designer::sym::{Graph, Id};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::emit::{function_tokens_inline, FunctionSpec, Inline};
+use crate::emit::{function_tokens_as, FunctionSpec, Inline};
 use crate::error::EmitError;
-use crate::float::Float;
-use crate::format::{comment_lets, format_items, space_items};
+use crate::float::{Float, Scalar};
+use crate::format::{comment_lets, format_items, macro_rules, space_items};
 use crate::names::const_name;
 use crate::param::Param;
 use crate::physical::{in_scope, of_model};
@@ -84,8 +86,10 @@ const DESIGN_CONSTS: &[&str] = &[
 const REF_SYMBOLS: [&str; 4] = ["z_ref", "v_ref", "a_ref", "j_ref"];
 const GAIN_SYMBOLS: [&str; 3] = ["gain_k1", "gain_k2", "gain_k3"];
 
-/// The controller's float modules, formatted and deterministic, each
-/// invoking the file's `params!` macro (which must precede them).
+/// The `law!` macro (the law's functions, written once) and the
+/// controller's float modules that invoke it, formatted and deterministic;
+/// each module invokes the file's `params!` macro too (which must precede
+/// them).
 pub fn emit_controller(input: &ControllerInput) -> Result<String, ControllerError> {
     let mut floats: Vec<Float> = Vec::new();
     for &f in &input.floats {
@@ -106,11 +110,13 @@ pub fn emit_controller(input: &ControllerInput) -> Result<String, ControllerErro
     let law = LawSymbols::build(&mut graph, input.design, &input.model.named)?;
     // MU0, Z_EPS as the file's params! declares them
     let physical = in_scope(&mut graph, &of_model(input.model));
-    let mut modules = Vec::new();
+    let f32 = floats.contains(&Float::F32);
+    let mut out = law_macro(&graph, input, &law, &physical, Scalar::Macro { f32 })?;
     for float in floats {
-        modules.push(float_module(&graph, input, &law, &physical, float)?);
+        out.push('\n');
+        out.push_str(&float_module(input, float)?);
     }
-    Ok(modules.join("\n"))
+    Ok(out)
 }
 
 /// The law's symbols and expressions in the (cloned) graph. The outputs
@@ -223,7 +229,7 @@ fn law_terms(
     input: &ControllerInput,
     law: &LawSymbols,
     physical: &[Param],
-    float: Float,
+    scalar: Scalar,
 ) -> Result<(TokenStream, Comments), ControllerError> {
     let model = input.model;
     let mut params: Vec<Param> = model.params.iter().map(Param::from).collect();
@@ -266,9 +272,10 @@ fn law_terms(
         outputs,
         named: law.named.clone(),
         output_symbols: STAGED_OUTPUTS.into_iter().zip(law.staged).collect(),
-        float,
+        // written in `scalar`, see below
+        float: Float::F64,
     };
-    let tokens = function_tokens_inline(graph, &spec, &params, Inline::Always)?;
+    let tokens = function_tokens_as(graph, &spec, &params, Inline::Always, scalar)?;
     Ok((tokens, comments))
 }
 
@@ -432,53 +439,71 @@ fn operations(input: &ControllerInput, float: Float) -> Result<Operations, Contr
     })
 }
 
-/// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.
-fn float_module(
+/// `macro_rules! law`: `law_terms` (the expression emitter's), `law` and
+/// `guarded_law`, written once over the float type `$f`.
+fn law_macro(
     graph: &Graph,
     input: &ControllerInput,
     law: &LawSymbols,
     physical: &[Param],
-    float: Float,
+    scalar: Scalar,
 ) -> Result<String, ControllerError> {
+    let ty = scalar.ty();
+    let (law_fn, comments) = law_terms(graph, input, law, physical, scalar)?;
+    let law_args = quote!(z: #ty, v: #ty, phi: #ty, zr: #ty, vr: #ty, ar: #ty, jr: #ty);
+    let tokens = quote! {
+        #law_fn
+
+        /// u of the tracking law [PT 50], not saturated and not guarded.
+        #[must_use]
+        pub fn law(#law_args) -> #ty {
+            law_terms(z, v, phi, zr, vr, ar, jr).u
+        }
+
+        /// The law [PT 50] as applied (`reldesign_runtime::control::guarded_law`): if
+        /// φ ≤ `PHI_GUARD` (φ → 0, where β = 1/L_g L_f²h blows up and D₀⁺ is left) it
+        /// is not evaluated and u = u_max drives the flux back into D₀⁺; otherwise u
+        /// of [PT 50]. Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
+        /// ±∞ to the bounds).
+        #[must_use]
+        pub fn guarded_law(#law_args) -> #ty {
+            control::guarded_law::<Design, #ty>([z, v, phi], [zr, vr, ar, jr])
+        }
+    };
+    let text = comment_lets(&space_items(&format_items(tokens)?), "law_terms", &comments);
+    let doc = format!(
+        "The tracking law [PT 50] of `{}` over the float type `$f`, written once:\n\
+         `law_terms`, `law` and `guarded_law`, declared in each float module as `law!(f64)` /\n\
+         `law!(f32)` beside the module's `params!`, gains and `Design`. Its literals are\n\
+         unsuffixed and `$f` types them: an f32 module reads each as the nearest f32, the\n\
+         value an f32 literal of its own would hold.",
+        input.model.description.name
+    );
+    Ok(macro_rules("law", &doc, &text))
+}
+
+/// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.
+fn float_module(input: &ControllerInput, float: Float) -> Result<String, ControllerError> {
     let ty = float.ty();
     let module = format_ident!("{}", float.name());
     let design = input.design;
-    let (law_fn, comments) = law_terms(graph, input, law, physical, float)?;
     let consts = design_consts(design, float)?;
     let Operations {
         tables,
         variants,
         motions,
     } = operations(input, float)?;
-    let law_args = quote!(z: #ty, v: #ty, phi: #ty, zr: #ty, vr: #ty, ar: #ty, jr: #ty);
     let tokens = quote! {
         #[doc = " The controller in this float type."]
         pub mod #module {
             use reldesign_runtime::control;
 
             params!(#ty);
+            law!(#ty);
 
             #consts
 
             #tables
-
-            #law_fn
-
-            /// u of the tracking law [PT 50], not saturated and not guarded.
-            #[must_use]
-            pub fn law(#law_args) -> #ty {
-                law_terms(z, v, phi, zr, vr, ar, jr).u
-            }
-
-            /// The law [PT 50] as applied (`reldesign_runtime::control::guarded_law`): if
-            /// φ ≤ `PHI_GUARD` (φ → 0, where β = 1/L_g L_f²h blows up and D₀⁺ is left) it
-            /// is not evaluated and u = u_max drives the flux back into D₀⁺; otherwise u
-            /// of [PT 50]. Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
-            /// ±∞ to the bounds).
-            #[must_use]
-            pub fn guarded_law(#law_args) -> #ty {
-                control::guarded_law::<Design, #ty>([z, v, phi], [zr, vr, ar, jr])
-            }
 
             /// A designed switching operation.
             #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -486,8 +511,8 @@ fn float_module(
                 #variants
             }
 
-            /// This module's design (limits, timing, guards, tables, the law [PT 50]) as the
-            /// runtime's soft-landing logic reads it.
+            /// This module's design (limits, timing, guards, tables, the law [PT 50] of
+            /// `law!`) as the runtime's soft-landing logic reads it.
             #[derive(Clone, Copy, Debug, PartialEq, Eq)]
             pub struct Design;
 
@@ -531,7 +556,7 @@ fn float_module(
         let (_, table_name, _, _) = names(op.operation);
         text = splice_table(&text, table_name, &op.table.segments, float)?;
     }
-    Ok(comment_lets(&text, "law_terms", &comments))
+    Ok(text)
 }
 
 /// Replaces the formatted `pub const TABLE: … = __ROWS_OF_TABLE__;` line by

@@ -9,7 +9,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use crate::error::EmitError;
-use crate::float::Float;
+use crate::float::{Float, Scalar};
 use crate::fold::{fold, Folded};
 use crate::format::{comment_lets, format_items};
 use crate::lower::Lowerer;
@@ -178,7 +178,7 @@ pub fn function_tokens(
     spec: &FunctionSpec,
     params: &[Param],
 ) -> Result<TokenStream, EmitError> {
-    function_tokens_inline(graph, spec, params, Inline::Hint)
+    function_tokens_as(graph, spec, params, Inline::Hint, Scalar::One(spec.float))
 }
 
 /// How an emitted function is offered to the inliner.
@@ -193,14 +193,17 @@ pub(crate) enum Inline {
     Always,
 }
 
-/// [`function_tokens`] with the given inlining attribute: parameter-only
-/// calls folded (`fold.rs`), then the plan (`plan.rs`), the lowering
-/// (`lower.rs`, physical constants by name) and the function's tokens.
-pub(crate) fn function_tokens_inline(
+/// [`function_tokens`] with the given inlining attribute, in `scalar` (which
+/// takes the place of `spec.float`: a macro's `$f` for a function written
+/// once for every float type): parameter-only calls folded (`fold.rs`), then
+/// the plan (`plan.rs`), the lowering (`lower.rs`, physical constants by
+/// name) and the function's tokens.
+pub(crate) fn function_tokens_as(
     graph: &Graph,
     spec: &FunctionSpec,
     params: &[Param],
     inline: Inline,
+    scalar: Scalar,
 ) -> Result<TokenStream, EmitError> {
     crate::names::check_local(spec.name)?;
     let roots: Vec<Id> = spec
@@ -230,8 +233,9 @@ pub(crate) fn function_tokens_inline(
     let mut lower = Lowerer {
         graph,
         bound: &plan.bound,
-        float: spec.float,
+        float: scalar,
         uses_real: false,
+        excessive: false,
         params: &param_ids,
         statics: HashMap::new(),
         defined: HashSet::new(),
@@ -269,9 +273,16 @@ pub(crate) fn function_tokens_inline(
     } else {
         quote!()
     };
-    body.extend(local_consts(&local, folded.as_ref(), spec.float)?);
+    let (consts, excessive) = local_consts(&local, folded.as_ref(), scalar)?;
+    body.extend(consts);
     body.extend(lets);
-    Ok(assemble(spec, &request, &plan.input_used, body, inline))
+    let excessive = excessive || lower.excessive;
+    let attrs = Attributes {
+        inline,
+        scalar,
+        excessive,
+    };
+    Ok(assemble(spec, &request, &plan.input_used, body, attrs))
 }
 
 /// The names of one function's plan: inputs, outputs (as mapped by the
@@ -331,15 +342,24 @@ fn owned<'s>(names: impl Iterator<Item = (&'s str, Id)>) -> Vec<(String, Id)> {
     names.map(|(n, id)| (n.to_owned(), id)).collect()
 }
 
+/// How the function is written besides its body.
+struct Attributes {
+    inline: Inline,
+    scalar: Scalar,
+    /// A literal or const has more digits than f32 holds: the f32
+    /// instantiation of a macro reads it rounded (`Scalar::excessive`).
+    excessive: bool,
+}
+
 /// The output struct and the function around `body`.
 fn assemble(
     spec: &FunctionSpec,
     request: &Request,
     input_used: &[bool],
     body: TokenStream,
-    inline: Inline,
+    attrs: Attributes,
 ) -> TokenStream {
-    let ty = spec.float.ty();
+    let ty = attrs.scalar.ty();
     let out_ty = ident(&format!("{}Output", camel(spec.name)));
     let fn_name = ident(spec.name);
     let args = request
@@ -362,15 +382,18 @@ fn assemble(
     let field_names = request.outputs.iter().map(|(n, _)| ident(n));
     let fn_doc = doc_attrs(spec.doc);
     let struct_doc = format!(" Outputs of [`{}`].", spec.name);
-    let allow = if request.inputs.len() > 7 {
+    let mut allow = if request.inputs.len() > 7 {
         quote!(#[allow(clippy::too_many_arguments)])
     } else {
         quote!()
     };
-    let inline = match inline {
+    let inline = match attrs.inline {
         Inline::Hint => quote!(#[inline]),
         Inline::Always => quote!(#[inline(always)]),
     };
+    if attrs.excessive {
+        allow.extend(quote!(#[allow(clippy::excessive_precision)]));
+    }
     quote! {
         #[doc = #struct_doc]
         #[derive(Clone, Copy, Debug, PartialEq)]
@@ -391,12 +414,13 @@ fn assemble(
 
 /// The function's own consts: the physical constants it writes by name and
 /// nobody declared for it (`physical.rs`), then its derived consts
-/// (`fold.rs`), each documented.
+/// (`fold.rs`), each documented; and whether one of them has more digits
+/// than f32 holds (`Scalar::excessive`).
 fn local_consts(
     physical: &[&Constant],
     folded: Option<&Folded>,
-    float: Float,
-) -> Result<TokenStream, EmitError> {
+    scalar: Scalar,
+) -> Result<(TokenStream, bool), EmitError> {
     let physical = physical
         .iter()
         .map(|c| (c.symbol, c.value, c.doc.to_owned()));
@@ -408,21 +432,23 @@ fn local_consts(
         (d.name.as_str(), d.value, doc)
     });
     let mut items = TokenStream::new();
-    let ty = float.ty();
+    let mut excessive = false;
+    let ty = scalar.ty();
     for (name, value, doc) in physical.chain(derived) {
         let cname = const_name(name)?;
-        let lit = float
-            .unsuffixed_signed(value)
+        let lit = scalar
+            .signed_literal(value)
             .ok_or_else(|| EmitError::NonFinite {
                 name: cname.clone(),
                 value: format!("{value:?}"),
-                float: float.name(),
+                float: scalar.name(),
             })?;
+        excessive |= scalar.excessive(value);
         let doc = format!(" {doc}");
         let cname = ident(&cname);
         items.extend(quote!(#[doc = #doc] const #cname: #ty = #lit;));
     }
-    Ok(items)
+    Ok((items, excessive))
 }
 
 /// `#[doc = " line"]` per line (an empty text gives none).

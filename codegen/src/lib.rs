@@ -22,13 +22,13 @@
 //! | `lower.rs` | one expression → Rust tokens (subtractions, divisions, powers, `if`) |
 //! | `names.rs` | name validation, parameter const names, readable temporaries |
 //! | `fold.rs` | parameter-only subexpressions that need a math call, evaluated when generated |
-//! | `float.rs` | [`Float`] and shortest round-trip literals |
-//! | `format.rs` | `prettyplease` formatting and `//` comments |
+//! | `float.rs` | [`Float`], shortest round-trip literals, and the `$f` of macros written once for every float type |
+//! | `format.rs` | `prettyplease` formatting, `//` comments and `macro_rules!` bodies |
 //! | `error.rs` | [`EmitError`] |
 //! | `build.rs` | a description → the emitted file ([`build_file`], [`compile`], [`emit`]) |
-//! | `controller.rs` | the feedback-linearizing controller modules (over `reldesign_runtime::control`) |
+//! | `controller.rs` | the feedback-linearizing controller: the `law!` macro and the float modules (over `reldesign_runtime::control`) |
 //! | `semera.rs` | the SEMERA and integral estimator modules |
-//! | `observer.rs` | the EKF and UKF modules |
+//! | `observer/` | the EKF and UKF: `model!` macros and float modules |
 
 mod build;
 mod controller;

@@ -25,7 +25,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use crate::error::EmitError;
-use crate::float::Float;
+use crate::float::Scalar;
 use crate::names::ident;
 use crate::physical::{recognise, Constant, Named};
 
@@ -70,9 +70,12 @@ impl Lowered {
 pub(crate) struct Lowerer<'a> {
     pub graph: &'a Graph,
     pub bound: &'a HashMap<Id, String>,
-    pub float: Float,
+    pub float: Scalar,
     /// Set when a `Real::…` call was emitted (the function then imports it).
     pub uses_real: bool,
+    /// Set when a literal has more digits than the f32 instantiation of a
+    /// macro holds (`Scalar::excessive`).
+    pub excessive: bool,
     /// Parameter symbols (their consts are compile-time values).
     pub params: &'a HashSet<Id>,
     /// Memo of [`Lowerer::is_static`].
@@ -149,9 +152,10 @@ impl Lowerer<'_> {
         })
     }
 
-    fn literal(&self, value: f64) -> Result<TokenStream, EmitError> {
+    fn literal(&mut self, value: f64) -> Result<TokenStream, EmitError> {
+        self.excessive |= self.float.excessive(value);
         self.float
-            .suffixed(value)
+            .literal(value)
             .ok_or_else(|| EmitError::NonFinite {
                 name: "a constant".to_owned(),
                 value: format!("{value:?}"),
@@ -211,7 +215,7 @@ impl Lowerer<'_> {
         }))
     }
 
-    fn literal_lowered(&self, value: f64) -> Result<Lowered, EmitError> {
+    fn literal_lowered(&mut self, value: f64) -> Result<Lowered, EmitError> {
         Ok(Lowered::new(self.literal(value)?, ATOM))
     }
 

@@ -197,7 +197,12 @@ fn header_and_sections_are_there() {
     assert!(code.contains("DO NOT EDIT"));
     assert!(code.contains(&format!("// source sha256: {hash}\n")));
     assert!(code.contains("macro_rules! params"));
+    // the law's functions once, in `law!`, whatever the floats
+    assert_eq!(code.matches("macro_rules! law {").count(), 1);
+    assert_eq!(code.matches("pub fn law_terms(").count(), 1);
     for needle in [
+        "law!(f64);",
+        "law!(f32);",
         "pub mod f64 {",
         "pub mod f32 {",
         "pub fn law(",

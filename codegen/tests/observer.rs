@@ -368,6 +368,7 @@ fn emitted_modules_hold_the_model_and_not_the_algorithm() {
             "pub mod f64 {",
             "params!(f64);",
             "kalman!(f64);",
+            "model!(f64);",
             "pub fn transition(",
             "pub fn measurement(",
             "pub fn acceleration(",
@@ -387,6 +388,10 @@ fn emitted_modules_hold_the_model_and_not_the_algorithm() {
             !code.contains("pub mod f32"),
             "{name}: only the requested floats"
         );
+        // one macro, the model functions written once over the float type
+        // (the parameters and settings are the file's `params!`, `kalman!`)
+        assert_eq!(code.matches("macro_rules!").count(), 1, "{name}");
+        assert!(code.contains("macro_rules! model {"), "{name}");
         // no panics, and no filter algebra: that is the runtime's
         for forbidden in [
             ".unwrap()",
@@ -395,7 +400,6 @@ fn emitted_modules_hold_the_model_and_not_the_algorithm() {
             " as f",
             " as usize",
             "unsafe",
-            "macro_rules",
             "linalg",
             "cholesky",
             "fn step",
@@ -592,6 +596,10 @@ fn the_build_declares_params_and_kalman_once() {
                 if name == "observers only" { 2 } else { 3 },
             ),
             ("kalman!(f64);", 2),
+            // the model functions once per filter, not once per float
+            ("macro_rules! model {", 2),
+            ("model!(f32);", 2),
+            ("pub fn transition(", 2),
             ("pub mod ekf {", 1),
             ("pub mod ukf {", 1),
         ] {

@@ -117,10 +117,118 @@ macro_rules! kalman {
     };
 }
 
+/// The tracking law [PT 50] of `perfect_tracking_valve` over the float type `$f`, written once:
+/// `law_terms`, `law` and `guarded_law`, declared in each float module as `law!(f64)` /
+/// `law!(f32)` beside the module's `params!`, gains and `Design`. Its literals are
+/// unsuffixed and `$f` types them: an f32 module reads each as the nearest f32, the
+/// value an f32 literal of its own would hold.
+macro_rules! law {
+    ($f:ty) => {
+        /// Outputs of [`law_terms`].
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct LawTermsOutput {
+            /// (41) ξ₃ = a(x) = L_f²h
+            pub xi3: $f,
+            /// (31) L_f³h
+            pub lf3h: $f,
+            /// (32) β(x) = 1 / L_g L_f²h
+            pub beta: $f,
+            /// (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
+            pub w: $f,
+            /// (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
+            pub alpha: $f,
+            /// (50) u = α + β·w = β·(w − L_f³h)
+            pub u: $f,
+        }
+
+        /// The terms of the tracking law (50) at the state x = [z, v, φ] and the
+        /// reference ξ_r = [z_r, v_r, a_r], z_r⁽³⁾ = j_r (not saturated, not guarded:
+        /// φ = 0 makes β infinite, see [`guarded_law`]).
+        #[inline(always)]
+        #[must_use]
+        #[allow(clippy::excessive_precision)]
+        pub fn law_terms(
+            z: $f,
+            v: $f,
+            phi: $f,
+            zr: $f,
+            vr: $f,
+            ar: $f,
+            jr: $f,
+        ) -> LawTermsOutput {
+            use reldesign_runtime::math::Real;
+
+            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+            const INV_SQRT_A_GAP: $f = 223.60679774997894;
+            let inv_m = 1.0 / M;
+            let f_passive = F0 + K_S * z + C * v;
+            let inv_a_gap = 1.0 / A_GAP;
+            let phi_sq = phi * phi;
+            let z_reg = z + Z_EPS;
+            let inv_z_reg = 1.0 / z_reg;
+            let fringe_log = Real::ln(2.0 * L_W * inv_z_reg);
+            let fringe_den = INV_SQRT_A_GAP * z * fringe_log + 1.0;
+            let inv_fringe_den = 1.0 / fringe_den;
+            let t0 = fringe_log - z * inv_z_reg;
+            let t1 = 1.0 - INV_SQRT_A_GAP * z * t0 * inv_fringe_den;
+            let f_mag = -0.5 / MU0 * inv_a_gap * phi_sq * inv_fringe_den * t1;
+            let f_net = f_mag - f_passive;
+            // (41) ξ₃ = a(x) = L_f²h
+            let xi3 = inv_m * f_net;
+            let flux_den = N * N + R * K_E;
+            let r_gap = 1.0 / MU0 * inv_a_gap * z * inv_fringe_den;
+            // (31) L_f³h
+            let lf3h = inv_m
+                * (v
+                    * (-K_S
+                        - 0.5 / MU0 * INV_SQRT_A_GAP * inv_a_gap * phi_sq
+                            * (inv_fringe_den * inv_fringe_den)
+                            * (2.0 * INV_SQRT_A_GAP * z * (t0 * t0) * inv_fringe_den
+                                - z * inv_z_reg * (z * inv_z_reg - 2.0) - 2.0 * t0))
+                    - C * inv_m * f_net
+                    + 1.0 / MU0 * R * inv_a_gap / flux_den * phi_sq * inv_fringe_den * t1
+                        * (R_CORE0 / (1.0 - 1.0 / PHI_SAT * Real::abs(phi)) + r_gap));
+            // (32) β(x) = 1 / L_g L_f²h
+            let beta = -MU0 * A_GAP * M * flux_den / N * fringe_den / (phi * t1);
+            // (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
+            let w = jr + GAIN_K1 * (zr - z) + GAIN_K2 * (vr - v) + GAIN_K3 * (ar - xi3);
+            // (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
+            let alpha = -lf3h * beta;
+            // (50) u = α + β·w = β·(w − L_f³h)
+            let u = beta * (w - lf3h);
+            LawTermsOutput {
+                xi3,
+                lf3h,
+                beta,
+                w,
+                alpha,
+                u,
+            }
+        }
+
+        /// u of the tracking law [PT 50], not saturated and not guarded.
+        #[must_use]
+        pub fn law(z: $f, v: $f, phi: $f, zr: $f, vr: $f, ar: $f, jr: $f) -> $f {
+            law_terms(z, v, phi, zr, vr, ar, jr).u
+        }
+
+        /// The law [PT 50] as applied (`reldesign_runtime::control::guarded_law`): if
+        /// φ ≤ `PHI_GUARD` (φ → 0, where β = 1/L_g L_f²h blows up and D₀⁺ is left) it
+        /// is not evaluated and u = u_max drives the flux back into D₀⁺; otherwise u
+        /// of [PT 50]. Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
+        /// ±∞ to the bounds).
+        #[must_use]
+        pub fn guarded_law(z: $f, v: $f, phi: $f, zr: $f, vr: $f, ar: $f, jr: $f) -> $f {
+            control::guarded_law::<Design, $f>([z, v, phi], [zr, vr, ar, jr])
+        }
+    };
+}
+
 /// The controller in this float type.
 pub mod f32 {
     use reldesign_runtime::control;
     params!(f32);
+    law!(f32);
 
     /// k1 of K = [k1, k2, k3] (48): s³ + k3·s² + k2·s + k1 is the characteristic polynomial of (49).
     pub const GAIN_K1: f32 = 249546470000.0;
@@ -253,112 +361,6 @@ pub mod f32 {
         [0.00596003, 0.0009999895, 0.0007879204, -38.85466, 927475.4, 1206583900.0, -2255284000000.0],
     ];
 
-    /// Outputs of [`law_terms`].
-    #[derive(Clone, Copy, Debug, PartialEq)]
-    pub struct LawTermsOutput {
-        /// (41) ξ₃ = a(x) = L_f²h
-        pub xi3: f32,
-        /// (31) L_f³h
-        pub lf3h: f32,
-        /// (32) β(x) = 1 / L_g L_f²h
-        pub beta: f32,
-        /// (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
-        pub w: f32,
-        /// (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
-        pub alpha: f32,
-        /// (50) u = α + β·w = β·(w − L_f³h)
-        pub u: f32,
-    }
-
-    /// The terms of the tracking law (50) at the state x = [z, v, φ] and the
-    /// reference ξ_r = [z_r, v_r, a_r], z_r⁽³⁾ = j_r (not saturated, not guarded:
-    /// φ = 0 makes β infinite, see [`guarded_law`]).
-    #[inline(always)]
-    #[must_use]
-    pub fn law_terms(
-        z: f32,
-        v: f32,
-        phi: f32,
-        zr: f32,
-        vr: f32,
-        ar: f32,
-        jr: f32,
-    ) -> LawTermsOutput {
-        use reldesign_runtime::math::Real;
-
-        /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-        const INV_SQRT_A_GAP: f32 = 223.6068;
-        let inv_m = 1.0_f32 / M;
-        let f_passive = F0 + K_S * z + C * v;
-        let inv_a_gap = 1.0_f32 / A_GAP;
-        let phi_sq = phi * phi;
-        let z_reg = z + Z_EPS;
-        let inv_z_reg = 1.0_f32 / z_reg;
-        let fringe_log = Real::ln(2.0_f32 * L_W * inv_z_reg);
-        let fringe_den = INV_SQRT_A_GAP * z * fringe_log + 1.0_f32;
-        let inv_fringe_den = 1.0_f32 / fringe_den;
-        let t0 = fringe_log - z * inv_z_reg;
-        let t1 = 1.0_f32 - INV_SQRT_A_GAP * z * t0 * inv_fringe_den;
-        let f_mag = -0.5_f32 / MU0 * inv_a_gap * phi_sq * inv_fringe_den * t1;
-        let f_net = f_mag - f_passive;
-        // (41) ξ₃ = a(x) = L_f²h
-        let xi3 = inv_m * f_net;
-        let flux_den = N * N + R * K_E;
-        let r_gap = 1.0_f32 / MU0 * inv_a_gap * z * inv_fringe_den;
-        // (31) L_f³h
-        let lf3h = inv_m
-            * (v
-                * (-K_S
-                    - 0.5_f32 / MU0 * INV_SQRT_A_GAP * inv_a_gap * phi_sq
-                        * (inv_fringe_den * inv_fringe_den)
-                        * (2.0_f32 * INV_SQRT_A_GAP * z * (t0 * t0) * inv_fringe_den
-                            - z * inv_z_reg * (z * inv_z_reg - 2.0_f32) - 2.0_f32 * t0))
-                - C * inv_m * f_net
-                + 1.0_f32 / MU0 * R * inv_a_gap / flux_den * phi_sq * inv_fringe_den * t1
-                    * (R_CORE0 / (1.0_f32 - 1.0_f32 / PHI_SAT * Real::abs(phi))
-                        + r_gap));
-        // (32) β(x) = 1 / L_g L_f²h
-        let beta = -MU0 * A_GAP * M * flux_den / N * fringe_den / (phi * t1);
-        // (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
-        let w = jr + GAIN_K1 * (zr - z) + GAIN_K2 * (vr - v) + GAIN_K3 * (ar - xi3);
-        // (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
-        let alpha = -lf3h * beta;
-        // (50) u = α + β·w = β·(w − L_f³h)
-        let u = beta * (w - lf3h);
-        LawTermsOutput {
-            xi3,
-            lf3h,
-            beta,
-            w,
-            alpha,
-            u,
-        }
-    }
-
-    /// u of the tracking law [PT 50], not saturated and not guarded.
-    #[must_use]
-    pub fn law(z: f32, v: f32, phi: f32, zr: f32, vr: f32, ar: f32, jr: f32) -> f32 {
-        law_terms(z, v, phi, zr, vr, ar, jr).u
-    }
-
-    /// The law [PT 50] as applied (`reldesign_runtime::control::guarded_law`): if
-    /// φ ≤ `PHI_GUARD` (φ → 0, where β = 1/L_g L_f²h blows up and D₀⁺ is left) it
-    /// is not evaluated and u = u_max drives the flux back into D₀⁺; otherwise u
-    /// of [PT 50]. Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
-    /// ±∞ to the bounds).
-    #[must_use]
-    pub fn guarded_law(
-        z: f32,
-        v: f32,
-        phi: f32,
-        zr: f32,
-        vr: f32,
-        ar: f32,
-        jr: f32,
-    ) -> f32 {
-        control::guarded_law::<Design, f32>([z, v, phi], [zr, vr, ar, jr])
-    }
-
     /// A designed switching operation.
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
     pub enum Operation {
@@ -368,8 +370,8 @@ pub mod f32 {
         Opening,
     }
 
-    /// This module's design (limits, timing, guards, tables, the law [PT 50]) as the
-    /// runtime's soft-landing logic reads it.
+    /// This module's design (limits, timing, guards, tables, the law [PT 50] of
+    /// `law!`) as the runtime's soft-landing logic reads it.
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
     pub struct Design;
 
@@ -426,6 +428,7 @@ pub mod f32 {
 pub mod f64 {
     use reldesign_runtime::control;
     params!(f64);
+    law!(f64);
 
     /// k1 of K = [k1, k2, k3] (48): s³ + k3·s² + k2·s + k1 is the characteristic polynomial of (49).
     pub const GAIN_K1: f64 = 249546480891.2322;
@@ -558,112 +561,6 @@ pub mod f64 {
         [0.005960030153854684, 0.0009999894282028755, 0.0007879203636807412, -38.85466169897067, 927475.4002497159, 1206583879.047023, -2255284127829.4976],
     ];
 
-    /// Outputs of [`law_terms`].
-    #[derive(Clone, Copy, Debug, PartialEq)]
-    pub struct LawTermsOutput {
-        /// (41) ξ₃ = a(x) = L_f²h
-        pub xi3: f64,
-        /// (31) L_f³h
-        pub lf3h: f64,
-        /// (32) β(x) = 1 / L_g L_f²h
-        pub beta: f64,
-        /// (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
-        pub w: f64,
-        /// (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
-        pub alpha: f64,
-        /// (50) u = α + β·w = β·(w − L_f³h)
-        pub u: f64,
-    }
-
-    /// The terms of the tracking law (50) at the state x = [z, v, φ] and the
-    /// reference ξ_r = [z_r, v_r, a_r], z_r⁽³⁾ = j_r (not saturated, not guarded:
-    /// φ = 0 makes β infinite, see [`guarded_law`]).
-    #[inline(always)]
-    #[must_use]
-    pub fn law_terms(
-        z: f64,
-        v: f64,
-        phi: f64,
-        zr: f64,
-        vr: f64,
-        ar: f64,
-        jr: f64,
-    ) -> LawTermsOutput {
-        use reldesign_runtime::math::Real;
-
-        /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-        const INV_SQRT_A_GAP: f64 = 223.60679774997894;
-        let inv_m = 1.0_f64 / M;
-        let f_passive = F0 + K_S * z + C * v;
-        let inv_a_gap = 1.0_f64 / A_GAP;
-        let phi_sq = phi * phi;
-        let z_reg = z + Z_EPS;
-        let inv_z_reg = 1.0_f64 / z_reg;
-        let fringe_log = Real::ln(2.0_f64 * L_W * inv_z_reg);
-        let fringe_den = INV_SQRT_A_GAP * z * fringe_log + 1.0_f64;
-        let inv_fringe_den = 1.0_f64 / fringe_den;
-        let t0 = fringe_log - z * inv_z_reg;
-        let t1 = 1.0_f64 - INV_SQRT_A_GAP * z * t0 * inv_fringe_den;
-        let f_mag = -0.5_f64 / MU0 * inv_a_gap * phi_sq * inv_fringe_den * t1;
-        let f_net = f_mag - f_passive;
-        // (41) ξ₃ = a(x) = L_f²h
-        let xi3 = inv_m * f_net;
-        let flux_den = N * N + R * K_E;
-        let r_gap = 1.0_f64 / MU0 * inv_a_gap * z * inv_fringe_den;
-        // (31) L_f³h
-        let lf3h = inv_m
-            * (v
-                * (-K_S
-                    - 0.5_f64 / MU0 * INV_SQRT_A_GAP * inv_a_gap * phi_sq
-                        * (inv_fringe_den * inv_fringe_den)
-                        * (2.0_f64 * INV_SQRT_A_GAP * z * (t0 * t0) * inv_fringe_den
-                            - z * inv_z_reg * (z * inv_z_reg - 2.0_f64) - 2.0_f64 * t0))
-                - C * inv_m * f_net
-                + 1.0_f64 / MU0 * R * inv_a_gap / flux_den * phi_sq * inv_fringe_den * t1
-                    * (R_CORE0 / (1.0_f64 - 1.0_f64 / PHI_SAT * Real::abs(phi))
-                        + r_gap));
-        // (32) β(x) = 1 / L_g L_f²h
-        let beta = -MU0 * A_GAP * M * flux_den / N * fringe_den / (phi * t1);
-        // (48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)
-        let w = jr + GAIN_K1 * (zr - z) + GAIN_K2 * (vr - v) + GAIN_K3 * (ar - xi3);
-        // (32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
-        let alpha = -lf3h * beta;
-        // (50) u = α + β·w = β·(w − L_f³h)
-        let u = beta * (w - lf3h);
-        LawTermsOutput {
-            xi3,
-            lf3h,
-            beta,
-            w,
-            alpha,
-            u,
-        }
-    }
-
-    /// u of the tracking law [PT 50], not saturated and not guarded.
-    #[must_use]
-    pub fn law(z: f64, v: f64, phi: f64, zr: f64, vr: f64, ar: f64, jr: f64) -> f64 {
-        law_terms(z, v, phi, zr, vr, ar, jr).u
-    }
-
-    /// The law [PT 50] as applied (`reldesign_runtime::control::guarded_law`): if
-    /// φ ≤ `PHI_GUARD` (φ → 0, where β = 1/L_g L_f²h blows up and D₀⁺ is left) it
-    /// is not evaluated and u = u_max drives the flux back into D₀⁺; otherwise u
-    /// of [PT 50]. Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
-    /// ±∞ to the bounds).
-    #[must_use]
-    pub fn guarded_law(
-        z: f64,
-        v: f64,
-        phi: f64,
-        zr: f64,
-        vr: f64,
-        ar: f64,
-        jr: f64,
-    ) -> f64 {
-        control::guarded_law::<Design, f64>([z, v, phi], [zr, vr, ar, jr])
-    }
-
     /// A designed switching operation.
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
     pub enum Operation {
@@ -673,8 +570,8 @@ pub mod f64 {
         Opening,
     }
 
-    /// This module's design (limits, timing, guards, tables, the law [PT 50]) as the
-    /// runtime's soft-landing logic reads it.
+    /// This module's design (limits, timing, guards, tables, the law [PT 50] of
+    /// `law!`) as the runtime's soft-landing logic reads it.
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
     pub struct Design;
 
@@ -729,273 +626,276 @@ pub mod f64 {
 
 /// The extended Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).
 pub mod ekf {
+    /// The model functions of `perfect_tracking_valve` over the float type `$f`, written once and declared in
+    /// each float module below as `model!(f64)` / `model!(f32)`. Their literals are unsuffixed
+    /// and `$f` types them: an f32 module reads each as the nearest f32, the value an f32
+    /// literal of its own would hold.
+    macro_rules! model {
+        ($f:ty) => {
+            /// Outputs of [`transition`].
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct TransitionOutput {
+                /// (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
+                pub z_next: $f,
+                /// (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
+                pub zp_next: $f,
+                /// (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
+                pub phi_next: $f,
+                /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                pub accel: $f,
+                /// ∂z_{k+1}/∂z
+                pub dz_dz: $f,
+                /// ∂z_{k+1}/∂z_prev
+                pub dz_dzp: $f,
+                /// ∂z_{k+1}/∂φ
+                pub dz_dphi: $f,
+                /// ∂z_prev_{k+1}/∂z
+                pub dzp_dz: $f,
+                /// ∂φ_{k+1}/∂z
+                pub dphi_dz: $f,
+                /// ∂φ_{k+1}/∂φ
+                pub dphi_dphi: $f,
+                /// g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
+                pub dphi_du: $f,
+            }
+
+            /// The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held
+            /// over the sample, the acceleration f_v of (87), and the symbolic Jacobians
+            /// ∂F/∂x and g = ∂F/∂u (entries not listed are constant).
+            #[inline]
+            #[must_use]
+            #[allow(clippy::excessive_precision)]
+            pub fn transition(z: $f, z_prev: $f, phi: $f, u: $f) -> TransitionOutput {
+                use reldesign_runtime::math::Real;
+
+                /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
+                const Z_EPS: $f = 1e-9;
+
+                /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+                const MU0: $f = 1.2566370614359173e-6;
+
+                /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+                const INV_SQRT_A_GAP: $f = 223.60679774997894;
+                let inv_m = 1.0 / M;
+                let t_s_sq = T_S * T_S;
+                let max = Real::max(z, Z_MIN);
+                // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
+                let zp_next = Real::min(max, Z_MAX);
+                let inv_t_s = 1.0 / T_S;
+                let max_2 = Real::max(phi, -PHI_LIM);
+                let min = Real::min(max_2, PHI_LIM);
+                let min_sq = min * min;
+                let inv_a_gap = 1.0 / A_GAP;
+                let t0 = zp_next + Z_EPS;
+                let inv_t0 = 1.0 / t0;
+                let ln = Real::ln(2.0 * L_W * inv_t0);
+                let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0;
+                let inv_t1 = 1.0 / t1;
+                let t2 = INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * inv_t0;
+                let inv_t1_sq = inv_t1 * inv_t1;
+                let t3 = 1.0 / MU0 * inv_a_gap * inv_t1
+                    - 1.0 / MU0 * inv_a_gap * zp_next * t2 * inv_t1_sq;
+                let t4 = -(F0 + K_S * zp_next + C * inv_t_s * (z - z_prev)) - 0.5 * min_sq * t3;
+                let t5 = inv_m * t_s_sq * t4;
+                let max_3 = Real::max(2.0 * z - z_prev + t5, Z_MIN);
+                let t6 = 1.0 / (N * N + R * K_E);
+                let inv_phi_sat = 1.0 / PHI_SAT;
+                let t7 = 1.0 - inv_phi_sat * Real::abs(min);
+                let inv_t7 = 1.0 / t7;
+                let t8 = Z_MAX - max_3;
+                let t9 = 2.0 * z - z_prev - Z_MIN + t5;
+                let sel = if z - Z_MIN >= 0.0 { 1.0 } else { 0.0 };
+                // ∂z_prev_{k+1}/∂z
+                let dzp_dz = if Z_MAX - max >= 0.0 { sel } else { 0.0 };
+                let t10 = INV_SQRT_A_GAP * ln * dzp_dz - INV_SQRT_A_GAP * zp_next * inv_t0 * dzp_dz;
+                let sel_2 = if t9 >= 0.0 {
+                    inv_m * t_s_sq
+                        * (-(K_S * dzp_dz + C * inv_t_s)
+                            - 0.5 * min_sq
+                                * (2.0 / MU0 * inv_a_gap * zp_next * t2 * t10 * (inv_t1_sq * inv_t1)
+                                    - 1.0 / MU0 * inv_a_gap * inv_t1_sq * t10
+                                    - 1.0 / MU0 * inv_a_gap * dzp_dz * t2 * inv_t1_sq
+                                    - 1.0 / MU0 * inv_a_gap * zp_next * inv_t1_sq
+                                        * (INV_SQRT_A_GAP * zp_next * dzp_dz * (inv_t0 * inv_t0)
+                                            - 2.0 * INV_SQRT_A_GAP * inv_t0 * dzp_dz))) + 2.0
+                } else {
+                    0.0
+                };
+                let sel_3 = if t9 >= 0.0 { C * T_S * inv_m - 1.0 } else { 0.0 };
+                let sel_4 = if phi + PHI_LIM >= 0.0 { 1.0 } else { 0.0 };
+                let sel_5 = if PHI_LIM - max_2 >= 0.0 { sel_4 } else { 0.0 };
+                let sel_6 = if t9 >= 0.0 { -inv_m * t_s_sq * min * sel_5 * t3 } else { 0.0 };
+                // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
+                let z_next = Real::min(max_3, Z_MAX);
+                // (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
+                let phi_next = phi
+                    + T_S * t6
+                        * (N * u
+                            - R
+                                * (R_CORE0 * min * inv_t7
+                                    + 1.0 / MU0 * inv_a_gap * zp_next * min * inv_t1));
+                // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                let accel = inv_m * t4;
+                // ∂z_{k+1}/∂z
+                let dz_dz = if t8 >= 0.0 { sel_2 } else { 0.0 };
+                // ∂z_{k+1}/∂z_prev
+                let dz_dzp = if t8 >= 0.0 { sel_3 } else { 0.0 };
+                // ∂z_{k+1}/∂φ
+                let dz_dphi = if t8 >= 0.0 { sel_6 } else { 0.0 };
+                // ∂φ_{k+1}/∂z
+                let dphi_dz = -R * T_S * t6
+                    * (1.0 / MU0 * inv_a_gap * min * dzp_dz * inv_t1
+                        - 1.0 / MU0 * inv_a_gap * zp_next * min * inv_t1_sq * t10);
+                // ∂φ_{k+1}/∂φ
+                let dphi_dphi = 1.0
+                    - R * T_S * t6
+                        * (R_CORE0 * inv_t7 * sel_5
+                            + R_CORE0 * inv_phi_sat * min * sel_5 * Real::signum0(min)
+                                * (inv_t7 * inv_t7)
+                            + 1.0 / MU0 * inv_a_gap * zp_next * sel_5 * inv_t1);
+                // g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
+                let dphi_du = N * T_S * t6;
+                TransitionOutput {
+                    z_next,
+                    zp_next,
+                    phi_next,
+                    accel,
+                    dz_dz,
+                    dz_dzp,
+                    dz_dphi,
+                    dzp_dz,
+                    dphi_dz,
+                    dphi_dphi,
+                    dphi_du,
+                }
+            }
+
+            /// Outputs of [`measurement`].
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct MeasurementOutput {
+                /// i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
+                pub i: $f,
+                /// ∂i/∂u (the input's noise in the measurement variance)
+                pub di_du: $f,
+                /// H = ∂i/∂z
+                pub di_dz: $f,
+                /// H = ∂i/∂φ
+                pub di_dphi: $f,
+            }
+
+            /// The measured quantity y = h(x, u) on the model's domain and its derivatives
+            /// (entries of ∂h/∂x not listed are constant).
+            #[inline]
+            #[must_use]
+            #[allow(clippy::excessive_precision)]
+            pub fn measurement(z: $f, _z_prev: $f, phi: $f, u: $f) -> MeasurementOutput {
+                use reldesign_runtime::math::Real;
+
+                /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
+                const Z_EPS: $f = 1e-9;
+
+                /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+                const MU0: $f = 1.2566370614359173e-6;
+
+                /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+                const INV_SQRT_A_GAP: $f = 223.60679774997894;
+                let t0 = 1.0 / (N * N + R * K_E);
+                let max = Real::max(phi, -PHI_LIM);
+                let min = Real::min(max, PHI_LIM);
+                let inv_phi_sat = 1.0 / PHI_SAT;
+                let t1 = 1.0 - inv_phi_sat * Real::abs(min);
+                let inv_t1 = 1.0 / t1;
+                let inv_a_gap = 1.0 / A_GAP;
+                let max_2 = Real::max(z, Z_MIN);
+                let min_2 = Real::min(max_2, Z_MAX);
+                let t2 = 1.0 / (min_2 + Z_EPS);
+                let ln = Real::ln(2.0 * L_W * t2);
+                let t3 = INV_SQRT_A_GAP * min_2 * ln + 1.0;
+                let inv_t3 = 1.0 / t3;
+                let sel = if z - Z_MIN >= 0.0 { 1.0 } else { 0.0 };
+                let sel_2 = if Z_MAX - max_2 >= 0.0 { sel } else { 0.0 };
+                let sel_3 = if phi + PHI_LIM >= 0.0 { 1.0 } else { 0.0 };
+                let sel_4 = if PHI_LIM - max >= 0.0 { sel_3 } else { 0.0 };
+                // i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
+                let i = t0
+                    * (K_E * u
+                        + N
+                            * (R_CORE0 * min * inv_t1
+                                + 1.0 / MU0 * inv_a_gap * min_2 * min * inv_t3));
+                // ∂i/∂u (the input's noise in the measurement variance)
+                let di_du = K_E * t0;
+                // H = ∂i/∂z
+                let di_dz = N * t0
+                    * (1.0 / MU0 * inv_a_gap * min * sel_2 * inv_t3
+                        - 1.0 / MU0 * inv_a_gap * min_2 * min * (inv_t3 * inv_t3)
+                            * (INV_SQRT_A_GAP * ln * sel_2 - INV_SQRT_A_GAP * min_2 * t2 * sel_2));
+                // H = ∂i/∂φ
+                let di_dphi = N * t0
+                    * (R_CORE0 * inv_t1 * sel_4
+                        + R_CORE0 * inv_phi_sat * min * sel_4 * Real::signum0(min)
+                            * (inv_t1 * inv_t1) + 1.0 / MU0 * inv_a_gap * min_2 * sel_4 * inv_t3);
+                MeasurementOutput {
+                    i,
+                    di_du,
+                    di_dz,
+                    di_dphi,
+                }
+            }
+
+            /// Outputs of [`acceleration`].
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct AccelerationOutput {
+                /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                pub accel: $f,
+            }
+
+            /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
+            /// estimate's a, at the posterior.
+            #[inline]
+            #[must_use]
+            #[allow(clippy::excessive_precision)]
+            pub fn acceleration(z: $f, z_prev: $f, phi: $f, _u: $f) -> AccelerationOutput {
+                use reldesign_runtime::math::Real;
+
+                /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
+                const Z_EPS: $f = 1e-9;
+
+                /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+                const MU0: $f = 1.2566370614359173e-6;
+
+                /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+                const INV_SQRT_A_GAP: $f = 223.60679774997894;
+                let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
+                let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
+                let inv_a_gap = 1.0 / A_GAP;
+                let t0 = 1.0 / (min + Z_EPS);
+                let ln = Real::ln(2.0 * L_W * t0);
+                let t1 = INV_SQRT_A_GAP * min * ln + 1.0;
+                // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                let accel = 1.0 / M
+                    * (-(F0 + K_S * min + C / T_S * (z - z_prev))
+                        - 0.5 * (min_2 * min_2)
+                            * (1.0 / MU0 * inv_a_gap / t1
+                                - 1.0 / MU0 * inv_a_gap * min
+                                    * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
+                                    / (t1 * t1)));
+                AccelerationOutput { accel }
+            }
+        };
+    }
+
     /// The extended Kalman filter of `perfect_tracking_valve` in f32, on the discretised model of
     /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
-    /// below in `reldesign_runtime::observe::Ekf` (update with the symbolic ∂h/∂x in Joseph form,
-    /// prediction with the symbolic ∂F/∂x).
+    /// of `model!` in `reldesign_runtime::observe::Ekf` (update with the symbolic ∂h/∂x in
+    /// Joseph form, prediction with the symbolic ∂F/∂x).
     /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
     pub mod f32 {
         use reldesign_runtime::observe::{self, Linearisation, Prediction, Reading};
         params!(f32);
         kalman!(f32);
+        model!(f32);
 
-        /// Outputs of [`transition`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct TransitionOutput {
-            /// (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
-            pub z_next: f32,
-            /// (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
-            pub zp_next: f32,
-            /// (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
-            pub phi_next: f32,
-            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            pub accel: f32,
-            /// ∂z_{k+1}/∂z
-            pub dz_dz: f32,
-            /// ∂z_{k+1}/∂z_prev
-            pub dz_dzp: f32,
-            /// ∂z_{k+1}/∂φ
-            pub dz_dphi: f32,
-            /// ∂z_prev_{k+1}/∂z
-            pub dzp_dz: f32,
-            /// ∂φ_{k+1}/∂z
-            pub dphi_dz: f32,
-            /// ∂φ_{k+1}/∂φ
-            pub dphi_dphi: f32,
-            /// g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
-            pub dphi_du: f32,
-        }
-
-        /// The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held
-        /// over the sample, the acceleration f_v of (87), and the symbolic Jacobians
-        /// ∂F/∂x and g = ∂F/∂u (entries not listed are constant).
-        #[inline]
-        #[must_use]
-        pub fn transition(z: f32, z_prev: f32, phi: f32, u: f32) -> TransitionOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f32 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f32 = 223.6068;
-            let inv_m = 1.0_f32 / M;
-            let t_s_sq = T_S * T_S;
-            let max = Real::max(z, Z_MIN);
-            // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
-            let zp_next = Real::min(max, Z_MAX);
-            let inv_t_s = 1.0_f32 / T_S;
-            let max_2 = Real::max(phi, -PHI_LIM);
-            let min = Real::min(max_2, PHI_LIM);
-            let min_sq = min * min;
-            let inv_a_gap = 1.0_f32 / A_GAP;
-            let t0 = zp_next + Z_EPS;
-            let inv_t0 = 1.0_f32 / t0;
-            let ln = Real::ln(2.0_f32 * L_W * inv_t0);
-            let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f32;
-            let inv_t1 = 1.0_f32 / t1;
-            let t2 = INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * inv_t0;
-            let inv_t1_sq = inv_t1 * inv_t1;
-            let t3 = 1.0_f32 / MU0 * inv_a_gap * inv_t1
-                - 1.0_f32 / MU0 * inv_a_gap * zp_next * t2 * inv_t1_sq;
-            let t4 = -(F0 + K_S * zp_next + C * inv_t_s * (z - z_prev))
-                - 0.5_f32 * min_sq * t3;
-            let t5 = inv_m * t_s_sq * t4;
-            let max_3 = Real::max(2.0_f32 * z - z_prev + t5, Z_MIN);
-            let t6 = 1.0_f32 / (N * N + R * K_E);
-            let inv_phi_sat = 1.0_f32 / PHI_SAT;
-            let t7 = 1.0_f32 - inv_phi_sat * Real::abs(min);
-            let inv_t7 = 1.0_f32 / t7;
-            let t8 = Z_MAX - max_3;
-            let t9 = 2.0_f32 * z - z_prev - Z_MIN + t5;
-            let sel = if z - Z_MIN >= 0.0_f32 { 1.0_f32 } else { 0.0_f32 };
-            // ∂z_prev_{k+1}/∂z
-            let dzp_dz = if Z_MAX - max >= 0.0_f32 { sel } else { 0.0_f32 };
-            let t10 = INV_SQRT_A_GAP * ln * dzp_dz
-                - INV_SQRT_A_GAP * zp_next * inv_t0 * dzp_dz;
-            let sel_2 = if t9 >= 0.0_f32 {
-                inv_m * t_s_sq
-                    * (-(K_S * dzp_dz + C * inv_t_s)
-                        - 0.5_f32 * min_sq
-                            * (2.0_f32 / MU0 * inv_a_gap * zp_next * t2 * t10
-                                * (inv_t1_sq * inv_t1)
-                                - 1.0_f32 / MU0 * inv_a_gap * inv_t1_sq * t10
-                                - 1.0_f32 / MU0 * inv_a_gap * dzp_dz * t2 * inv_t1_sq
-                                - 1.0_f32 / MU0 * inv_a_gap * zp_next * inv_t1_sq
-                                    * (INV_SQRT_A_GAP * zp_next * dzp_dz * (inv_t0 * inv_t0)
-                                        - 2.0_f32 * INV_SQRT_A_GAP * inv_t0 * dzp_dz))) + 2.0_f32
-            } else {
-                0.0_f32
-            };
-            let sel_3 = if t9 >= 0.0_f32 { C * T_S * inv_m - 1.0_f32 } else { 0.0_f32 };
-            let sel_4 = if phi + PHI_LIM >= 0.0_f32 { 1.0_f32 } else { 0.0_f32 };
-            let sel_5 = if PHI_LIM - max_2 >= 0.0_f32 { sel_4 } else { 0.0_f32 };
-            let sel_6 = if t9 >= 0.0_f32 {
-                -inv_m * t_s_sq * min * sel_5 * t3
-            } else {
-                0.0_f32
-            };
-            // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
-            let z_next = Real::min(max_3, Z_MAX);
-            // (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
-            let phi_next = phi
-                + T_S * t6
-                    * (N * u
-                        - R
-                            * (R_CORE0 * min * inv_t7
-                                + 1.0_f32 / MU0 * inv_a_gap * zp_next * min * inv_t1));
-            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            let accel = inv_m * t4;
-            // ∂z_{k+1}/∂z
-            let dz_dz = if t8 >= 0.0_f32 { sel_2 } else { 0.0_f32 };
-            // ∂z_{k+1}/∂z_prev
-            let dz_dzp = if t8 >= 0.0_f32 { sel_3 } else { 0.0_f32 };
-            // ∂z_{k+1}/∂φ
-            let dz_dphi = if t8 >= 0.0_f32 { sel_6 } else { 0.0_f32 };
-            // ∂φ_{k+1}/∂z
-            let dphi_dz = -R * T_S * t6
-                * (1.0_f32 / MU0 * inv_a_gap * min * dzp_dz * inv_t1
-                    - 1.0_f32 / MU0 * inv_a_gap * zp_next * min * inv_t1_sq * t10);
-            // ∂φ_{k+1}/∂φ
-            let dphi_dphi = 1.0_f32
-                - R * T_S * t6
-                    * (R_CORE0 * inv_t7 * sel_5
-                        + R_CORE0 * inv_phi_sat * min * sel_5 * Real::signum0(min)
-                            * (inv_t7 * inv_t7)
-                        + 1.0_f32 / MU0 * inv_a_gap * zp_next * sel_5 * inv_t1);
-            // g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
-            let dphi_du = N * T_S * t6;
-            TransitionOutput {
-                z_next,
-                zp_next,
-                phi_next,
-                accel,
-                dz_dz,
-                dz_dzp,
-                dz_dphi,
-                dzp_dz,
-                dphi_dz,
-                dphi_dphi,
-                dphi_du,
-            }
-        }
-
-        /// Outputs of [`measurement`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct MeasurementOutput {
-            /// i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
-            pub i: f32,
-            /// ∂i/∂u (the input's noise in the measurement variance)
-            pub di_du: f32,
-            /// H = ∂i/∂z
-            pub di_dz: f32,
-            /// H = ∂i/∂φ
-            pub di_dphi: f32,
-        }
-
-        /// The measured quantity y = h(x, u) on the model's domain and its derivatives
-        /// (entries of ∂h/∂x not listed are constant).
-        #[inline]
-        #[must_use]
-        pub fn measurement(z: f32, _z_prev: f32, phi: f32, u: f32) -> MeasurementOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f32 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f32 = 223.6068;
-            let t0 = 1.0_f32 / (N * N + R * K_E);
-            let max = Real::max(phi, -PHI_LIM);
-            let min = Real::min(max, PHI_LIM);
-            let inv_phi_sat = 1.0_f32 / PHI_SAT;
-            let t1 = 1.0_f32 - inv_phi_sat * Real::abs(min);
-            let inv_t1 = 1.0_f32 / t1;
-            let inv_a_gap = 1.0_f32 / A_GAP;
-            let max_2 = Real::max(z, Z_MIN);
-            let min_2 = Real::min(max_2, Z_MAX);
-            let t2 = 1.0_f32 / (min_2 + Z_EPS);
-            let ln = Real::ln(2.0_f32 * L_W * t2);
-            let t3 = INV_SQRT_A_GAP * min_2 * ln + 1.0_f32;
-            let inv_t3 = 1.0_f32 / t3;
-            let sel = if z - Z_MIN >= 0.0_f32 { 1.0_f32 } else { 0.0_f32 };
-            let sel_2 = if Z_MAX - max_2 >= 0.0_f32 { sel } else { 0.0_f32 };
-            let sel_3 = if phi + PHI_LIM >= 0.0_f32 { 1.0_f32 } else { 0.0_f32 };
-            let sel_4 = if PHI_LIM - max >= 0.0_f32 { sel_3 } else { 0.0_f32 };
-            // i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
-            let i = t0
-                * (K_E * u
-                    + N
-                        * (R_CORE0 * min * inv_t1
-                            + 1.0_f32 / MU0 * inv_a_gap * min_2 * min * inv_t3));
-            // ∂i/∂u (the input's noise in the measurement variance)
-            let di_du = K_E * t0;
-            // H = ∂i/∂z
-            let di_dz = N * t0
-                * (1.0_f32 / MU0 * inv_a_gap * min * sel_2 * inv_t3
-                    - 1.0_f32 / MU0 * inv_a_gap * min_2 * min * (inv_t3 * inv_t3)
-                        * (INV_SQRT_A_GAP * ln * sel_2
-                            - INV_SQRT_A_GAP * min_2 * t2 * sel_2));
-            // H = ∂i/∂φ
-            let di_dphi = N * t0
-                * (R_CORE0 * inv_t1 * sel_4
-                    + R_CORE0 * inv_phi_sat * min * sel_4 * Real::signum0(min)
-                        * (inv_t1 * inv_t1)
-                    + 1.0_f32 / MU0 * inv_a_gap * min_2 * sel_4 * inv_t3);
-            MeasurementOutput {
-                i,
-                di_du,
-                di_dz,
-                di_dphi,
-            }
-        }
-
-        /// Outputs of [`acceleration`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct AccelerationOutput {
-            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            pub accel: f32,
-        }
-
-        /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
-        /// estimate's a, at the posterior.
-        #[inline]
-        #[must_use]
-        pub fn acceleration(z: f32, z_prev: f32, phi: f32, _u: f32) -> AccelerationOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f32 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f32 = 223.6068;
-            let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
-            let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-            let inv_a_gap = 1.0_f32 / A_GAP;
-            let t0 = 1.0_f32 / (min + Z_EPS);
-            let ln = Real::ln(2.0_f32 * L_W * t0);
-            let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f32;
-            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            let accel = 1.0_f32 / M
-                * (-(F0 + K_S * min + C / T_S * (z - z_prev))
-                    - 0.5_f32 * (min_2 * min_2)
-                        * (1.0_f32 / MU0 * inv_a_gap / t1
-                            - 1.0_f32 / MU0 * inv_a_gap * min
-                                * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
-                                / (t1 * t1)));
-            AccelerationOutput { accel }
-        }
-
-        /// The discretised model: the functions above, for the runtime's filter.
+        /// The discretised model: the functions of `model!`, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Model;
 
@@ -1060,271 +960,16 @@ pub mod ekf {
 
     /// The extended Kalman filter of `perfect_tracking_valve` in f64, on the discretised model of
     /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
-    /// below in `reldesign_runtime::observe::Ekf` (update with the symbolic ∂h/∂x in Joseph form,
-    /// prediction with the symbolic ∂F/∂x).
+    /// of `model!` in `reldesign_runtime::observe::Ekf` (update with the symbolic ∂h/∂x in
+    /// Joseph form, prediction with the symbolic ∂F/∂x).
     /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
     pub mod f64 {
         use reldesign_runtime::observe::{self, Linearisation, Prediction, Reading};
         params!(f64);
         kalman!(f64);
+        model!(f64);
 
-        /// Outputs of [`transition`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct TransitionOutput {
-            /// (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
-            pub z_next: f64,
-            /// (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
-            pub zp_next: f64,
-            /// (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
-            pub phi_next: f64,
-            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            pub accel: f64,
-            /// ∂z_{k+1}/∂z
-            pub dz_dz: f64,
-            /// ∂z_{k+1}/∂z_prev
-            pub dz_dzp: f64,
-            /// ∂z_{k+1}/∂φ
-            pub dz_dphi: f64,
-            /// ∂z_prev_{k+1}/∂z
-            pub dzp_dz: f64,
-            /// ∂φ_{k+1}/∂z
-            pub dphi_dz: f64,
-            /// ∂φ_{k+1}/∂φ
-            pub dphi_dphi: f64,
-            /// g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
-            pub dphi_du: f64,
-        }
-
-        /// The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held
-        /// over the sample, the acceleration f_v of (87), and the symbolic Jacobians
-        /// ∂F/∂x and g = ∂F/∂u (entries not listed are constant).
-        #[inline]
-        #[must_use]
-        pub fn transition(z: f64, z_prev: f64, phi: f64, u: f64) -> TransitionOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f64 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
-            let inv_m = 1.0_f64 / M;
-            let t_s_sq = T_S * T_S;
-            let max = Real::max(z, Z_MIN);
-            // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
-            let zp_next = Real::min(max, Z_MAX);
-            let inv_t_s = 1.0_f64 / T_S;
-            let max_2 = Real::max(phi, -PHI_LIM);
-            let min = Real::min(max_2, PHI_LIM);
-            let min_sq = min * min;
-            let inv_a_gap = 1.0_f64 / A_GAP;
-            let t0 = zp_next + Z_EPS;
-            let inv_t0 = 1.0_f64 / t0;
-            let ln = Real::ln(2.0_f64 * L_W * inv_t0);
-            let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f64;
-            let inv_t1 = 1.0_f64 / t1;
-            let t2 = INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * inv_t0;
-            let inv_t1_sq = inv_t1 * inv_t1;
-            let t3 = 1.0_f64 / MU0 * inv_a_gap * inv_t1
-                - 1.0_f64 / MU0 * inv_a_gap * zp_next * t2 * inv_t1_sq;
-            let t4 = -(F0 + K_S * zp_next + C * inv_t_s * (z - z_prev))
-                - 0.5_f64 * min_sq * t3;
-            let t5 = inv_m * t_s_sq * t4;
-            let max_3 = Real::max(2.0_f64 * z - z_prev + t5, Z_MIN);
-            let t6 = 1.0_f64 / (N * N + R * K_E);
-            let inv_phi_sat = 1.0_f64 / PHI_SAT;
-            let t7 = 1.0_f64 - inv_phi_sat * Real::abs(min);
-            let inv_t7 = 1.0_f64 / t7;
-            let t8 = Z_MAX - max_3;
-            let t9 = 2.0_f64 * z - z_prev - Z_MIN + t5;
-            let sel = if z - Z_MIN >= 0.0_f64 { 1.0_f64 } else { 0.0_f64 };
-            // ∂z_prev_{k+1}/∂z
-            let dzp_dz = if Z_MAX - max >= 0.0_f64 { sel } else { 0.0_f64 };
-            let t10 = INV_SQRT_A_GAP * ln * dzp_dz
-                - INV_SQRT_A_GAP * zp_next * inv_t0 * dzp_dz;
-            let sel_2 = if t9 >= 0.0_f64 {
-                inv_m * t_s_sq
-                    * (-(K_S * dzp_dz + C * inv_t_s)
-                        - 0.5_f64 * min_sq
-                            * (2.0_f64 / MU0 * inv_a_gap * zp_next * t2 * t10
-                                * (inv_t1_sq * inv_t1)
-                                - 1.0_f64 / MU0 * inv_a_gap * inv_t1_sq * t10
-                                - 1.0_f64 / MU0 * inv_a_gap * dzp_dz * t2 * inv_t1_sq
-                                - 1.0_f64 / MU0 * inv_a_gap * zp_next * inv_t1_sq
-                                    * (INV_SQRT_A_GAP * zp_next * dzp_dz * (inv_t0 * inv_t0)
-                                        - 2.0_f64 * INV_SQRT_A_GAP * inv_t0 * dzp_dz))) + 2.0_f64
-            } else {
-                0.0_f64
-            };
-            let sel_3 = if t9 >= 0.0_f64 { C * T_S * inv_m - 1.0_f64 } else { 0.0_f64 };
-            let sel_4 = if phi + PHI_LIM >= 0.0_f64 { 1.0_f64 } else { 0.0_f64 };
-            let sel_5 = if PHI_LIM - max_2 >= 0.0_f64 { sel_4 } else { 0.0_f64 };
-            let sel_6 = if t9 >= 0.0_f64 {
-                -inv_m * t_s_sq * min * sel_5 * t3
-            } else {
-                0.0_f64
-            };
-            // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
-            let z_next = Real::min(max_3, Z_MAX);
-            // (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
-            let phi_next = phi
-                + T_S * t6
-                    * (N * u
-                        - R
-                            * (R_CORE0 * min * inv_t7
-                                + 1.0_f64 / MU0 * inv_a_gap * zp_next * min * inv_t1));
-            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            let accel = inv_m * t4;
-            // ∂z_{k+1}/∂z
-            let dz_dz = if t8 >= 0.0_f64 { sel_2 } else { 0.0_f64 };
-            // ∂z_{k+1}/∂z_prev
-            let dz_dzp = if t8 >= 0.0_f64 { sel_3 } else { 0.0_f64 };
-            // ∂z_{k+1}/∂φ
-            let dz_dphi = if t8 >= 0.0_f64 { sel_6 } else { 0.0_f64 };
-            // ∂φ_{k+1}/∂z
-            let dphi_dz = -R * T_S * t6
-                * (1.0_f64 / MU0 * inv_a_gap * min * dzp_dz * inv_t1
-                    - 1.0_f64 / MU0 * inv_a_gap * zp_next * min * inv_t1_sq * t10);
-            // ∂φ_{k+1}/∂φ
-            let dphi_dphi = 1.0_f64
-                - R * T_S * t6
-                    * (R_CORE0 * inv_t7 * sel_5
-                        + R_CORE0 * inv_phi_sat * min * sel_5 * Real::signum0(min)
-                            * (inv_t7 * inv_t7)
-                        + 1.0_f64 / MU0 * inv_a_gap * zp_next * sel_5 * inv_t1);
-            // g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
-            let dphi_du = N * T_S * t6;
-            TransitionOutput {
-                z_next,
-                zp_next,
-                phi_next,
-                accel,
-                dz_dz,
-                dz_dzp,
-                dz_dphi,
-                dzp_dz,
-                dphi_dz,
-                dphi_dphi,
-                dphi_du,
-            }
-        }
-
-        /// Outputs of [`measurement`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct MeasurementOutput {
-            /// i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
-            pub i: f64,
-            /// ∂i/∂u (the input's noise in the measurement variance)
-            pub di_du: f64,
-            /// H = ∂i/∂z
-            pub di_dz: f64,
-            /// H = ∂i/∂φ
-            pub di_dphi: f64,
-        }
-
-        /// The measured quantity y = h(x, u) on the model's domain and its derivatives
-        /// (entries of ∂h/∂x not listed are constant).
-        #[inline]
-        #[must_use]
-        pub fn measurement(z: f64, _z_prev: f64, phi: f64, u: f64) -> MeasurementOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f64 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
-            let t0 = 1.0_f64 / (N * N + R * K_E);
-            let max = Real::max(phi, -PHI_LIM);
-            let min = Real::min(max, PHI_LIM);
-            let inv_phi_sat = 1.0_f64 / PHI_SAT;
-            let t1 = 1.0_f64 - inv_phi_sat * Real::abs(min);
-            let inv_t1 = 1.0_f64 / t1;
-            let inv_a_gap = 1.0_f64 / A_GAP;
-            let max_2 = Real::max(z, Z_MIN);
-            let min_2 = Real::min(max_2, Z_MAX);
-            let t2 = 1.0_f64 / (min_2 + Z_EPS);
-            let ln = Real::ln(2.0_f64 * L_W * t2);
-            let t3 = INV_SQRT_A_GAP * min_2 * ln + 1.0_f64;
-            let inv_t3 = 1.0_f64 / t3;
-            let sel = if z - Z_MIN >= 0.0_f64 { 1.0_f64 } else { 0.0_f64 };
-            let sel_2 = if Z_MAX - max_2 >= 0.0_f64 { sel } else { 0.0_f64 };
-            let sel_3 = if phi + PHI_LIM >= 0.0_f64 { 1.0_f64 } else { 0.0_f64 };
-            let sel_4 = if PHI_LIM - max >= 0.0_f64 { sel_3 } else { 0.0_f64 };
-            // i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
-            let i = t0
-                * (K_E * u
-                    + N
-                        * (R_CORE0 * min * inv_t1
-                            + 1.0_f64 / MU0 * inv_a_gap * min_2 * min * inv_t3));
-            // ∂i/∂u (the input's noise in the measurement variance)
-            let di_du = K_E * t0;
-            // H = ∂i/∂z
-            let di_dz = N * t0
-                * (1.0_f64 / MU0 * inv_a_gap * min * sel_2 * inv_t3
-                    - 1.0_f64 / MU0 * inv_a_gap * min_2 * min * (inv_t3 * inv_t3)
-                        * (INV_SQRT_A_GAP * ln * sel_2
-                            - INV_SQRT_A_GAP * min_2 * t2 * sel_2));
-            // H = ∂i/∂φ
-            let di_dphi = N * t0
-                * (R_CORE0 * inv_t1 * sel_4
-                    + R_CORE0 * inv_phi_sat * min * sel_4 * Real::signum0(min)
-                        * (inv_t1 * inv_t1)
-                    + 1.0_f64 / MU0 * inv_a_gap * min_2 * sel_4 * inv_t3);
-            MeasurementOutput {
-                i,
-                di_du,
-                di_dz,
-                di_dphi,
-            }
-        }
-
-        /// Outputs of [`acceleration`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct AccelerationOutput {
-            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            pub accel: f64,
-        }
-
-        /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
-        /// estimate's a, at the posterior.
-        #[inline]
-        #[must_use]
-        pub fn acceleration(z: f64, z_prev: f64, phi: f64, _u: f64) -> AccelerationOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f64 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
-            let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
-            let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-            let inv_a_gap = 1.0_f64 / A_GAP;
-            let t0 = 1.0_f64 / (min + Z_EPS);
-            let ln = Real::ln(2.0_f64 * L_W * t0);
-            let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f64;
-            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            let accel = 1.0_f64 / M
-                * (-(F0 + K_S * min + C / T_S * (z - z_prev))
-                    - 0.5_f64 * (min_2 * min_2)
-                        * (1.0_f64 / MU0 * inv_a_gap / t1
-                            - 1.0_f64 / MU0 * inv_a_gap * min
-                                * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
-                                / (t1 * t1)));
-            AccelerationOutput { accel }
-        }
-
-        /// The discretised model: the functions above, for the runtime's filter.
+        /// The discretised model: the functions of `model!`, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Model;
 
@@ -1390,177 +1035,189 @@ pub mod ekf {
 
 /// The unscented Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).
 pub mod ukf {
+    /// The model functions of `perfect_tracking_valve` over the float type `$f`, written once and declared in
+    /// each float module below as `model!(f64)` / `model!(f32)`. Their literals are unsuffixed
+    /// and `$f` types them: an f32 module reads each as the nearest f32, the value an f32
+    /// literal of its own would hold.
+    macro_rules! model {
+        ($f:ty) => {
+            /// Outputs of [`transition`].
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct TransitionOutput {
+                /// (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
+                pub z_next: $f,
+                /// (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
+                pub zp_next: $f,
+                /// (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
+                pub phi_next: $f,
+                /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                pub accel: $f,
+            }
+
+            /// The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held
+            /// over the sample, and the acceleration f_v of (87).
+            #[inline]
+            #[must_use]
+            #[allow(clippy::excessive_precision)]
+            pub fn transition(z: $f, z_prev: $f, phi: $f, u: $f) -> TransitionOutput {
+                use reldesign_runtime::math::Real;
+
+                /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
+                const Z_EPS: $f = 1e-9;
+
+                /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+                const MU0: $f = 1.2566370614359173e-6;
+
+                /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+                const INV_SQRT_A_GAP: $f = 223.60679774997894;
+                let inv_m = 1.0 / M;
+                // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
+                let zp_next = Real::min(Real::max(z, Z_MIN), Z_MAX);
+                let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
+                let inv_a_gap = 1.0 / A_GAP;
+                let t0 = 1.0 / (zp_next + Z_EPS);
+                let ln = Real::ln(2.0 * L_W * t0);
+                let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0;
+                let inv_t1 = 1.0 / t1;
+                let t2 = -(F0 + K_S * zp_next + C / T_S * (z - z_prev))
+                    - 0.5 * (min * min)
+                        * (1.0 / MU0 * inv_a_gap * inv_t1
+                            - 1.0 / MU0 * inv_a_gap * zp_next
+                                * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * t0)
+                                * (inv_t1 * inv_t1));
+                // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
+                let z_next = Real::min(
+                    Real::max(2.0 * z - z_prev + inv_m * (T_S * T_S) * t2, Z_MIN),
+                    Z_MAX,
+                );
+                // (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
+                let phi_next = phi
+                    + T_S / (N * N + R * K_E)
+                        * (N * u
+                            - R
+                                * (R_CORE0 * min / (1.0 - 1.0 / PHI_SAT * Real::abs(min))
+                                    + 1.0 / MU0 * inv_a_gap * zp_next * min * inv_t1));
+                // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                let accel = inv_m * t2;
+                TransitionOutput {
+                    z_next,
+                    zp_next,
+                    phi_next,
+                    accel,
+                }
+            }
+
+            /// Outputs of [`measurement`].
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct MeasurementOutput {
+                /// i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
+                pub i: $f,
+                /// ∂i/∂u (the input's noise in the measurement variance)
+                pub di_du: $f,
+            }
+
+            /// The measured quantity y = h(x, u) on the model's domain and ∂h/∂u.
+            #[inline]
+            #[must_use]
+            #[allow(clippy::excessive_precision)]
+            pub fn measurement(z: $f, _z_prev: $f, phi: $f, u: $f) -> MeasurementOutput {
+                use reldesign_runtime::math::Real;
+
+                /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
+                const Z_EPS: $f = 1e-9;
+
+                /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+                const MU0: $f = 1.2566370614359173e-6;
+
+                /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+                const INV_SQRT_A_GAP: $f = 223.60679774997894;
+                let t0 = 1.0 / (N * N + R * K_E);
+                let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
+                let min_2 = Real::min(Real::max(z, Z_MIN), Z_MAX);
+                // i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
+                let i = t0
+                    * (K_E * u
+                        + N
+                            * (R_CORE0 * min / (1.0 - 1.0 / PHI_SAT * Real::abs(min))
+                                + 1.0 / MU0 / A_GAP * min_2 * min
+                                    / (INV_SQRT_A_GAP * min_2 * Real::ln(2.0 * L_W / (min_2 + Z_EPS))
+                                        + 1.0)));
+                // ∂i/∂u (the input's noise in the measurement variance)
+                let di_du = K_E * t0;
+                MeasurementOutput { i, di_du }
+            }
+
+            /// Outputs of [`acceleration`].
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct AccelerationOutput {
+                /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                pub accel: $f,
+            }
+
+            /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
+            /// estimate's a, at the posterior.
+            #[inline]
+            #[must_use]
+            #[allow(clippy::excessive_precision)]
+            pub fn acceleration(z: $f, z_prev: $f, phi: $f, _u: $f) -> AccelerationOutput {
+                use reldesign_runtime::math::Real;
+
+                /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
+                const Z_EPS: $f = 1e-9;
+
+                /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
+                const MU0: $f = 1.2566370614359173e-6;
+
+                /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
+                const INV_SQRT_A_GAP: $f = 223.60679774997894;
+                let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
+                let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
+                let inv_a_gap = 1.0 / A_GAP;
+                let t0 = 1.0 / (min + Z_EPS);
+                let ln = Real::ln(2.0 * L_W * t0);
+                let t1 = INV_SQRT_A_GAP * min * ln + 1.0;
+                // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                let accel = 1.0 / M
+                    * (-(F0 + K_S * min + C / T_S * (z - z_prev))
+                        - 0.5 * (min_2 * min_2)
+                            * (1.0 / MU0 * inv_a_gap / t1
+                                - 1.0 / MU0 * inv_a_gap * min
+                                    * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
+                                    / (t1 * t1)));
+                AccelerationOutput { accel }
+            }
+
+            /// Outputs of [`input_gain`].
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct InputGainOutput {
+                /// g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
+                pub dphi_du: $f,
+            }
+
+            /// g = ∂F/∂u of the transition (84): the input's noise σ_u enters the process
+            /// noise as σ_u²·g·gᵀ. Entries not listed are constant.
+            #[inline]
+            #[must_use]
+            pub fn input_gain(_z: $f, _z_prev: $f, _phi: $f, _u: $f) -> InputGainOutput {
+                // g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
+                let dphi_du = N * T_S / (N * N + R * K_E);
+                InputGainOutput { dphi_du }
+            }
+        };
+    }
+
     /// The unscented Kalman filter of `perfect_tracking_valve` in f32, on the discretised model of
     /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
-    /// below in `reldesign_runtime::observe::Ukf` (sigma points x̄ ± γ·(columns of chol P) through h
-    /// and F; failed factorisations are repaired and counted).
+    /// of `model!` in `reldesign_runtime::observe::Ukf` (sigma points x̄ ± γ·(columns of chol P)
+    /// through h and F; failed factorisations are repaired and counted).
     /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
     pub mod f32 {
         use reldesign_runtime::observe::{self, Prediction, Reading};
         params!(f32);
         kalman!(f32);
+        model!(f32);
 
-        /// Outputs of [`transition`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct TransitionOutput {
-            /// (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
-            pub z_next: f32,
-            /// (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
-            pub zp_next: f32,
-            /// (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
-            pub phi_next: f32,
-            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            pub accel: f32,
-        }
-
-        /// The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held
-        /// over the sample, and the acceleration f_v of (87).
-        #[inline]
-        #[must_use]
-        pub fn transition(z: f32, z_prev: f32, phi: f32, u: f32) -> TransitionOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f32 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f32 = 223.6068;
-            let inv_m = 1.0_f32 / M;
-            // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
-            let zp_next = Real::min(Real::max(z, Z_MIN), Z_MAX);
-            let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-            let inv_a_gap = 1.0_f32 / A_GAP;
-            let t0 = 1.0_f32 / (zp_next + Z_EPS);
-            let ln = Real::ln(2.0_f32 * L_W * t0);
-            let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f32;
-            let inv_t1 = 1.0_f32 / t1;
-            let t2 = -(F0 + K_S * zp_next + C / T_S * (z - z_prev))
-                - 0.5_f32 * (min * min)
-                    * (1.0_f32 / MU0 * inv_a_gap * inv_t1
-                        - 1.0_f32 / MU0 * inv_a_gap * zp_next
-                            * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * t0)
-                            * (inv_t1 * inv_t1));
-            // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
-            let z_next = Real::min(
-                Real::max(2.0_f32 * z - z_prev + inv_m * (T_S * T_S) * t2, Z_MIN),
-                Z_MAX,
-            );
-            // (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
-            let phi_next = phi
-                + T_S / (N * N + R * K_E)
-                    * (N * u
-                        - R
-                            * (R_CORE0 * min / (1.0_f32 - 1.0_f32 / PHI_SAT * Real::abs(min))
-                                + 1.0_f32 / MU0 * inv_a_gap * zp_next * min * inv_t1));
-            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            let accel = inv_m * t2;
-            TransitionOutput {
-                z_next,
-                zp_next,
-                phi_next,
-                accel,
-            }
-        }
-
-        /// Outputs of [`measurement`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct MeasurementOutput {
-            /// i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
-            pub i: f32,
-            /// ∂i/∂u (the input's noise in the measurement variance)
-            pub di_du: f32,
-        }
-
-        /// The measured quantity y = h(x, u) on the model's domain and ∂h/∂u.
-        #[inline]
-        #[must_use]
-        pub fn measurement(z: f32, _z_prev: f32, phi: f32, u: f32) -> MeasurementOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f32 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f32 = 223.6068;
-            let t0 = 1.0_f32 / (N * N + R * K_E);
-            let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-            let min_2 = Real::min(Real::max(z, Z_MIN), Z_MAX);
-            // i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
-            let i = t0
-                * (K_E * u
-                    + N
-                        * (R_CORE0 * min / (1.0_f32 - 1.0_f32 / PHI_SAT * Real::abs(min))
-                            + 1.0_f32 / MU0 / A_GAP * min_2 * min
-                                / (INV_SQRT_A_GAP * min_2
-                                    * Real::ln(2.0_f32 * L_W / (min_2 + Z_EPS)) + 1.0_f32)));
-            // ∂i/∂u (the input's noise in the measurement variance)
-            let di_du = K_E * t0;
-            MeasurementOutput { i, di_du }
-        }
-
-        /// Outputs of [`acceleration`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct AccelerationOutput {
-            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            pub accel: f32,
-        }
-
-        /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
-        /// estimate's a, at the posterior.
-        #[inline]
-        #[must_use]
-        pub fn acceleration(z: f32, z_prev: f32, phi: f32, _u: f32) -> AccelerationOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f32 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f32 = 1.256637e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f32 = 223.6068;
-            let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
-            let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-            let inv_a_gap = 1.0_f32 / A_GAP;
-            let t0 = 1.0_f32 / (min + Z_EPS);
-            let ln = Real::ln(2.0_f32 * L_W * t0);
-            let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f32;
-            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            let accel = 1.0_f32 / M
-                * (-(F0 + K_S * min + C / T_S * (z - z_prev))
-                    - 0.5_f32 * (min_2 * min_2)
-                        * (1.0_f32 / MU0 * inv_a_gap / t1
-                            - 1.0_f32 / MU0 * inv_a_gap * min
-                                * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
-                                / (t1 * t1)));
-            AccelerationOutput { accel }
-        }
-
-        /// Outputs of [`input_gain`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct InputGainOutput {
-            /// g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
-            pub dphi_du: f32,
-        }
-
-        /// g = ∂F/∂u of the transition (84): the input's noise σ_u enters the process
-        /// noise as σ_u²·g·gᵀ. Entries not listed are constant.
-        #[inline]
-        #[must_use]
-        pub fn input_gain(_z: f32, _z_prev: f32, _phi: f32, _u: f32) -> InputGainOutput {
-            // g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
-            let dphi_du = N * T_S / (N * N + R * K_E);
-            InputGainOutput { dphi_du }
-        }
-
-        /// The discretised model: the functions above, for the runtime's filter.
+        /// The discretised model: the functions of `model!`, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Model;
 
@@ -1613,175 +1270,16 @@ pub mod ukf {
 
     /// The unscented Kalman filter of `perfect_tracking_valve` in f64, on the discretised model of
     /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
-    /// below in `reldesign_runtime::observe::Ukf` (sigma points x̄ ± γ·(columns of chol P) through h
-    /// and F; failed factorisations are repaired and counted).
+    /// of `model!` in `reldesign_runtime::observe::Ukf` (sigma points x̄ ± γ·(columns of chol P)
+    /// through h and F; failed factorisations are repaired and counted).
     /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
     pub mod f64 {
         use reldesign_runtime::observe::{self, Prediction, Reading};
         params!(f64);
         kalman!(f64);
+        model!(f64);
 
-        /// Outputs of [`transition`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct TransitionOutput {
-            /// (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
-            pub z_next: f64,
-            /// (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
-            pub zp_next: f64,
-            /// (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
-            pub phi_next: f64,
-            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            pub accel: f64,
-        }
-
-        /// The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held
-        /// over the sample, and the acceleration f_v of (87).
-        #[inline]
-        #[must_use]
-        pub fn transition(z: f64, z_prev: f64, phi: f64, u: f64) -> TransitionOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f64 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
-            let inv_m = 1.0_f64 / M;
-            // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
-            let zp_next = Real::min(Real::max(z, Z_MIN), Z_MAX);
-            let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-            let inv_a_gap = 1.0_f64 / A_GAP;
-            let t0 = 1.0_f64 / (zp_next + Z_EPS);
-            let ln = Real::ln(2.0_f64 * L_W * t0);
-            let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0_f64;
-            let inv_t1 = 1.0_f64 / t1;
-            let t2 = -(F0 + K_S * zp_next + C / T_S * (z - z_prev))
-                - 0.5_f64 * (min * min)
-                    * (1.0_f64 / MU0 * inv_a_gap * inv_t1
-                        - 1.0_f64 / MU0 * inv_a_gap * zp_next
-                            * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * t0)
-                            * (inv_t1 * inv_t1));
-            // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
-            let z_next = Real::min(
-                Real::max(2.0_f64 * z - z_prev + inv_m * (T_S * T_S) * t2, Z_MIN),
-                Z_MAX,
-            );
-            // (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
-            let phi_next = phi
-                + T_S / (N * N + R * K_E)
-                    * (N * u
-                        - R
-                            * (R_CORE0 * min / (1.0_f64 - 1.0_f64 / PHI_SAT * Real::abs(min))
-                                + 1.0_f64 / MU0 * inv_a_gap * zp_next * min * inv_t1));
-            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            let accel = inv_m * t2;
-            TransitionOutput {
-                z_next,
-                zp_next,
-                phi_next,
-                accel,
-            }
-        }
-
-        /// Outputs of [`measurement`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct MeasurementOutput {
-            /// i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
-            pub i: f64,
-            /// ∂i/∂u (the input's noise in the measurement variance)
-            pub di_du: f64,
-        }
-
-        /// The measured quantity y = h(x, u) on the model's domain and ∂h/∂u.
-        #[inline]
-        #[must_use]
-        pub fn measurement(z: f64, _z_prev: f64, phi: f64, u: f64) -> MeasurementOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f64 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
-            let t0 = 1.0_f64 / (N * N + R * K_E);
-            let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-            let min_2 = Real::min(Real::max(z, Z_MIN), Z_MAX);
-            // i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
-            let i = t0
-                * (K_E * u
-                    + N
-                        * (R_CORE0 * min / (1.0_f64 - 1.0_f64 / PHI_SAT * Real::abs(min))
-                            + 1.0_f64 / MU0 / A_GAP * min_2 * min
-                                / (INV_SQRT_A_GAP * min_2
-                                    * Real::ln(2.0_f64 * L_W / (min_2 + Z_EPS)) + 1.0_f64)));
-            // ∂i/∂u (the input's noise in the measurement variance)
-            let di_du = K_E * t0;
-            MeasurementOutput { i, di_du }
-        }
-
-        /// Outputs of [`acceleration`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct AccelerationOutput {
-            /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            pub accel: f64,
-        }
-
-        /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
-        /// estimate's a, at the posterior.
-        #[inline]
-        #[must_use]
-        pub fn acceleration(z: f64, z_prev: f64, phi: f64, _u: f64) -> AccelerationOutput {
-            use reldesign_runtime::math::Real;
-
-            /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
-            const Z_EPS: f64 = 1e-9;
-
-            /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
-            const MU0: f64 = 1.2566370614359173e-6;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: f64 = 223.60679774997894;
-            let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
-            let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-            let inv_a_gap = 1.0_f64 / A_GAP;
-            let t0 = 1.0_f64 / (min + Z_EPS);
-            let ln = Real::ln(2.0_f64 * L_W * t0);
-            let t1 = INV_SQRT_A_GAP * min * ln + 1.0_f64;
-            // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
-            let accel = 1.0_f64 / M
-                * (-(F0 + K_S * min + C / T_S * (z - z_prev))
-                    - 0.5_f64 * (min_2 * min_2)
-                        * (1.0_f64 / MU0 * inv_a_gap / t1
-                            - 1.0_f64 / MU0 * inv_a_gap * min
-                                * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
-                                / (t1 * t1)));
-            AccelerationOutput { accel }
-        }
-
-        /// Outputs of [`input_gain`].
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct InputGainOutput {
-            /// g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
-            pub dphi_du: f64,
-        }
-
-        /// g = ∂F/∂u of the transition (84): the input's noise σ_u enters the process
-        /// noise as σ_u²·g·gᵀ. Entries not listed are constant.
-        #[inline]
-        #[must_use]
-        pub fn input_gain(_z: f64, _z_prev: f64, _phi: f64, _u: f64) -> InputGainOutput {
-            // g = ∂φ_{k+1}/∂u (maps the input's noise into Q)
-            let dphi_du = N * T_S / (N * N + R * K_E);
-            InputGainOutput { dphi_du }
-        }
-
-        /// The discretised model: the functions above, for the runtime's filter.
+        /// The discretised model: the functions of `model!`, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Model;
 

@@ -9,9 +9,9 @@ use designer::sym::{Graph, Id};
 use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::emit::{function_tokens, FunctionSpec};
+use crate::emit::{function_tokens_as, FunctionSpec, Inline};
 use crate::error::EmitError;
-use crate::float::Float;
+use crate::float::{Float, Scalar};
 use crate::param::Param;
 
 use super::{lit, Kind, ObserverError};
@@ -48,12 +48,13 @@ pub(super) struct Function {
 }
 
 impl Function {
+    /// The output struct and the function, written in `scalar`.
     pub(super) fn tokens(
         &self,
         graph: &Graph,
         dm: &DiscreteModel,
         params: &[Param],
-        float: Float,
+        scalar: Scalar,
     ) -> Result<TokenStream, EmitError> {
         let mut inputs: Vec<(&str, Id)> = state_names(dm)
             .iter()
@@ -75,9 +76,10 @@ impl Function {
                 .collect(),
             named: vec![],
             output_symbols: vec![],
-            float,
+            // written in `scalar` (function_tokens_as)
+            float: Float::F64,
         };
-        function_tokens(graph, &spec, params)
+        function_tokens_as(graph, &spec, params, Inline::Hint, scalar)
     }
 
     pub(super) fn comments(&self) -> Vec<(&str, &str)> {

@@ -5,15 +5,18 @@
 //! The filters themselves are the runtime's (`reldesign_runtime::observe`:
 //! `Ekf`, `Ukf`, generic over the float and the model), written once; the
 //! emitted code holds only what is the model's. [`emit_ekf`] and
-//! [`emit_ukf`] return one `pub mod f64 { … }` / `pub mod f32 { … }` per
-//! requested float type (the caller wraps them, e.g. in `pub mod ekf { … }`,
-//! which [`wrap_module`] does), each with:
+//! [`emit_ukf`] return `macro_rules! model { ($f:ty) => { … } }`, the model
+//! functions written once over the float type, and one `pub mod f64 { … }` /
+//! `pub mod f32 { … }` per requested float type (the caller wraps them, e.g.
+//! in `pub mod ekf { … }`, which [`wrap_module`] does, so that each filter's
+//! `model!` is its own), each with:
 //!
 //! - `params!(f64)` and `kalman!(f64)`: the model's parameters and the
 //!   filters' settings, written once per file ([`emit_observer_params`],
 //!   [`emit_kalman_macro`]);
-//! - the model functions, written by the expression emitter as straight-line
-//!   code with CSE'd `let`s and equation numbers in comments: `transition`
+//! - `model!(f64)`: the model functions, written by the expression emitter as
+//!   straight-line code with CSE'd `let`s and equation numbers in comments
+//!   (unsuffixed literals that `$f` types, see `float::Scalar`): `transition`
 //!   [JA 84–85] with the acceleration f_v of [JA 87] (the EKF's also returns the
 //!   symbolic Jacobian ∂F/∂x and g = ∂F/∂u), `measurement` h and ∂h/∂u (and
 //!   ∂h/∂x for the EKF), `acceleration`, `input_gain` g (UKF);
@@ -34,12 +37,12 @@ use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use crate::error::EmitError;
-use crate::float::Float;
-use crate::format::{comment_lets, format_items, space_items};
+use crate::float::{Float, Scalar};
+use crate::format::{comment_lets, format_items, macro_rules, space_items};
 use crate::names::const_name;
 use crate::param::Param;
 
-use layout::{state_names, vector_tokens, Layout};
+use layout::{state_names, vector_tokens, Function, Layout};
 pub use settings::{emit_kalman_macro, emit_observer_params};
 
 /// Everything [`emit_ekf`] and [`emit_ukf`] need.
@@ -71,14 +74,14 @@ pub enum ObserverError {
     NameTaken(String),
 }
 
-/// The extended Kalman filter: formatted `pub mod f64 { … }` /
-/// `pub mod f32 { … }` items.
+/// The extended Kalman filter: formatted `macro_rules! model` and
+/// `pub mod f64 { … }` / `pub mod f32 { … }` items.
 pub fn emit_ekf(input: &ObserverInput) -> Result<String, ObserverError> {
     emit(input, Kind::Ekf)
 }
 
-/// The unscented Kalman filter: formatted `pub mod f64 { … }` /
-/// `pub mod f32 { … }` items.
+/// The unscented Kalman filter: formatted `macro_rules! model` and
+/// `pub mod f64 { … }` / `pub mod f32 { … }` items.
 pub fn emit_ukf(input: &ObserverInput) -> Result<String, ObserverError> {
     emit(input, Kind::Ukf)
 }
@@ -128,12 +131,12 @@ fn emit(input: &ObserverInput, kind: Kind) -> Result<String, ObserverError> {
             return Err(ObserverError::NameTaken(c));
         }
     }
-    let mut out = String::new();
+    let layout = Layout::new(input.discrete, kind);
+    let f32 = floats.contains(&Float::F32);
+    let mut out = model_macro(input, &layout, Scalar::Macro { f32 })?;
     for float in floats {
-        if !out.is_empty() {
-            out.push('\n');
-        }
-        out.push_str(&float_module(input, kind, float)?);
+        out.push('\n');
+        out.push_str(&float_module(input, &layout, kind, float)?);
     }
     Ok(out)
 }
@@ -163,27 +166,55 @@ fn doc_attrs(text: &str) -> TokenStream {
     out
 }
 
-/// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.
-fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<String, ObserverError> {
-    let dm = input.discrete;
-    let layout = Layout::new(dm, kind);
-    let ty = float.ty();
-    let module = format_ident!("{}", float.name());
-    let params: Vec<Param> = dm.param_list().into_iter().map(Param::from).collect();
-
+/// The model functions `layout` holds, in the order they are emitted.
+fn functions(layout: &Layout) -> Vec<&Function> {
     let mut functions = vec![
         &layout.transition,
         &layout.measurement,
         &layout.acceleration,
     ];
-    if let Some(f) = &layout.input_gain {
-        functions.push(f);
-    }
+    functions.extend(&layout.input_gain);
+    functions
+}
+
+/// `macro_rules! model`: the model functions, written once over the float
+/// type `$f` with their `//` equation comments.
+fn model_macro(
+    input: &ObserverInput,
+    layout: &Layout,
+    scalar: Scalar,
+) -> Result<String, ObserverError> {
+    let dm = input.discrete;
+    let params: Vec<Param> = dm.param_list().into_iter().map(Param::from).collect();
     let mut items = TokenStream::new();
-    for f in &functions {
-        items.extend(f.tokens(&dm.graph, dm, &params, float)?);
+    for f in functions(layout) {
+        items.extend(f.tokens(&dm.graph, dm, &params, scalar)?);
     }
-    items.extend(model_impl(dm, &layout, kind, float)?);
+    let mut text = space_items(&format_items(items)?);
+    for f in functions(layout) {
+        text = comment_lets(&text, f.name, &f.comments());
+    }
+    let doc = format!(
+        "The model functions of `{}` over the float type `$f`, written once and declared in\n\
+         each float module below as `model!(f64)` / `model!(f32)`. Their literals are unsuffixed\n\
+         and `$f` types them: an f32 module reads each as the nearest f32, the value an f32\n\
+         literal of its own would hold.",
+        input.name
+    );
+    Ok(macro_rules("model", &doc, &text))
+}
+
+/// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.
+fn float_module(
+    input: &ObserverInput,
+    layout: &Layout,
+    kind: Kind,
+    float: Float,
+) -> Result<String, ObserverError> {
+    let dm = input.discrete;
+    let ty = float.ty();
+    let module = format_ident!("{}", float.name());
+    let items = model_impl(dm, layout, kind, float)?;
 
     let state_doc = state_names(dm)
         .iter()
@@ -193,19 +224,19 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
     let (what, filter) = match kind {
         Kind::Ekf => (
             "extended",
-            "`reldesign_runtime::observe::Ekf` (update with the symbolic ∂h/∂x in Joseph form,\n\
-             prediction with the symbolic ∂F/∂x)",
+            "`reldesign_runtime::observe::Ekf` (update with the symbolic ∂h/∂x in\n\
+             Joseph form, prediction with the symbolic ∂F/∂x)",
         ),
         Kind::Ukf => (
             "unscented",
-            "`reldesign_runtime::observe::Ukf` (sigma points x̄ ± γ·(columns of chol P) through h\n\
-             and F; failed factorisations are repaired and counted)",
+            "`reldesign_runtime::observe::Ukf` (sigma points x̄ ± γ·(columns of chol P)\n\
+             through h and F; failed factorisations are repaired and counted)",
         ),
     };
     let module_doc = doc_attrs(&format!(
         "The {what} Kalman filter of `{name}` in {float}, on the discretised model of\n\
          jiles-atherton-actuator-model §6.1 (84)–(87) with x = [{state_doc}]: the model functions\n\
-         below in {filter}.\n\
+         of `model!` in {filter}.\n\
          The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.",
         name = input.name,
         float = float.name(),
@@ -225,15 +256,12 @@ fn float_module(input: &ObserverInput, kind: Kind, float: Float) -> Result<Strin
 
             params!(#ty);
             kalman!(#ty);
+            model!(#ty);
 
             #items
         }
     };
-    let mut text = space_items(&format_items(tokens)?);
-    for f in &functions {
-        text = comment_lets(&text, f.name, &f.comments());
-    }
-    Ok(text)
+    Ok(space_items(&format_items(tokens)?))
 }
 
 /// The pieces every trait method of the emitted `Model` is written with.
@@ -322,7 +350,7 @@ fn model_impl(
         args, states, call, ..
     } = &f;
     Ok(quote! {
-        /// The discretised model: the functions above, for the runtime's filter.
+        /// The discretised model: the functions of `model!`, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Model;
 

@@ -11,8 +11,8 @@ use designer::observe::discrete::{PHI_LIM, Z_MAX, Z_MIN};
 use proc_macro2::{Ident, Span, TokenStream};
 use quote::quote;
 
-use crate::float::Float;
-use crate::format::format_items;
+use crate::float::{Float, Scalar};
+use crate::format::{format_items, macro_rules};
 use crate::names::const_name;
 
 use super::{doc_attrs, lit, ObserverError, ObserverInput};
@@ -37,9 +37,6 @@ pub(super) const KALMAN_CONSTS: &[&str] = &[
     "PHI_LIM",
     "SETTINGS",
 ];
-
-/// The placeholder of the float type while the items are formatted.
-const FLOAT: &str = "MacroFloatType";
 
 /// The settings as (const name, value, doc), in the order of the macro.
 fn named_settings(dm: &DiscreteModel) -> Vec<(&'static str, f64, &'static str)> {
@@ -107,7 +104,7 @@ fn named_settings(dm: &DiscreteModel) -> Vec<(&'static str, f64, &'static str)> 
 /// invoked as `kalman!(f64)` / `kalman!(f32)` in every EKF and UKF module.
 pub fn emit_kalman_macro(input: &ObserverInput) -> Result<String, ObserverError> {
     let dm = input.discrete;
-    let f = Ident::new(FLOAT, Span::call_site());
+    let f = Scalar::Macro { f32: true }.ty();
     let mut items = TokenStream::new();
     for (name, value, doc) in named_settings(dm) {
         let id = Ident::new(name, Span::call_site());
@@ -133,23 +130,13 @@ pub fn emit_kalman_macro(input: &ObserverInput) -> Result<String, ObserverError>
         });
     }
     items.extend(settings_const(dm, &f, &n)?);
-    let body = format_items(items)?.replace(FLOAT, "$f");
-    let mut text = format!(
-        "/// The Kalman filters' settings of `{}` (`[observer]`, `[observer.kalman]`), one per\n\
-         /// line, and the filters' `Settings` derived from them; declared in each filter module\n\
-         /// as `kalman!(f64)` / `kalman!(f32)`.\n\
-         macro_rules! kalman {{\n    ($f:ty) => {{\n",
+    let doc = format!(
+        "The Kalman filters' settings of `{}` (`[observer]`, `[observer.kalman]`), one per\n\
+         line, and the filters' `Settings` derived from them; declared in each filter module\n\
+         as `kalman!(f64)` / `kalman!(f32)`.",
         input.name
     );
-    for line in body.lines() {
-        if !line.is_empty() {
-            text.push_str("        ");
-            text.push_str(line);
-        }
-        text.push('\n');
-    }
-    text.push_str("    };\n}\n");
-    Ok(text)
+    Ok(macro_rules("kalman", &doc, &format_items(items)?))
 }
 
 /// `pub const SETTINGS`: the runtime's `Settings` from the named settings.
