@@ -3,15 +3,14 @@
 //! denied, and evaluates like the designer's tape: to 1e-12 relative in f64
 //! and 1e-5 in f32.
 //!
-//! The check crate is written under the workspace's `target/codegen-check/`
-//! and built with its own target dir there (reused across runs).
-
-mod common;
-use common::{cargo, clippy_panic_free, workspace_target, write_if_changed};
+//! The check crate is the scratch crate `target/codegen-check/`
+//! (`support::ScratchCrate`, built in the scratch crates' shared target dir,
+//! reused across runs).
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::path::Path;
+
+use support::{assert_close, example_path, ScratchCrate, Tol};
 
 use designer::description::parse_file;
 use designer::design::Linearization;
@@ -185,8 +184,7 @@ fn synthetic() -> Case {
 
 /// α, β of the perfect-tracking valve.
 fn valve_law() -> Case {
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/perfect-tracking-valve.toml");
+    let path = example_path("perfect-tracking-valve.toml");
     let mut m = Model::build(&parse_file(&path).unwrap());
     let lin = Linearization::derive(&mut m).unwrap();
     let s = m.states.clone();
@@ -215,24 +213,9 @@ fn valve_law() -> Case {
     }
 }
 
-/// Writes the check crate: lib = params + functions in `double` and
-/// `single`; main = prints every output at every point, one line each.
-fn write_crate(dir: &Path, cases: &[Case]) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let runtime = root.join("runtime").canonicalize().unwrap();
-    std::fs::create_dir_all(dir.join("src")).unwrap();
-    let manifest = format!(
-        "[package]\nname = \"codegen-check\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n\
-         [dependencies]\nreldesign-runtime = {{ path = {:?} }}\n\n[workspace]\n",
-        runtime.display().to_string()
-    );
-    write_if_changed(&dir.join("Cargo.toml"), &manifest);
-    if let Ok(lock) = std::fs::read_to_string(root.join("Cargo.lock")) {
-        // pins libm to the workspace's version (works offline)
-        if !dir.join("Cargo.lock").exists() {
-            std::fs::write(dir.join("Cargo.lock"), lock).unwrap();
-        }
-    }
+/// Writes the check crate's sources: lib = params + functions in `double`
+/// and `single`; main = prints every output at every point, one line each.
+fn write_crate(krate: &ScratchCrate, cases: &[Case]) {
     let mut lib = String::from(
         "//! Emitted by codegen/tests/compiled.rs.\n#![no_std]\n#![forbid(unsafe_code)]\n",
     );
@@ -247,7 +230,7 @@ fn write_crate(dir: &Path, cases: &[Case]) {
             .unwrap();
         }
     }
-    write_if_changed(&dir.join("src/lib.rs"), &lib);
+    krate.write("src/lib.rs", &lib);
     let mut main = String::from("fn main() {\n");
     for module in ["double", "single"] {
         for case in cases {
@@ -269,16 +252,16 @@ fn write_crate(dir: &Path, cases: &[Case]) {
         }
     }
     main.push_str("}\n");
-    write_if_changed(&dir.join("src/main.rs"), &main);
+    krate.write("src/main.rs", &main);
 }
 
 #[test]
 fn emitted_code_compiles_passes_clippy_and_matches_the_tape() {
     let mut cases = [synthetic(), valve_law()];
-    let dir = workspace_target().join("codegen-check");
-    write_crate(&dir, &cases);
-    clippy_panic_free(&dir);
-    let out = cargo(&dir, &["run", "--offline", "--quiet"]);
+    let krate = ScratchCrate::new("codegen-check");
+    write_crate(&krate, &cases);
+    krate.clippy_panic_free();
+    let out = krate.cargo(&["run", "--offline", "--quiet"]);
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();
     for (float, tol) in [("f64", 1e-12), ("f32", 1e-5)] {
@@ -288,14 +271,9 @@ fn emitted_code_compiles_passes_clippy_and_matches_the_tape() {
                 let line = lines.next().expect("one line per point");
                 let got: Vec<f64> = line.split(' ').map(|v| v.parse().unwrap()).collect();
                 assert_eq!(got.len(), want.len());
-                for ((g, w), o) in got.iter().zip(want).zip(&case.outputs) {
-                    let err = (g - w).abs() / w.abs().max(1e-300);
-                    assert!(
-                        err <= tol || (g == w),
-                        "{float} {}::{} at {p:?}: emitted {g:e}, tape {w:e}, relative error {err:e}",
-                        case.name,
-                        o.0
-                    );
+                for ((&g, &w), o) in got.iter().zip(want).zip(&case.outputs) {
+                    let what = format!("{float} {}::{} at {p:?} (emitted, tape)", case.name, o.0);
+                    assert_close(g, w, Tol::rel(tol), what);
                 }
             }
         }

@@ -3,16 +3,11 @@
 //! (f64 and f32), the law against the designer's tape, and finite saturated
 //! outputs at φ = 0, z = 0 and NaN inputs.
 //!
-//! The check crate is written under the workspace's
-//! `target/codegen-check-controller/` and built in the target dir of
-//! `compiled.rs` (`target/codegen-check-target/`).
-
-mod common;
-use common::{cargo, clippy_panic_free, workspace_target, write_if_changed};
+//! The check crate is the scratch crate `target/codegen-check-controller/`
+//! (`support::ScratchCrate`, built in the scratch crates' shared target dir).
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::path::Path;
 
 use designer::description::{parse_str, Gains, Operation};
 use designer::design::{
@@ -22,13 +17,14 @@ use designer::design::{
 use designer::model::Model;
 use designer::sym::{Id, Tape};
 use reldesign_build::{emit_controller, params_macro, ControllerInput, Float, Header};
+use support::{assert_close, example_path, ScratchCrate, Tol};
 
-const VALVE: &str = "../examples/perfect-tracking-valve.toml";
+const VALVE: &str = "perfect-tracking-valve.toml";
 const T0: f64 = 1e-3;
 const TF: f64 = 6e-3;
 
 fn valve_text() -> String {
-    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(VALVE)).unwrap()
+    std::fs::read_to_string(example_path(VALVE)).unwrap()
 }
 
 /// The quintic z0 → zf of (52)–(53) as one exact table segment.
@@ -153,9 +149,9 @@ fn the_table_reproduces_the_quintic() {
         let seg = &v.segments.segments[0];
         let got = Segments::eval_segment(seg, t - seg[0]);
         let want = v.polynomial.at(t);
-        assert!((got.z - want.z).abs() < 1e-15, "z at {t}");
-        assert!((got.v - want.v).abs() < 1e-12, "v at {t}");
-        assert!((got.a - want.a).abs() < 1e-8 * 240.0, "a at {t}");
+        assert_close(got.z, want.z, Tol::abs(1e-15), format!("z at {t}"));
+        assert_close(got.v, want.v, Tol::abs(1e-12), format!("v at {t}"));
+        assert_close(got.a, want.a, Tol::abs(1e-8 * 240.0), format!("a at {t}"));
     }
 }
 
@@ -327,26 +323,12 @@ fn edge_points() -> Vec<[f64; 4]> {
 fn emitted_controller_compiles_passes_clippy_and_matches_the_tape() {
     let mut v = valve(&valve_text());
     let code = emit_ops(&v, &[Float::F64, Float::F32], true);
-    let dir = workspace_target().join("codegen-check-controller");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let runtime = root.join("runtime").canonicalize().unwrap();
-    std::fs::create_dir_all(dir.join("src")).unwrap();
-    let manifest = format!(
-        "[package]\nname = \"codegen-check-controller\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n\
-         [dependencies]\nreldesign-runtime = {{ path = {:?} }}\n\n[workspace]\n",
-        runtime.display().to_string()
-    );
-    write_if_changed(&dir.join("Cargo.toml"), &manifest);
-    if let Ok(lock) = std::fs::read_to_string(root.join("Cargo.lock")) {
-        if !dir.join("Cargo.lock").exists() {
-            std::fs::write(dir.join("Cargo.lock"), lock).unwrap();
-        }
-    }
-    write_if_changed(
-        &dir.join("src/lib.rs"),
+    let krate = ScratchCrate::new("codegen-check-controller");
+    krate.write(
+        "src/lib.rs",
         "//! Emitted by codegen/tests/controller.rs.\n#![no_std]\n#![forbid(unsafe_code)]\n\npub mod valve;\n",
     );
-    write_if_changed(&dir.join("src/valve.rs"), &code);
+    krate.write("src/valve.rs", &code);
 
     let points = law_points();
     let edges = edge_points();
@@ -387,10 +369,10 @@ fn emitted_controller_compiles_passes_clippy_and_matches_the_tape() {
         }
     }
     main.push_str("}\n");
-    write_if_changed(&dir.join("src/main.rs"), &main);
+    krate.write("src/main.rs", &main);
 
-    clippy_panic_free(&dir);
-    let out = cargo(&dir, &["run", "--offline", "--quiet"]);
+    krate.clippy_panic_free();
+    let out = krate.cargo(&["run", "--offline", "--quiet"]);
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();
 
@@ -399,12 +381,9 @@ fn emitted_controller_compiles_passes_clippy_and_matches_the_tape() {
     for (float, tol) in [("f64", 1e-12), ("f32", 2e-3)] {
         for (p, w) in points.iter().zip(&want) {
             let got: f64 = lines.next().unwrap().parse().unwrap();
-            // relative to the size of the terms (u = α + β·w may cancel)
-            let scale = w.abs().max(1.0);
-            assert!(
-                (got - w).abs() <= tol * scale,
-                "{float} law at {p:?}: emitted {got:e}, tape {w:e}"
-            );
+            // relative to the size of the terms, at least 1 (u = α + β·w may cancel)
+            let what = format!("{float} law at {p:?} (emitted, tape)");
+            assert_close(got, *w, Tol::rel(tol).or_abs(tol), what);
         }
         for e in &edges {
             let got: f64 = lines.next().unwrap().parse().unwrap();
@@ -442,17 +421,12 @@ fn emitted_controller_compiles_passes_clippy_and_matches_the_tape() {
                 r.v = stroke * creep;
             }
             let ztol = if float == "f64" { 1e-15 } else { 1e-9 };
-            assert!(
-                (got[0] - r.z).abs() <= ztol,
-                "{float} z_r({t}) = {} vs {}",
-                got[0],
-                r.z
-            );
-            assert!(
-                (got[1] - r.v).abs() <= 1e3 * ztol,
-                "{float} v_r({t}) = {} vs {}",
+            assert_close(got[0], r.z, Tol::abs(ztol), format!("{float} z_r({t})"));
+            assert_close(
                 got[1],
-                r.v
+                r.v,
+                Tol::abs(1e3 * ztol),
+                format!("{float} v_r({t})"),
             );
         }
     }

@@ -2,18 +2,17 @@
 //! independent builds, one changed line per changed parameter, the shape of
 //! the emitted arithmetic, and refused inputs.
 
-use std::path::Path;
-
 use designer::description::parse_str;
 use designer::design::Linearization;
 use designer::model::Model;
 use designer::sym::{Graph, Id};
 use reldesign_build::{emit_function, emit_params, EmitError, Float, FunctionSpec, Param};
+use support::example_path;
 
-const VALVE: &str = "../examples/perfect-tracking-valve.toml";
+const VALVE: &str = "perfect-tracking-valve.toml";
 
 fn valve_text() -> String {
-    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(VALVE)).unwrap()
+    std::fs::read_to_string(example_path(VALVE)).unwrap()
 }
 
 fn valve(text: &str) -> Model {

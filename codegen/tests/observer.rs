@@ -9,15 +9,10 @@
 //! setting is written on one line of the file; and the emission is
 //! byte-identical across two runs.
 //!
-//! The check crate is written under the workspace's
-//! `target/codegen-check-observer/` and built in the target dir of
-//! `compiled.rs` (`target/codegen-check-target/`).
-
-mod common;
-use common::{cargo, clippy_panic_free, workspace_target, write_if_changed};
+//! The check crate is the scratch crate `target/codegen-check-observer/`
+//! (`support::ScratchCrate`, built in the scratch crates' shared target dir).
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
 
 use designer::description::{parse_file, parse_str, Core, Description};
 use designer::model::Model;
@@ -29,21 +24,18 @@ use designer::sim::{Options, PiecewiseLinear};
 use reldesign_build::{
     emit_ekf, emit_kalman_macro, emit_observer_params, emit_ukf, wrap_module, Float, ObserverInput,
 };
+use support::{example_path, ScratchCrate};
 
 const TS: f64 = 50e-6;
 
 fn example(file: &str) -> Description {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../examples")
-        .join(file);
-    parse_file(&p).unwrap_or_else(|e| panic!("{e}"))
+    parse_file(&example_path(file)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The perfect-tracking valve's physics with a text replacement: current
 /// drive, or a resistance drift (the model then depends on t).
 fn variant(from: &str, to: &str) -> Description {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/perfect-tracking-valve.toml");
-    let text = std::fs::read_to_string(p).unwrap();
+    let text = std::fs::read_to_string(example_path("perfect-tracking-valve.toml")).unwrap();
     let physics = &text[..text.find("\n[trajectory]").unwrap()];
     let changed = physics.replacen(from, to, 1);
     assert_ne!(changed, physics);
@@ -216,28 +208,10 @@ const CASES: [(&str, &str, bool, &str); 4] = [
     ("resist", "perfect-tracking-valve.toml", true, "valve.csv"),
 ];
 
-fn check_dir() -> PathBuf {
-    workspace_target().join("codegen-check-observer")
-}
-
 /// The check crate: lib with the emitted modules, a binary that runs every
 /// filter over the record files and prints one line per estimate.
-fn write_crate() -> PathBuf {
-    let dir = check_dir();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let runtime = root.join("runtime").canonicalize().unwrap();
-    std::fs::create_dir_all(dir.join("src")).unwrap();
-    let manifest = format!(
-        "[package]\nname = \"codegen-check-observer\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n\
-         [dependencies]\nreldesign-runtime = {{ path = {:?} }}\n\n[workspace]\n",
-        runtime.display().to_string()
-    );
-    write_if_changed(&dir.join("Cargo.toml"), &manifest);
-    if let Ok(lock) = std::fs::read_to_string(root.join("Cargo.lock")) {
-        if !dir.join("Cargo.lock").exists() {
-            std::fs::write(dir.join("Cargo.lock"), lock).unwrap();
-        }
-    }
+fn write_crate() -> ScratchCrate {
+    let krate = ScratchCrate::new("codegen-check-observer");
     let mut lib = String::from(
         "//! Emitted by codegen/tests/observer.rs.\n#![no_std]\n#![forbid(unsafe_code)]\n\n",
     );
@@ -258,10 +232,10 @@ fn write_crate() -> PathBuf {
         ("resist", example("perfect-tracking-valve.toml"), true),
     ] {
         let code = emit(&d, resistance, &[Float::F64, Float::F32]);
-        write_if_changed(&dir.join(format!("src/{module}.rs")), &code);
+        krate.write(&format!("src/{module}.rs"), &code);
         writeln!(lib, "pub mod {module};").unwrap();
     }
-    write_if_changed(&dir.join("src/lib.rs"), &lib);
+    krate.write("src/lib.rs", &lib);
 
     let mut main = String::from(
         "//! Runs the emitted filters over record files (`u,i` per line).\n\
@@ -303,8 +277,8 @@ fn write_crate() -> PathBuf {
         }
     }
     main.push_str("}\n");
-    write_if_changed(&dir.join("src/main.rs"), &main);
-    dir
+    krate.write("src/main.rs", &main);
+    krate
 }
 
 #[test]
@@ -470,23 +444,20 @@ fn values(e: &Estimate) -> [f64; 5] {
 
 #[test]
 fn emitted_filters_compile_pass_clippy_and_match_the_designer() {
-    let dir = write_crate();
-    let data = dir.join("data");
+    let krate = write_crate();
+    let data = krate.dir().join("data");
     std::fs::create_dir_all(&data).unwrap();
     let mut records = Vec::new();
     for (_, file, resistance, name) in CASES {
         let d = example(file);
         let rec = record(&d, 15e-3, name.contains("holes"));
         let text: String = rec.iter().map(|(u, i)| format!("{u:?},{i:?}\n")).collect();
-        write_if_changed(&data.join(name), &text);
+        krate.write(&format!("data/{name}"), &text);
         records.push((d, resistance, rec, name));
     }
 
-    clippy_panic_free(&dir);
-    let out = cargo(
-        &dir,
-        &["run", "--offline", "--quiet", "--", data.to_str().unwrap()],
-    );
+    krate.clippy_panic_free();
+    let out = krate.cargo(&["run", "--offline", "--quiet", "--", data.to_str().unwrap()]);
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();
 
@@ -574,8 +545,7 @@ fn emitted_filters_compile_pass_clippy_and_match_the_designer() {
 /// `params!`) and without one (the observers' own).
 #[test]
 fn the_build_declares_params_and_kalman_once() {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/perfect-tracking-valve.toml");
-    let text = std::fs::read_to_string(p).unwrap();
+    let text = std::fs::read_to_string(example_path("perfect-tracking-valve.toml")).unwrap();
     let physics = &text[..text.find("\n[trajectory]").unwrap()];
     let observers = &text[text.find("\n[observer]").unwrap()..];
     for (name, toml) in [

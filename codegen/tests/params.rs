@@ -5,18 +5,13 @@
 //! The controller, the filters and the estimators all invoke `params!`, so
 //! the whole file is checked, observer sections included.
 
-use std::path::{Path, PathBuf};
-
 use designer::description::parse_str;
 use designer::design::Design;
 use reldesign_build::{const_name, emit};
+use support::root;
 
 /// Top-level modules that declare the parameters themselves: none.
 const NOT_YET_ON_PARAMS: &[&str] = &[];
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
 
 /// A description's whole text (controller and observer sections).
 fn description_text(path: &str) -> String {

@@ -7,12 +7,8 @@
 //! a simulated noisy record of the semera valve: bit for bit in f64 (the same
 //! runtime code), and in f32 within the tolerances stated below.
 //!
-//! The check crate is written under the workspace's
-//! `target/codegen-check-semera/` and built in the target dir of
-//! `compiled.rs` (`target/codegen-check-target/`).
-
-mod common;
-use common::{cargo, clippy_panic_free, workspace_target, write_if_changed};
+//! The check crate is the scratch crate `target/codegen-check-semera/`
+//! (`support::ScratchCrate`, built in the scratch crates' shared target dir).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -25,13 +21,11 @@ use designer::observe::semera::{Estimate, Semera, SemeraConfig};
 use designer::replay::replay;
 use designer::sim::{Options, PiecewiseLinear};
 use reldesign_build::{emit, emit_semera, Float, SemeraError, SemeraInput};
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+use support::scratch::{workspace_target, SHARED_TARGET};
+use support::{example_path, root, ScratchCrate};
 
 fn valve() -> Description {
-    parse_file(&root().join("examples/semera-valve.toml")).unwrap()
+    parse_file(&example_path("semera-valve.toml")).unwrap()
 }
 
 /// The whole emitted file (`params!`, then `pub mod estimators`).
@@ -65,7 +59,7 @@ fn emission_is_deterministic_and_one_parameter_is_one_line() {
     }
 
     // one parameter changed: one line of the file (both floats read it)
-    let text = std::fs::read_to_string(root().join("examples/semera-valve.toml")).unwrap();
+    let text = std::fs::read_to_string(example_path("semera-valve.toml")).unwrap();
     for (from, to) in [
         ("inductance_accel_std = 1e8", "inductance_accel_std = 2e8"),
         ("energize_threshold = 15.0", "energize_threshold = 12.5"),
@@ -203,25 +197,12 @@ fn values(e: &Estimate) -> [f64; 5] {
 fn emitted_estimators_compile_pass_clippy_and_match_the_reference() {
     let d = valve();
     let code = file(&d);
-    let dir = workspace_target().join("codegen-check-semera");
-    let runtime = root().join("runtime").canonicalize().unwrap();
-    std::fs::create_dir_all(dir.join("src")).unwrap();
-    let manifest = format!(
-        "[package]\nname = \"codegen-check-semera\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n\
-         [dependencies]\nreldesign-runtime = {{ path = {:?} }}\n\n[workspace]\n",
-        runtime.display().to_string()
-    );
-    write_if_changed(&dir.join("Cargo.toml"), &manifest);
-    if let Ok(lock) = std::fs::read_to_string(root().join("Cargo.lock")) {
-        if !dir.join("Cargo.lock").exists() {
-            std::fs::write(dir.join("Cargo.lock"), lock).unwrap();
-        }
-    }
-    write_if_changed(
-        &dir.join("src/lib.rs"),
+    let krate = ScratchCrate::new("codegen-check-semera");
+    krate.write(
+        "src/lib.rs",
         "//! Emitted by codegen/tests/semera.rs.\n#![no_std]\n#![forbid(unsafe_code)]\n\npub mod semera;\n",
     );
-    write_if_changed(&dir.join("src/semera.rs"), &code);
+    krate.write("src/semera.rs", &code);
     // the binary reads `v i` lines on stdin, prints one line per estimator and float
     let mut main = String::from(
         "use std::io::BufRead;\nuse codegen_check_semera::semera::estimators::{f32 as s32, f64 as s64};\n\n\
@@ -245,19 +226,19 @@ fn emitted_estimators_compile_pass_clippy_and_match_the_reference() {
         .unwrap();
     }
     main.push_str("    }\n}\n");
-    write_if_changed(&dir.join("src/main.rs"), &main);
+    krate.write("src/main.rs", &main);
 
-    clippy_panic_free(&dir);
+    krate.clippy_panic_free();
     // the algorithms: the runtime's modules deny the same lints (their `#![deny]`)
-    cargo(&root().join("runtime"), &["clippy", "--offline", "--lib"]);
-    cargo(&dir, &["build", "--offline", "--quiet", "--release"]);
+    support::scratch::cargo(&root().join("runtime"), &["clippy", "--offline", "--lib"]);
+    krate.cargo(&["build", "--offline", "--quiet", "--release"]);
     let truth = truth(&d);
     let rec = record(&d, &truth);
     let mut stdin = String::new();
     for (v, i) in &rec {
         writeln!(stdin, "{v:?} {i:?}").unwrap();
     }
-    let exe = common_exe(&dir);
+    let exe = release_binary(&krate);
     let out = run_with_stdin(&exe, &stdin);
     let lines: Vec<&str> = out.lines().collect();
     assert_eq!(lines.len(), 4 * rec.len());
@@ -336,14 +317,16 @@ fn emitted_estimators_compile_pass_clippy_and_match_the_reference() {
     assert!(worst_r < 5e-3, "the f32 SEMERA drifts: {worst_r} Ω");
 }
 
-fn common_exe(dir: &Path) -> PathBuf {
+/// The check crate's binary as `cargo build --release` leaves it.
+fn release_binary(krate: &ScratchCrate) -> PathBuf {
     workspace_target()
-        .join("codegen-check-target/release/codegen-check-semera")
+        .join(SHARED_TARGET)
+        .join("release/codegen-check-semera")
         .canonicalize()
         .unwrap_or_else(|_| {
             panic!(
                 "the check binary of {} was not built where expected",
-                dir.display()
+                krate.dir().display()
             )
         })
 }

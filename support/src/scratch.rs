@@ -55,6 +55,28 @@ pub fn manifest(name: &str) -> String {
     )
 }
 
+/// Runs cargo in `dir` (a scratch crate, or a package of the workspace to
+/// build beside them) into [`SHARED_TARGET`], without the caller's
+/// `RUSTFLAGS`; panics with stderr unless it succeeds.
+pub fn cargo(dir: &Path, args: &[&str]) -> Output {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo)
+        .args(args)
+        .current_dir(dir)
+        .env("CARGO_TARGET_DIR", workspace_target().join(SHARED_TARGET))
+        .env_remove("RUSTFLAGS")
+        .env_remove("CARGO_ENCODED_RUSTFLAGS")
+        .output()
+        .expect("cannot run cargo");
+    assert!(
+        out.status.success(),
+        "cargo {args:?} in {} failed:\n{}",
+        dir.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// A scratch crate in `target/NAME/`.
 pub struct ScratchCrate {
     dir: PathBuf,
@@ -93,22 +115,7 @@ impl ScratchCrate {
     /// Runs cargo in the crate, into [`SHARED_TARGET`]; panics with stderr
     /// unless it succeeds.
     pub fn cargo(&self, args: &[&str]) -> Output {
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-        let out = Command::new(cargo)
-            .args(args)
-            .current_dir(&self.dir)
-            .env("CARGO_TARGET_DIR", workspace_target().join(SHARED_TARGET))
-            .env_remove("RUSTFLAGS")
-            .env_remove("CARGO_ENCODED_RUSTFLAGS")
-            .output()
-            .expect("cannot run cargo");
-        assert!(
-            out.status.success(),
-            "cargo {args:?} in {} failed:\n{}",
-            self.dir.display(),
-            String::from_utf8_lossy(&out.stderr)
-        );
-        out
+        cargo(&self.dir, args)
     }
 
     /// Clippy on the crate's library with [`PANIC_FREE_LINTS`] denied.
