@@ -79,7 +79,7 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
         })?;
         modules.push(wrap_module(
             "estimators",
-            "The model-free electrical estimators (semera-electromagnetic-estimation):\nSEMERA (Algorithm 1) and the integral estimator (Algorithm 2).",
+            "The model-free electrical estimators (semera-electromagnetic-estimation):\nSEMERA [SE Alg. 1] and the integral estimator [SE Alg. 2].",
             &items,
         ));
     }
@@ -139,7 +139,7 @@ fn header(design: &Design) -> String {
     let d = &design.description;
     let what = match design.controller {
         Some(_) => format!(
-            "perfect-tracking soft-landing controller of `{}` (feedback linearization, eq. 50)",
+            "perfect-tracking soft-landing controller of `{}` (feedback linearization, [PT 50])",
             d.name
         ),
         None => format!("observers of `{}`", d.name),

@@ -239,25 +239,25 @@ fn law_terms(
     }
     let [z, v, phi] = [model.states[0], model.states[1], model.states[2]];
     let outputs = vec![
-        ("xi3", law.xi3, "(41) ξ₃ = a(x) = L_f²h"),
-        ("lf3h", law.lf3h, "(31) L_f³h"),
-        ("beta", law.beta, "(32) β(x) = 1 / L_g L_f²h"),
+        ("xi3", law.xi3, "[PT 41] ξ₃ = a(x) = L_f²h"),
+        ("lf3h", law.lf3h, "[PT 31] L_f³h"),
+        ("beta", law.beta, "[PT 32] β(x) = 1 / L_g L_f²h"),
         (
             "w",
             law.w,
-            "(48) w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] (41)",
+            "[PT 48] w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] [PT 41]",
         ),
         (
             "alpha",
             law.alpha,
-            "(32) α(x) = −L_f³h / L_g L_f²h = −L_f³h·β",
+            "[PT 32] α(x) = −L_f³h / L_g L_f²h = −L_f³h·β",
         ),
-        ("u", law.u, "(50) u = α + β·w = β·(w − L_f³h)"),
+        ("u", law.u, "[PT 50] u = α + β·w = β·(w − L_f³h)"),
     ];
     let comments = outputs.iter().map(|&(n, _, d)| (n, d)).collect();
     let spec = FunctionSpec {
         name: "law_terms",
-        doc: "The terms of the tracking law (50) at the state x = [z, v, φ] and the\n\
+        doc: "The terms of the tracking law [PT 50] at the state x = [z, v, φ] and the\n\
               reference ξ_r = [z_r, v_r, a_r], z_r⁽³⁾ = j_r (not saturated, not guarded:\n\
               φ = 0 makes β infinite, see [`guarded_law`]).",
         inputs: vec![
@@ -303,13 +303,13 @@ fn doc_attrs(text: &str) -> TokenStream {
 fn design_consts(d: &ControllerDesign, float: Float) -> Result<TokenStream, ControllerError> {
     let [k1, k2, k3] = d.gains;
     let consts = [
-        ("GAIN_K1", k1, "k1 of K = [k1, k2, k3] (48): s³ + k3·s² + k2·s + k1 is the characteristic polynomial of (49)."),
-        ("GAIN_K2", k2, "k2 of K (48)."),
-        ("GAIN_K3", k3, "k3 of K (48)."),
+        ("GAIN_K1", k1, "k1 of K = [k1, k2, k3] [PT 48]: s³ + k3·s² + k2·s + k1 is the characteristic polynomial of [PT 49]."),
+        ("GAIN_K2", k2, "k2 of K [PT 48]."),
+        ("GAIN_K3", k3, "k3 of K [PT 48]."),
         ("U_MIN", d.u_min, "Lower supply limit u_min."),
         ("U_MAX", d.u_max, "Upper supply limit u_max."),
-        ("T_TAKEOFF", d.takeoff, "t₀ [s] from the operation's start: end of the pre-movement stage (51)."),
-        ("T_LANDING", d.landing, "t_f [s] from the operation's start: end of the motion (51)."),
+        ("T_TAKEOFF", d.takeoff, "t₀ [s] from the operation's start: end of the pre-movement stage [PT 51]."),
+        ("T_LANDING", d.landing, "t_f [s] from the operation's start: end of the motion [PT 51]."),
         ("SAMPLE_PERIOD", d.sample_period, "T_s [s]: call `Controller::step` once per sample period."),
         ("PHI_GUARD", d.phi_guard, "Guard at φ → 0 [Wb]: where φ ≤ PHI_GUARD the law is not evaluated and u = u_max\n(drives the flux into D₀⁺). 10⁻³ of the smallest flux the reference needs, rounded down."),
         ("LANDED_BAND", d.landed_band, "Distance [m] to the end stop within which the armature counts as in contact\n(expert rules after t_f): 10⁻⁹ of the stroke, rounded down."),
@@ -416,7 +416,7 @@ fn operations(input: &ControllerInput, float: Float) -> Result<Operations, Contr
         let n = Literal::usize_unsuffixed(op.table.segments.len());
         let rows = format_ident!("{}", placeholder(table_name));
         let table_doc = doc_attrs(&format!(
-            "Reference of the {} motion z_m on [t₀, t_f] (51): one row\n[t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;\na(τ) = c0 + c1·τ + c2·τ² + c3·τ³ with τ = t − t_k, v and z its integrals.",
+            "Reference of the {} motion z_m on [t₀, t_f] [PT 51]: one row\n[t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;\na(τ) = c0 + c1·τ + c2·τ² + c3·τ³ with τ = t − t_k, v and z its integrals.",
             variant.to_string().to_lowercase()
         ));
         tables.extend(quote!(#table_doc pub const #table: [[#ty; 7]; #n] = #rows;));

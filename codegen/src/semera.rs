@@ -92,28 +92,28 @@ type Key = (&'static str, &'static str);
 #[rustfmt::skip]
 const OBSERVER: [Key; 3] = [
     ("sample_period", "Δ [s], call `step` once per sample."),
-    ("voltage_noise", "σ_v [V], in the gain (43)."),
+    ("voltage_noise", "σ_v [V], in the gain [SE 43]."),
     ("current_noise", "σ_i [A], the CI detector's unit."),
 ];
 
 /// `[observer.semera]`, in the runtime's field order.
 #[rustfmt::skip]
 const SEMERA: [Key; 7] = [
-    ("initial_resistance", "r̄₀ [Ω] (25)"),
-    ("initial_resistance_std", "σ_r0 [Ω] (26)"),
-    ("initial_inductance", "l̄₀ [H] (25), the expert rule's l̂"),
-    ("initial_inductance_std", "σ_l0 [H] (26)"),
-    ("resistance_rate_std", "σ_ṙ [Ω/s] (24)"),
-    ("inductance_accel_std", "σ_l̈ [H/s²] (24)"),
+    ("initial_resistance", "r̄₀ [Ω], [SE 25]"),
+    ("initial_resistance_std", "σ_r0 [Ω], [SE 26]"),
+    ("initial_inductance", "l̄₀ [H], [SE 25], the expert rule's l̂"),
+    ("initial_inductance_std", "σ_l0 [H], [SE 26]"),
+    ("resistance_rate_std", "σ_ṙ [Ω/s], [SE 24]"),
+    ("inductance_accel_std", "σ_l̈ [H/s²], [SE 24]"),
     ("ci_sigmas", "n_σ: the CI detector's half-width in σ_i"),
 ];
 
 /// `[observer.integral]`, in the runtime's field order.
 #[rustfmt::skip]
 const INTEGRAL: [Key; 5] = [
-    ("initial_resistance", "r̄₀ [Ω] until the first (47)"),
+    ("initial_resistance", "r̄₀ [Ω] until the first [SE 47]"),
     ("initial_inductance", "l̄₀ [H], the expert rule's l̂"),
-    ("initial_flux_linkage", "λ₀ [Wb] at each reset (46)"),
+    ("initial_flux_linkage", "λ₀ [Wb] at each reset [SE 46]"),
     ("ci_sigmas", "n_σ: the CI detector's half-width in σ_i"),
     ("energize_threshold", "[V]: u rising above it starts an operation"),
 ];
@@ -134,7 +134,7 @@ fn sections(input: &SemeraInput) -> Vec<Section> {
     let semera = input.semera.map(|s| Section {
         module: "semera",
         ty: "Semera",
-        doc: "SEMERA (Algorithm 1)",
+        doc: "SEMERA [SE Alg. 1]",
         observer: &["sample_period", "voltage_noise", "current_noise"],
         keys: &SEMERA,
         values: vec![
@@ -150,7 +150,7 @@ fn sections(input: &SemeraInput) -> Vec<Section> {
     let integral = input.integral.map(|g| Section {
         module: "integral",
         ty: "Integral",
-        doc: "The integral estimator (Algorithm 2)",
+        doc: "The integral estimator [SE Alg. 2]",
         observer: &["sample_period", "current_noise"],
         keys: &INTEGRAL,
         values: vec![
@@ -267,7 +267,7 @@ fn float_module(name: &str, sections: &[Section], float: Float) -> String {
     }
     uses.sort_unstable();
     format!(
-        "/// The model-free estimators of `{name}` in {f} (semera-electromagnetic-estimation §II).\n\
+        "/// The model-free estimators of `{name}` in {f} [SE §II].\n\
          pub mod {f} {{\n    use reldesign_runtime::{{{uses}}};\n\n    params!({f});\n    settings!({f});\n{aliases}}}\n",
         uses = uses.join(", "),
     )

@@ -207,7 +207,7 @@ fn header_and_sections_are_there() {
         "pub const REFERENCE_CLOSING: [[f32; 7]; 1]",
         "pub type Controller = control::SoftLanding<Design, f64>;",
         "impl control::Law<f32> for Design {",
-        "// (50) u = α + β·w",
+        "// [PT 50] u = α + β·w",
         // physical constants and the model's subexpressions by name
         "pub const MU0: $f = 4e-7 * ::core::$f::consts::PI;",
         "let z_reg = z + Z_EPS;",
@@ -399,7 +399,7 @@ fn emitted_controller_compiles_passes_clippy_and_matches_the_tape() {
                 assert_eq!(
                     got,
                     24.0 * phi.signum(),
-                    "{float}: expert rule (43) at z_min"
+                    "{float}: expert rule [SM 43] at z_min"
                 );
             }
         }

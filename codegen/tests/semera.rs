@@ -54,7 +54,9 @@ fn emission_is_deterministic_and_one_parameter_is_one_line() {
         );
     }
     // each setting says what it is: its equation or unit
-    for cite in ["(24)", "(25)", "(26)", "(43)", "(46)", "(47)", "[V]"] {
+    for cite in [
+        "[SE 24]", "[SE 25]", "[SE 26]", "[SE 43]", "[SE 46]", "[SE 47]", "[V]",
+    ] {
         assert!(a.contains(cite), "no citation of {cite}");
     }
 

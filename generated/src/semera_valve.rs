@@ -37,7 +37,7 @@ macro_rules! params {
 }
 
 /// The model-free electrical estimators (semera-electromagnetic-estimation):
-/// SEMERA (Algorithm 1) and the integral estimator (Algorithm 2).
+/// SEMERA [SE Alg. 1] and the integral estimator [SE Alg. 2].
 pub mod estimators {
     /// The estimators' settings of `semera_valve`, one value per line, declared in each float
     /// module as `settings!(f64)` / `settings!(f32)` (N is `params!`'s).
@@ -45,39 +45,39 @@ pub mod estimators {
         ($f:ty) => {
             /// `observer.sample_period`: Δ [s], call `step` once per sample.
             pub const SAMPLE_PERIOD: $f = 5e-5;
-            /// `observer.voltage_noise`: σ_v [V], in the gain (43).
+            /// `observer.voltage_noise`: σ_v [V], in the gain [SE 43].
             pub const VOLTAGE_NOISE: $f = 0.015;
             /// `observer.current_noise`: σ_i [A], the CI detector's unit.
             pub const CURRENT_NOISE: $f = 0.001;
-            /// SEMERA (Algorithm 1): `[observer.semera]`.
+            /// SEMERA [SE Alg. 1]: `[observer.semera]`.
             pub const SEMERA: semera::Settings<$f> = semera::Settings {
                 sample_period: SAMPLE_PERIOD,
                 voltage_noise: VOLTAGE_NOISE,
                 current_noise: CURRENT_NOISE,
                 turns: N,
-                initial_resistance: 77.5,          // r̄₀ [Ω] (25)
-                initial_resistance_std: 1.0,       // σ_r0 [Ω] (26)
-                initial_inductance: 0.05,          // l̄₀ [H] (25), the expert rule's l̂
-                initial_inductance_std: 0.005,     // σ_l0 [H] (26)
-                resistance_rate_std: 1.0,          // σ_ṙ [Ω/s] (24)
-                inductance_accel_std: 100000000.0, // σ_l̈ [H/s²] (24)
+                initial_resistance: 77.5,          // r̄₀ [Ω], [SE 25]
+                initial_resistance_std: 1.0,       // σ_r0 [Ω], [SE 26]
+                initial_inductance: 0.05,          // l̄₀ [H], [SE 25], the expert rule's l̂
+                initial_inductance_std: 0.005,     // σ_l0 [H], [SE 26]
+                resistance_rate_std: 1.0,          // σ_ṙ [Ω/s], [SE 24]
+                inductance_accel_std: 100000000.0, // σ_l̈ [H/s²], [SE 24]
                 ci_sigmas: 3.29,                   // n_σ: the CI detector's half-width in σ_i
             };
-            /// The integral estimator (Algorithm 2): `[observer.integral]`.
+            /// The integral estimator [SE Alg. 2]: `[observer.integral]`.
             pub const INTEGRAL: integral::Settings<$f> = integral::Settings {
                 sample_period: SAMPLE_PERIOD,
                 current_noise: CURRENT_NOISE,
                 turns: N,
-                initial_resistance: 77.5,  // r̄₀ [Ω] until the first (47)
+                initial_resistance: 77.5,  // r̄₀ [Ω] until the first [SE 47]
                 initial_inductance: 0.05,  // l̄₀ [H], the expert rule's l̂
-                initial_flux_linkage: 0.0, // λ₀ [Wb] at each reset (46)
+                initial_flux_linkage: 0.0, // λ₀ [Wb] at each reset [SE 46]
                 ci_sigmas: 3.29,           // n_σ: the CI detector's half-width in σ_i
                 energize_threshold: 15.0,  // [V]: u rising above it starts an operation
             };
         };
     }
 
-    /// The model-free estimators of `semera_valve` in f32 (semera-electromagnetic-estimation §II).
+    /// The model-free estimators of `semera_valve` in f32 [SE §II].
     pub mod f32 {
         use reldesign_runtime::{integral, semera};
 
@@ -87,14 +87,14 @@ pub mod estimators {
         /// The estimate of one sample: r̂, l̂, λ̂, φ̂ = λ̂/N, R̂ = N²/l̂ and the CI detector's `valid`.
         pub type Estimate = semera::Estimate<f32>;
 
-        /// SEMERA (Algorithm 1): `Semera::new(&SEMERA)`, then `step(v, i)` every Δ.
+        /// SEMERA [SE Alg. 1]: `Semera::new(&SEMERA)`, then `step(v, i)` every Δ.
         pub type Semera = semera::Semera<f32>;
 
-        /// The integral estimator (Algorithm 2): `Integral::new(&INTEGRAL)`, then `step(v, i)` every Δ.
+        /// The integral estimator [SE Alg. 2]: `Integral::new(&INTEGRAL)`, then `step(v, i)` every Δ.
         pub type Integral = integral::Integral<f32>;
     }
 
-    /// The model-free estimators of `semera_valve` in f64 (semera-electromagnetic-estimation §II).
+    /// The model-free estimators of `semera_valve` in f64 [SE §II].
     pub mod f64 {
         use reldesign_runtime::{integral, semera};
 
@@ -104,10 +104,10 @@ pub mod estimators {
         /// The estimate of one sample: r̂, l̂, λ̂, φ̂ = λ̂/N, R̂ = N²/l̂ and the CI detector's `valid`.
         pub type Estimate = semera::Estimate<f64>;
 
-        /// SEMERA (Algorithm 1): `Semera::new(&SEMERA)`, then `step(v, i)` every Δ.
+        /// SEMERA [SE Alg. 1]: `Semera::new(&SEMERA)`, then `step(v, i)` every Δ.
         pub type Semera = semera::Semera<f64>;
 
-        /// The integral estimator (Algorithm 2): `Integral::new(&INTEGRAL)`, then `step(v, i)` every Δ.
+        /// The integral estimator [SE Alg. 2]: `Integral::new(&INTEGRAL)`, then `step(v, i)` every Δ.
         pub type Integral = integral::Integral<f64>;
     }
 }
