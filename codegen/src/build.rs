@@ -96,8 +96,8 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
         })?);
         type Emitter = fn(&ObserverInput) -> Result<String, ObserverError>;
         let kinds: [(Estimator, &str, &str, Emitter); 2] = [
-            (Estimator::Ekf, "ekf", "The extended Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).", emit_ekf),
-            (Estimator::Ukf, "ukf", "The unscented Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).", emit_ukf),
+            (Estimator::Ekf, "ekf", "The extended Kalman filter on the discretised model (jiles-atherton-actuator-model [JA 84–87]).", emit_ekf),
+            (Estimator::Ukf, "ukf", "The unscented Kalman filter on the discretised model (jiles-atherton-actuator-model [JA 84–87]).", emit_ukf),
         ];
         for (kind, name, doc, emit) in kinds {
             if !o.estimators.contains(&kind) {

@@ -51,9 +51,9 @@ macro_rules! kalman {
         pub const VOLTAGE_NOISE: $f = 0.015;
         /// σ_i [A]: standard deviation of the measured coil current's noise.
         pub const CURRENT_NOISE: $f = 0.001;
-        /// σ of w_z [m] per sample (84a).
+        /// σ of w_z [m] per sample [JA 84a].
         pub const PROCESS_Z: $f = 1e-9;
-        /// σ of w_φ [Wb] per sample (84c).
+        /// σ of w_φ [Wb] per sample [JA 84c].
         pub const PROCESS_PHI: $f = 3e-9;
         /// Initial σ of z [m] (shared by z_prev: the filter starts at rest).
         pub const INITIAL_Z_STD: $f = 1e-5;
@@ -624,7 +624,7 @@ pub mod f64 {
     pub type Controller = control::SoftLanding<Design, f64>;
 }
 
-/// The extended Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).
+/// The extended Kalman filter on the discretised model (jiles-atherton-actuator-model [JA 84–87]).
 pub mod ekf {
     /// The model functions of `perfect_tracking_valve` over the float type `$f`, written once and declared in
     /// each float module below as `model!(f64)` / `model!(f32)`. Their literals are unsuffixed
@@ -635,13 +635,13 @@ pub mod ekf {
             /// Outputs of [`transition`].
             #[derive(Clone, Copy, Debug, PartialEq)]
             pub struct TransitionOutput {
-                /// (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
+                /// [JA 84a] z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s [JA 85]
                 pub z_next: $f,
-                /// (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
+                /// [JA 84b] z_prev,{k+1} = sat_{z_min}^{z_max}(z)
                 pub zp_next: $f,
-                /// (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
+                /// [JA 84c] φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
                 pub phi_next: $f,
-                /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                /// [JA 87] a = f_v(z, v, φ), the free-motion acceleration at v of [JA 85]
                 pub accel: $f,
                 /// ∂z_{k+1}/∂z
                 pub dz_dz: $f,
@@ -659,8 +659,8 @@ pub mod ekf {
                 pub dphi_du: $f,
             }
 
-            /// The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held
-            /// over the sample, the acceleration f_v of (87), and the symbolic Jacobians
+            /// The discretised model [JA 84–85] at x = [z, z_prev, φ(, H_c)] with the input u held
+            /// over the sample, the acceleration f_v of [JA 87], and the symbolic Jacobians
             /// ∂F/∂x and g = ∂F/∂u (entries not listed are constant).
             #[inline]
             #[must_use]
@@ -679,7 +679,7 @@ pub mod ekf {
                 let inv_m = 1.0 / M;
                 let t_s_sq = T_S * T_S;
                 let max = Real::max(z, Z_MIN);
-                // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
+                // [JA 84b] z_prev,{k+1} = sat_{z_min}^{z_max}(z)
                 let zp_next = Real::min(max, Z_MAX);
                 let inv_t_s = 1.0 / T_S;
                 let max_2 = Real::max(phi, -PHI_LIM);
@@ -725,16 +725,16 @@ pub mod ekf {
                 let sel_4 = if phi + PHI_LIM >= 0.0 { 1.0 } else { 0.0 };
                 let sel_5 = if PHI_LIM - max_2 >= 0.0 { sel_4 } else { 0.0 };
                 let sel_6 = if t9 >= 0.0 { -inv_m * t_s_sq * min * sel_5 * t3 } else { 0.0 };
-                // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
+                // [JA 84a] z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s [JA 85]
                 let z_next = Real::min(max_3, Z_MAX);
-                // (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
+                // [JA 84c] φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
                 let phi_next = phi
                     + T_S * t6
                         * (N * u
                             - R
                                 * (R_CORE0 * min * inv_t7
                                     + 1.0 / MU0 * inv_a_gap * zp_next * min * inv_t1));
-                // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                // [JA 87] a = f_v(z, v, φ), the free-motion acceleration at v of [JA 85]
                 let accel = inv_m * t4;
                 // ∂z_{k+1}/∂z
                 let dz_dz = if t8 >= 0.0 { sel_2 } else { 0.0 };
@@ -773,7 +773,7 @@ pub mod ekf {
             /// Outputs of [`measurement`].
             #[derive(Clone, Copy, Debug, PartialEq)]
             pub struct MeasurementOutput {
-                /// i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
+                /// i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current [JA 41]
                 pub i: $f,
                 /// ∂i/∂u (the input's noise in the measurement variance)
                 pub di_du: $f,
@@ -816,7 +816,7 @@ pub mod ekf {
                 let sel_2 = if Z_MAX - max_2 >= 0.0 { sel } else { 0.0 };
                 let sel_3 = if phi + PHI_LIM >= 0.0 { 1.0 } else { 0.0 };
                 let sel_4 = if PHI_LIM - max >= 0.0 { sel_3 } else { 0.0 };
-                // i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
+                // i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current [JA 41]
                 let i = t0
                     * (K_E * u
                         + N
@@ -845,11 +845,11 @@ pub mod ekf {
             /// Outputs of [`acceleration`].
             #[derive(Clone, Copy, Debug, PartialEq)]
             pub struct AccelerationOutput {
-                /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                /// [JA 87] a = f_v(z, v, φ), the free-motion acceleration at v of [JA 85]
                 pub accel: $f,
             }
 
-            /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
+            /// The acceleration f_v of [JA 87] at x = [z, z_prev, φ(, H_c)] (v of [JA 85]): the
             /// estimate's a, at the posterior.
             #[inline]
             #[must_use]
@@ -871,7 +871,7 @@ pub mod ekf {
                 let t0 = 1.0 / (min + Z_EPS);
                 let ln = Real::ln(2.0 * L_W * t0);
                 let t1 = INV_SQRT_A_GAP * min * ln + 1.0;
-                // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                // [JA 87] a = f_v(z, v, φ), the free-motion acceleration at v of [JA 85]
                 let accel = 1.0 / M
                     * (-(F0 + K_S * min + C / T_S * (z - z_prev))
                         - 0.5 * (min_2 * min_2)
@@ -885,7 +885,7 @@ pub mod ekf {
     }
 
     /// The extended Kalman filter of `perfect_tracking_valve` in f32, on the discretised model of
-    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
+    /// jiles-atherton-actuator-model [JA §6.1] [JA 84–87] with x = [z, z_prev, φ]: the model functions
     /// of `model!` in `reldesign_runtime::observe::Ekf` (update with the symbolic ∂h/∂x in
     /// Joseph form, prediction with the symbolic ∂F/∂x).
     /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
@@ -959,7 +959,7 @@ pub mod ekf {
     }
 
     /// The extended Kalman filter of `perfect_tracking_valve` in f64, on the discretised model of
-    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
+    /// jiles-atherton-actuator-model [JA §6.1] [JA 84–87] with x = [z, z_prev, φ]: the model functions
     /// of `model!` in `reldesign_runtime::observe::Ekf` (update with the symbolic ∂h/∂x in
     /// Joseph form, prediction with the symbolic ∂F/∂x).
     /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
@@ -1033,7 +1033,7 @@ pub mod ekf {
     }
 }
 
-/// The unscented Kalman filter on the discretised model (jiles-atherton-actuator-model (84)–(87)).
+/// The unscented Kalman filter on the discretised model (jiles-atherton-actuator-model [JA 84–87]).
 pub mod ukf {
     /// The model functions of `perfect_tracking_valve` over the float type `$f`, written once and declared in
     /// each float module below as `model!(f64)` / `model!(f32)`. Their literals are unsuffixed
@@ -1044,18 +1044,18 @@ pub mod ukf {
             /// Outputs of [`transition`].
             #[derive(Clone, Copy, Debug, PartialEq)]
             pub struct TransitionOutput {
-                /// (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
+                /// [JA 84a] z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s [JA 85]
                 pub z_next: $f,
-                /// (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
+                /// [JA 84b] z_prev,{k+1} = sat_{z_min}^{z_max}(z)
                 pub zp_next: $f,
-                /// (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
+                /// [JA 84c] φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
                 pub phi_next: $f,
-                /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                /// [JA 87] a = f_v(z, v, φ), the free-motion acceleration at v of [JA 85]
                 pub accel: $f,
             }
 
-            /// The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held
-            /// over the sample, and the acceleration f_v of (87).
+            /// The discretised model [JA 84–85] at x = [z, z_prev, φ(, H_c)] with the input u held
+            /// over the sample, and the acceleration f_v of [JA 87].
             #[inline]
             #[must_use]
             #[allow(clippy::excessive_precision)]
@@ -1071,7 +1071,7 @@ pub mod ukf {
                 /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
                 const INV_SQRT_A_GAP: $f = 223.60679774997894;
                 let inv_m = 1.0 / M;
-                // (84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)
+                // [JA 84b] z_prev,{k+1} = sat_{z_min}^{z_max}(z)
                 let zp_next = Real::min(Real::max(z, Z_MIN), Z_MAX);
                 let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
                 let inv_a_gap = 1.0 / A_GAP;
@@ -1085,19 +1085,19 @@ pub mod ukf {
                             - 1.0 / MU0 * inv_a_gap * zp_next
                                 * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * t0)
                                 * (inv_t1 * inv_t1));
-                // (84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)
+                // [JA 84a] z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s [JA 85]
                 let z_next = Real::min(
                     Real::max(2.0 * z - z_prev + inv_m * (T_S * T_S) * t2, Z_MIN),
                     Z_MAX,
                 );
-                // (84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
+                // [JA 84c] φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)
                 let phi_next = phi
                     + T_S / (N * N + R * K_E)
                         * (N * u
                             - R
                                 * (R_CORE0 * min / (1.0 - 1.0 / PHI_SAT * Real::abs(min))
                                     + 1.0 / MU0 * inv_a_gap * zp_next * min * inv_t1));
-                // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                // [JA 87] a = f_v(z, v, φ), the free-motion acceleration at v of [JA 85]
                 let accel = inv_m * t2;
                 TransitionOutput {
                     z_next,
@@ -1110,7 +1110,7 @@ pub mod ukf {
             /// Outputs of [`measurement`].
             #[derive(Clone, Copy, Debug, PartialEq)]
             pub struct MeasurementOutput {
-                /// i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
+                /// i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current [JA 41]
                 pub i: $f,
                 /// ∂i/∂u (the input's noise in the measurement variance)
                 pub di_du: $f,
@@ -1134,7 +1134,7 @@ pub mod ukf {
                 let t0 = 1.0 / (N * N + R * K_E);
                 let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
                 let min_2 = Real::min(Real::max(z, Z_MIN), Z_MAX);
-                // i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))
+                // i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current [JA 41]
                 let i = t0
                     * (K_E * u
                         + N
@@ -1150,11 +1150,11 @@ pub mod ukf {
             /// Outputs of [`acceleration`].
             #[derive(Clone, Copy, Debug, PartialEq)]
             pub struct AccelerationOutput {
-                /// (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                /// [JA 87] a = f_v(z, v, φ), the free-motion acceleration at v of [JA 85]
                 pub accel: $f,
             }
 
-            /// The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the
+            /// The acceleration f_v of [JA 87] at x = [z, z_prev, φ(, H_c)] (v of [JA 85]): the
             /// estimate's a, at the posterior.
             #[inline]
             #[must_use]
@@ -1176,7 +1176,7 @@ pub mod ukf {
                 let t0 = 1.0 / (min + Z_EPS);
                 let ln = Real::ln(2.0 * L_W * t0);
                 let t1 = INV_SQRT_A_GAP * min * ln + 1.0;
-                // (87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)
+                // [JA 87] a = f_v(z, v, φ), the free-motion acceleration at v of [JA 85]
                 let accel = 1.0 / M
                     * (-(F0 + K_S * min + C / T_S * (z - z_prev))
                         - 0.5 * (min_2 * min_2)
@@ -1194,7 +1194,7 @@ pub mod ukf {
                 pub dphi_du: $f,
             }
 
-            /// g = ∂F/∂u of the transition (84): the input's noise σ_u enters the process
+            /// g = ∂F/∂u of the transition [JA 84]: the input's noise σ_u enters the process
             /// noise as σ_u²·g·gᵀ. Entries not listed are constant.
             #[inline]
             #[must_use]
@@ -1207,7 +1207,7 @@ pub mod ukf {
     }
 
     /// The unscented Kalman filter of `perfect_tracking_valve` in f32, on the discretised model of
-    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
+    /// jiles-atherton-actuator-model [JA §6.1] [JA 84–87] with x = [z, z_prev, φ]: the model functions
     /// of `model!` in `reldesign_runtime::observe::Ukf` (sigma points x̄ ± γ·(columns of chol P)
     /// through h and F; failed factorisations are repaired and counted).
     /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.
@@ -1269,7 +1269,7 @@ pub mod ukf {
     }
 
     /// The unscented Kalman filter of `perfect_tracking_valve` in f64, on the discretised model of
-    /// jiles-atherton-actuator-model §6.1 (84)–(87) with x = [z, z_prev, φ]: the model functions
+    /// jiles-atherton-actuator-model [JA §6.1] [JA 84–87] with x = [z, z_prev, φ]: the model functions
     /// of `model!` in `reldesign_runtime::observe::Ukf` (sigma points x̄ ± γ·(columns of chol P)
     /// through h and F; failed factorisations are repaired and counted).
     /// The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.

@@ -137,15 +137,15 @@ pub(super) struct Layout {
 /// `(84a)`… : the doc of F's output for a state.
 fn next_doc(k: StateKind) -> &'static str {
     match k {
-        StateKind::Position => "(84a) z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s (85)",
-        StateKind::PreviousPosition => "(84b) z_prev,{k+1} = sat_{z_min}^{z_max}(z)",
-        StateKind::Flux => "(84c) φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)",
-        StateKind::CoreField => "(84d) H_c,{k+1} = H_c + T_s·f_Hc(z, φ, H_c, u)",
+        StateKind::Position => "[JA 84a] z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s [JA 85]",
+        StateKind::PreviousPosition => "[JA 84b] z_prev,{k+1} = sat_{z_min}^{z_max}(z)",
+        StateKind::Flux => "[JA 84c] φ_{k+1} = φ + T_s·f_φ(z, φ, H_c, u)",
+        StateKind::CoreField => "[JA 84d] H_c,{k+1} = H_c + T_s·f_Hc(z, φ, H_c, u)",
         StateKind::Resistance => "R_{k+1} = R (random walk)",
     }
 }
 
-const ACCEL_DOC: &str = "(87) a = f_v(z, v, φ), the free-motion acceleration at v of (85)";
+const ACCEL_DOC: &str = "[JA 87] a = f_v(z, v, φ), the free-motion acceleration at v of [JA 85]";
 
 /// `transition` (with ∂F/∂x and g for the EKF), the entries of ∂F/∂x (EKF)
 /// and of g, and the UKF's `input_gain` (none when g is constant).
@@ -193,20 +193,20 @@ fn transition(
         .collect();
     let input_gain = (kind == Kind::Ukf && !gain_outputs.is_empty()).then(|| Function {
         name: "input_gain",
-        doc: "g = ∂F/∂u of the transition (84): the input's noise σ_u enters the process\n\
+        doc: "g = ∂F/∂u of the transition [JA 84]: the input's noise σ_u enters the process\n\
               noise as σ_u²·g·gᵀ. Entries not listed are constant."
             .to_owned(),
         outputs: gain_outputs,
     });
     let doc = match kind {
         Kind::Ekf => {
-            "The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held\n\
-             over the sample, the acceleration f_v of (87), and the symbolic Jacobians\n\
+            "The discretised model [JA 84–85] at x = [z, z_prev, φ(, H_c)] with the input u held\n\
+             over the sample, the acceleration f_v of [JA 87], and the symbolic Jacobians\n\
              ∂F/∂x and g = ∂F/∂u (entries not listed are constant)."
         }
         Kind::Ukf => {
-            "The discretised model (84)–(85) at x = [z, z_prev, φ(, H_c)] with the input u held\n\
-             over the sample, and the acceleration f_v of (87)."
+            "The discretised model [JA 84–85] at x = [z, z_prev, φ(, H_c)] with the input u held\n\
+             over the sample, and the acceleration f_v of [JA 87]."
         }
     };
     let function = Function {
@@ -220,9 +220,9 @@ fn transition(
 /// `measurement` (y, ∂y/∂u, and ∂y/∂x for the EKF) and the entries of ∂h/∂x.
 fn measurement(dm: &DiscreteModel, kind: Kind, y: &str) -> (Function, Vec<Entry>) {
     let y_doc = if dm.drive == Drive::Voltage {
-        "i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current (jiles-atherton-actuator-model (41))"
+        "i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current [JA 41]"
     } else {
-        "u_coil = R·u + N·f_φ, the coil voltage (eq. 1)"
+        "u_coil = R·u + N·f_φ, the coil voltage [JA 1]"
     };
     let mut outputs = vec![
         (y.to_owned(), dm.measurement, y_doc.to_owned()),
@@ -266,9 +266,10 @@ impl Layout {
         let (measurement, h_row) = measurement(dm, kind, &y);
         let acceleration = Function {
             name: "acceleration",
-            doc: "The acceleration f_v of (87) at x = [z, z_prev, φ(, H_c)] (v of (85)): the\n\
+            doc:
+                "The acceleration f_v of [JA 87] at x = [z, z_prev, φ(, H_c)] (v of [JA 85]): the\n\
                   estimate's a, at the posterior."
-                .to_owned(),
+                    .to_owned(),
             outputs: vec![("accel".to_owned(), dm.acceleration, ACCEL_DOC.to_owned())],
         };
         Layout {

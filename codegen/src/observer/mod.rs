@@ -235,7 +235,7 @@ fn float_module(
     };
     let module_doc = doc_attrs(&format!(
         "The {what} Kalman filter of `{name}` in {float}, on the discretised model of\n\
-         jiles-atherton-actuator-model §6.1 (84)–(87) with x = [{state_doc}]: the model functions\n\
+         jiles-atherton-actuator-model [JA §6.1] [JA 84–87] with x = [{state_doc}]: the model functions\n\
          of `model!` in {filter}.\n\
          The model is evaluated at z in [z_min, z_max]; the posterior z, z_prev are projected onto it.",
         name = input.name,

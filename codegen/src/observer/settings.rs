@@ -53,15 +53,19 @@ fn named_settings(dm: &DiscreteModel) -> Vec<(&'static str, f64, &'static str)> 
             s.current_noise,
             "σ_i [A]: standard deviation of the measured coil current's noise.",
         ),
-        ("PROCESS_Z", s.process_z, "σ of w_z [m] per sample (84a)."),
+        (
+            "PROCESS_Z",
+            s.process_z,
+            "σ of w_z [m] per sample [JA 84a].",
+        ),
         (
             "PROCESS_PHI",
             s.process_phi,
-            "σ of w_φ [Wb] per sample (84c).",
+            "σ of w_φ [Wb] per sample [JA 84c].",
         ),
     ];
     if let Some(q) = s.process_hc {
-        settings.push(("PROCESS_HC", q, "σ of w_Hc [A/m] per sample (84d)."));
+        settings.push(("PROCESS_HC", q, "σ of w_Hc [A/m] per sample [JA 84d]."));
     }
     settings.push((
         "INITIAL_Z_STD",
