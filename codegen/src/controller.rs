@@ -32,7 +32,7 @@ use quote::{format_ident, quote};
 
 use crate::emit::{function_tokens_as, FunctionSpec, Inline};
 use crate::error::EmitError;
-use crate::float::{Float, Scalar};
+use crate::float::{Float, Scalar, MACRO_LITERALS};
 use crate::format::{comment_lets, format_items, macro_rules, space_items};
 use crate::names::const_name;
 use crate::param::Param;
@@ -272,7 +272,7 @@ fn law_terms(
         outputs,
         named: law.named.clone(),
         output_symbols: STAGED_OUTPUTS.into_iter().zip(law.staged).collect(),
-        // written in `scalar`, see below
+        // written in `scalar` (function_tokens_as)
         float: Float::F64,
     };
     let tokens = function_tokens_as(graph, &spec, &params, Inline::Always, scalar)?;
@@ -474,9 +474,7 @@ fn law_macro(
     let doc = format!(
         "The tracking law [PT 50] of `{}` over the float type `$f`, written once:\n\
          `law_terms`, `law` and `guarded_law`, declared in each float module as `law!(f64)` /\n\
-         `law!(f32)` beside the module's `params!`, gains and `Design`. Its literals are\n\
-         unsuffixed and `$f` types them: an f32 module reads each as the nearest f32, the\n\
-         value an f32 literal of its own would hold.",
+         `law!(f32)` beside the module's `params!`, gains and `Design`.\n{MACRO_LITERALS}",
         input.model.description.name
     );
     Ok(macro_rules("law", &doc, &text))

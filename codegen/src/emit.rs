@@ -38,6 +38,8 @@ pub struct FunctionSpec<'a> {
     /// terms of an earlier one (u = β·(w − L_f³h) rather than β's and w's
     /// expressions multiplied out). The output then gets a `let` of its own.
     pub output_symbols: Vec<(&'a str, Id)>,
+    /// The scalar type (the crate's own emitters write the functions of
+    /// their float-generic macros over the macro's `$f` instead).
     pub float: Float,
 }
 

@@ -93,6 +93,11 @@ pub(crate) enum Scalar {
 /// (`format::macro_rules`).
 pub(crate) const MACRO_FLOAT: &str = "Ft";
 
+/// What a macro's doc says of its literals (`Scalar::Macro`).
+pub(crate) const MACRO_LITERALS: &str =
+    "Its literals are unsuffixed and `$f` types them: an f32 module reads each as the\n\
+     nearest f32, the value an f32 literal of its own would hold.";
+
 impl Scalar {
     /// For the messages of errors.
     pub(crate) fn name(self) -> &'static str {

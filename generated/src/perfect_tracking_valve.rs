@@ -119,9 +119,9 @@ macro_rules! kalman {
 
 /// The tracking law [PT 50] of `perfect_tracking_valve` over the float type `$f`, written once:
 /// `law_terms`, `law` and `guarded_law`, declared in each float module as `law!(f64)` /
-/// `law!(f32)` beside the module's `params!`, gains and `Design`. Its literals are
-/// unsuffixed and `$f` types them: an f32 module reads each as the nearest f32, the
-/// value an f32 literal of its own would hold.
+/// `law!(f32)` beside the module's `params!`, gains and `Design`.
+/// Its literals are unsuffixed and `$f` types them: an f32 module reads each as the
+/// nearest f32, the value an f32 literal of its own would hold.
 macro_rules! law {
     ($f:ty) => {
         /// Outputs of [`law_terms`].
@@ -626,10 +626,10 @@ pub mod f64 {
 
 /// The extended Kalman filter on the discretised model (jiles-atherton-actuator-model [JA 84–87]).
 pub mod ekf {
-    /// The model functions of `perfect_tracking_valve` over the float type `$f`, written once and declared in
-    /// each float module below as `model!(f64)` / `model!(f32)`. Their literals are unsuffixed
-    /// and `$f` types them: an f32 module reads each as the nearest f32, the value an f32
-    /// literal of its own would hold.
+    /// The model functions of `perfect_tracking_valve` over the float type `$f`, written once
+    /// and declared in each float module below as `model!(f64)` / `model!(f32)`.
+    /// Its literals are unsuffixed and `$f` types them: an f32 module reads each as the
+    /// nearest f32, the value an f32 literal of its own would hold.
     macro_rules! model {
         ($f:ty) => {
             /// Outputs of [`transition`].
@@ -849,8 +849,8 @@ pub mod ekf {
                 pub accel: $f,
             }
 
-            /// The acceleration f_v of [JA 87] at x = [z, z_prev, φ(, H_c)] (v of [JA 85]): the
-            /// estimate's a, at the posterior.
+            /// The acceleration f_v of [JA 87] at x = [z, z_prev, φ(, H_c)] (v of [JA 85]):
+            /// the estimate's a, at the posterior.
             #[inline]
             #[must_use]
             #[allow(clippy::excessive_precision)]
@@ -1035,10 +1035,10 @@ pub mod ekf {
 
 /// The unscented Kalman filter on the discretised model (jiles-atherton-actuator-model [JA 84–87]).
 pub mod ukf {
-    /// The model functions of `perfect_tracking_valve` over the float type `$f`, written once and declared in
-    /// each float module below as `model!(f64)` / `model!(f32)`. Their literals are unsuffixed
-    /// and `$f` types them: an f32 module reads each as the nearest f32, the value an f32
-    /// literal of its own would hold.
+    /// The model functions of `perfect_tracking_valve` over the float type `$f`, written once
+    /// and declared in each float module below as `model!(f64)` / `model!(f32)`.
+    /// Its literals are unsuffixed and `$f` types them: an f32 module reads each as the
+    /// nearest f32, the value an f32 literal of its own would hold.
     macro_rules! model {
         ($f:ty) => {
             /// Outputs of [`transition`].
@@ -1154,8 +1154,8 @@ pub mod ukf {
                 pub accel: $f,
             }
 
-            /// The acceleration f_v of [JA 87] at x = [z, z_prev, φ(, H_c)] (v of [JA 85]): the
-            /// estimate's a, at the posterior.
+            /// The acceleration f_v of [JA 87] at x = [z, z_prev, φ(, H_c)] (v of [JA 85]):
+            /// the estimate's a, at the posterior.
             #[inline]
             #[must_use]
             #[allow(clippy::excessive_precision)]

@@ -134,7 +134,7 @@ pub(super) struct Layout {
     pub(super) h_row: Vec<Entry>,
 }
 
-/// `(84a)`… : the doc of F's output for a state.
+/// `[JA 84a]`… : the doc of F's output for a state.
 fn next_doc(k: StateKind) -> &'static str {
     match k {
         StateKind::Position => "[JA 84a] z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s [JA 85]",
@@ -266,10 +266,9 @@ impl Layout {
         let (measurement, h_row) = measurement(dm, kind, &y);
         let acceleration = Function {
             name: "acceleration",
-            doc:
-                "The acceleration f_v of [JA 87] at x = [z, z_prev, φ(, H_c)] (v of [JA 85]): the\n\
-                  estimate's a, at the posterior."
-                    .to_owned(),
+            doc: "The acceleration f_v of [JA 87] at x = [z, z_prev, φ(, H_c)] (v of [JA 85]):\n\
+                  the estimate's a, at the posterior."
+                .to_owned(),
             outputs: vec![("accel".to_owned(), dm.acceleration, ACCEL_DOC.to_owned())],
         };
         Layout {

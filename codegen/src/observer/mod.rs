@@ -37,7 +37,7 @@ use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use crate::error::EmitError;
-use crate::float::{Float, Scalar};
+use crate::float::{Float, Scalar, MACRO_LITERALS};
 use crate::format::{comment_lets, format_items, macro_rules, space_items};
 use crate::names::const_name;
 use crate::param::Param;
@@ -195,10 +195,9 @@ fn model_macro(
         text = comment_lets(&text, f.name, &f.comments());
     }
     let doc = format!(
-        "The model functions of `{}` over the float type `$f`, written once and declared in\n\
-         each float module below as `model!(f64)` / `model!(f32)`. Their literals are unsuffixed\n\
-         and `$f` types them: an f32 module reads each as the nearest f32, the value an f32\n\
-         literal of its own would hold.",
+        "The model functions of `{}` over the float type `$f`, written once\n\
+         and declared in each float module below as `model!(f64)` / `model!(f32)`.\n\
+         {MACRO_LITERALS}",
         input.name
     );
     Ok(macro_rules("model", &doc, &text))

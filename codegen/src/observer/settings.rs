@@ -11,7 +11,7 @@ use designer::observe::discrete::{PHI_LIM, Z_MAX, Z_MIN};
 use proc_macro2::{Ident, Span, TokenStream};
 use quote::quote;
 
-use crate::float::{Float, Scalar};
+use crate::float::{Float, MACRO_FLOAT};
 use crate::format::{format_items, macro_rules};
 use crate::names::const_name;
 
@@ -108,7 +108,7 @@ fn named_settings(dm: &DiscreteModel) -> Vec<(&'static str, f64, &'static str)> 
 /// invoked as `kalman!(f64)` / `kalman!(f32)` in every EKF and UKF module.
 pub fn emit_kalman_macro(input: &ObserverInput) -> Result<String, ObserverError> {
     let dm = input.discrete;
-    let f = Scalar::Macro { f32: true }.ty();
+    let f = Ident::new(MACRO_FLOAT, Span::call_site());
     let mut items = TokenStream::new();
     for (name, value, doc) in named_settings(dm) {
         let id = Ident::new(name, Span::call_site());
