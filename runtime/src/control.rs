@@ -26,7 +26,6 @@
 //! plus `From<u8>` for the polynomial's small integer divisors).
 
 use core::fmt::Debug;
-use core::marker::PhantomData;
 
 use crate::linalg::Scalar;
 
@@ -46,14 +45,14 @@ pub enum Landing {
 
 /// One designed operation [PT 51]: the reference on [t₀, t_f] and its rest positions.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Motion<T: 'static> {
+pub struct Motion<'a, T> {
     pub landing: Landing,
     /// z₀: the rest position before t₀.
     pub z0: T,
     /// z_f: the end stop held after t_f.
     pub zf: T,
     /// One [`Row`] per segment, in time order.
-    pub table: &'static [Row<T>],
+    pub table: &'a [Row<T>],
 }
 
 /// The design values the operation logic reads (the consts of the emitted module).
@@ -78,16 +77,29 @@ pub struct Settings<T> {
     pub creep_max: T,
 }
 
-/// What the emitted module provides: its operations, design values and law.
-pub trait Law<T> {
+/// What every controller module provides: its operations, design values and
+/// reference tables. The emitted modules implement it on a unit struct (and
+/// [`ConstPlan`], so that their controllers have a `const fn new`); the
+/// designer on its run-time design, so that `reldesign loop` runs this very
+/// code.
+pub trait Plan<T> {
     /// The designed operations (an enum of the emitted module).
     type Operation: Copy + Debug + PartialEq;
-    const SETTINGS: Settings<T>;
+    fn settings(&self) -> Settings<T>;
     /// The reference and rest positions of `operation`.
-    fn motion(operation: Self::Operation) -> Motion<T>;
+    fn motion(&self, operation: Self::Operation) -> Motion<'_, T>;
+}
+
+/// A plan that exists at compile time (an emitted unit struct).
+pub trait ConstPlan: Sized {
+    const PLAN: Self;
+}
+
+/// A feedback-linearizing module: its plan and the tracking law [PT 50].
+pub trait Law<T>: Plan<T> {
     /// u of the tracking law [PT 50] at the state x = [z, v, φ] and the reference
     /// [z_r, v_r, a_r, j_r]: not guarded, not saturated.
-    fn law(x: [T; 3], reference: [T; 4]) -> T;
+    fn law(&self, x: [T; 3], reference: [T; 4]) -> T;
 }
 
 /// [z_r, v_r, a_r, j_r] of one table row at τ = t − t_k (the integrals of
@@ -128,41 +140,73 @@ pub fn saturate<T: Scalar>(u: T, settings: &Settings<T>) -> T {
     }
 }
 
+/// sgn φ as the expert rules and the sliding mode read it: −1 below 0, +1 at
+/// or above it (sgn 0 = +1), 0 for NaN (no input).
+#[inline]
+pub fn flux_sign<T: Scalar>(phi: T) -> T {
+    if phi < T::ZERO {
+        -T::ONE
+    } else if phi >= T::ZERO {
+        T::ONE
+    } else {
+        T::ZERO
+    }
+}
+
+/// The expert rule [SM 43] at the end stop z_f (within `landed_band`):
+/// closing → u = u_max·sgn φ holds it closed, opening → u = 0 lets the
+/// spring hold it open; `None` away from z_f. Saturated.
+#[inline]
+pub fn expert_rule<T: Scalar>(
+    motion: &Motion<T>,
+    settings: &Settings<T>,
+    z: T,
+    phi: T,
+) -> Option<T> {
+    match motion.landing {
+        Landing::Closing if z <= motion.zf + settings.landed_band => {
+            Some(saturate(settings.u_max * flux_sign(phi), settings))
+        }
+        Landing::Opening if z >= motion.zf - settings.landed_band => {
+            Some(saturate(T::ZERO, settings))
+        }
+        _ => None,
+    }
+}
+
 /// The law [PT 50] as applied: where φ ≤ `phi_guard` (φ → 0, where β = 1/L_g L_f²h
 /// blows up and D₀⁺ is left) it is not evaluated and u = u_max drives the flux
 /// back into D₀⁺; otherwise [`Law::law`]. Saturated.
 #[inline]
-pub fn guarded_law<L: Law<T>, T: Scalar>(x: [T; 3], reference: [T; 4]) -> T {
-    let settings = L::SETTINGS;
+pub fn guarded_law<L: Law<T>, T: Scalar>(law: &L, x: [T; 3], reference: [T; 4]) -> T {
+    let settings = law.settings();
     let [_, _, phi] = x;
     if phi <= settings.phi_guard {
         return saturate(settings.u_max, &settings);
     }
-    saturate(L::law(x, reference), &settings)
+    saturate(law.law(x, reference), &settings)
 }
 
-/// One operation of the actuator under the law `L` (the rules in the module
-/// docs): pre-movement before t₀, tracking of the table on [t₀, t_f], hold at
-/// z_f after t_f. Allocation- and panic-free.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SoftLanding<L: Law<T>, T> {
-    operation: L::Operation,
+/// Where an operation stands: which, its start time and the table segment it
+/// is in. [`Tracker::reference`] is the reference every law of a [`Plan`]
+/// tracks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tracker<O, T> {
+    operation: O,
     /// Time at which the operation started [s].
     start: T,
     /// Current segment of the table (only moves forward).
     cursor: usize,
-    law: PhantomData<L>,
 }
 
-impl<L: Law<T>, T: Scalar + From<u8> + 'static> SoftLanding<L, T> {
-    /// A controller for `operation`, started at t = 0.
+impl<O: Copy, T: Scalar + From<u8>> Tracker<O, T> {
+    /// A tracker of `operation`, started at t = 0.
     #[must_use]
-    pub const fn new(operation: L::Operation) -> Self {
-        SoftLanding {
+    pub const fn new(operation: O) -> Self {
+        Tracker {
             operation,
             start: T::ZERO,
             cursor: 0,
-            law: PhantomData,
         }
     }
 
@@ -172,18 +216,24 @@ impl<L: Law<T>, T: Scalar + From<u8> + 'static> SoftLanding<L, T> {
         self.cursor = 0;
     }
 
-    /// The operation this controller runs.
+    /// The operation tracked.
     #[must_use]
-    pub const fn operation(&self) -> L::Operation {
+    pub const fn operation(&self) -> O {
         self.operation
+    }
+
+    /// Time since the operation's start [s].
+    #[must_use]
+    pub fn elapsed(&self, t: T) -> T {
+        t - self.start
     }
 
     /// [z_r, v_r, a_r, j_r] at `t` [PT 51]: z₀ at rest before t₀, the table on
     /// [t₀, t_f], after t_f just beyond z_f and creeping on (press, creep).
     /// Advances the segment cursor.
-    pub fn reference(&mut self, t: T) -> [T; 4] {
-        let settings = L::SETTINGS;
-        let motion = L::motion(self.operation);
+    pub fn reference<P: Plan<T, Operation = O>>(&mut self, plan: &P, t: T) -> [T; 4] {
+        let settings = plan.settings();
+        let motion = plan.motion(self.operation);
         let time = t - self.start;
         let rest = [motion.z0, T::ZERO, T::ZERO, T::ZERO];
         if (settings.takeoff..=settings.landing).contains(&time) {
@@ -216,46 +266,76 @@ impl<L: Law<T>, T: Scalar + From<u8> + 'static> SoftLanding<L, T> {
             rest
         }
     }
+}
 
-    /// After t_f at the end stop: the expert rule [SM 43], closing → u = u_max·sgn φ
-    /// (sgn 0 = +1, NaN φ → 0), opening → u = 0; `None` elsewhere.
-    fn hold(&self, time: T, z: T, phi: T) -> Option<T> {
-        let settings = L::SETTINGS;
-        if time > settings.landing {
-            let motion = L::motion(self.operation);
-            match motion.landing {
-                Landing::Closing if z <= motion.zf + settings.landed_band => {
-                    let u = if phi < T::ZERO {
-                        -settings.u_max
-                    } else if phi >= T::ZERO {
-                        settings.u_max
-                    } else {
-                        T::ZERO
-                    };
-                    return Some(saturate(u, &settings));
-                }
-                Landing::Opening if z >= motion.zf - settings.landed_band => {
-                    return Some(saturate(T::ZERO, &settings));
-                }
-                _ => {}
-            }
+/// One operation of the actuator under the law `L` (the rules in the module
+/// docs): pre-movement before t₀, tracking of the table on [t₀, t_f], hold at
+/// z_f after t_f. Allocation- and panic-free.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SoftLanding<L: Law<T>, T> {
+    law: L,
+    tracker: Tracker<L::Operation, T>,
+}
+
+impl<L: Law<T> + ConstPlan, T: Scalar + From<u8>> SoftLanding<L, T> {
+    /// A controller for `operation` of the emitted module's plan, started at t = 0.
+    #[must_use]
+    pub const fn new(operation: L::Operation) -> Self {
+        Self::with(L::PLAN, operation)
+    }
+}
+
+impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
+    /// A controller for `operation` of `law`, started at t = 0.
+    #[must_use]
+    pub const fn with(law: L, operation: L::Operation) -> Self {
+        SoftLanding {
+            law,
+            tracker: Tracker::new(operation),
         }
-        None
+    }
+
+    /// Starts the operation at `t_start` [s]: reference times count from here.
+    pub fn start(&mut self, t_start: T) {
+        self.tracker.start(t_start);
+    }
+
+    /// The operation this controller runs.
+    #[must_use]
+    pub const fn operation(&self) -> L::Operation {
+        self.tracker.operation()
+    }
+
+    /// [z_r, v_r, a_r, j_r] at `t` ([`Tracker::reference`]).
+    pub fn reference(&mut self, t: T) -> [T; 4] {
+        self.tracker.reference(&self.law, t)
+    }
+
+    /// After t_f at the end stop: the expert rule [SM 43] ([`expert_rule`]);
+    /// `None` elsewhere.
+    fn hold(&self, time: T, z: T, phi: T) -> Option<T> {
+        let settings = self.law.settings();
+        if time > settings.landing {
+            let motion = self.law.motion(self.tracker.operation());
+            expert_rule(&motion, &settings, z, phi)
+        } else {
+            None
+        }
     }
 
     /// The input u in [u_min, u_max] at time `t` [s] for the measured state
     /// x = [z, v, φ]: the hold rule at the end stop, else [`guarded_law`] at
     /// the reference of [`SoftLanding::reference`]. Finite for any input.
     pub fn step(&mut self, t: T, z: T, v: T, phi: T) -> T {
-        if let Some(u) = self.hold(t - self.start, z, phi) {
+        if let Some(u) = self.hold(self.tracker.elapsed(t), z, phi) {
             return u;
         }
         let reference = self.reference(t);
-        guarded_law::<L, T>([z, v, phi], reference)
+        guarded_law(&self.law, [z, v, phi], reference)
     }
 }
 
-impl<L: Law<T>, T: Scalar + From<u8> + 'static> crate::Controller<T> for SoftLanding<L, T> {
+impl<L: Law<T>, T: Scalar + From<u8>> crate::Controller<T> for SoftLanding<L, T> {
     fn step(&mut self, t: T, y: &crate::Measurement<T>) -> T {
         SoftLanding::step(self, t, y.z, y.v, y.phi)
     }

@@ -12,6 +12,7 @@ pub mod linalg;
 mod ln;
 pub mod observe;
 pub mod semera;
+pub mod sliding;
 
 /// Scalar math for generated code, through `libm` (no `std`).
 ///

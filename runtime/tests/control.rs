@@ -2,7 +2,8 @@
 //! linear in its inputs): every rule of the module docs, in f64 and f32.
 
 use reldesign_runtime::control::{
-    eval_segment, guarded_law, saturate, Landing, Law, Motion, Settings, SoftLanding,
+    eval_segment, guarded_law, saturate, ConstPlan, Landing, Law, Motion, Plan, Settings,
+    SoftLanding,
 };
 use reldesign_runtime::{Controller, Measurement};
 
@@ -31,9 +32,11 @@ macro_rules! toy {
             #[derive(Clone, Copy, Debug, PartialEq, Eq)]
             pub struct Toy;
 
-            impl Law<$f> for Toy {
-                type Operation = Operation;
-                const SETTINGS: Settings<$f> = Settings {
+            impl ConstPlan for Toy {
+                const PLAN: Self = Toy;
+            }
+
+            pub const SETTINGS: Settings<$f> = Settings {
                     u_min: -24.0,
                     u_max: 20.0,
                     takeoff: 1.0,
@@ -44,7 +47,13 @@ macro_rules! toy {
                     creep: 0.5,
                     creep_max: 0.05,
                 };
-                fn motion(operation: Operation) -> Motion<$f> {
+
+            impl Plan<$f> for Toy {
+                type Operation = Operation;
+                fn settings(&self) -> Settings<$f> {
+                    SETTINGS
+                }
+                fn motion(&self, operation: Operation) -> Motion<'_, $f> {
                     match operation {
                         Operation::Closing => Motion {
                             landing: Landing::Closing,
@@ -60,8 +69,11 @@ macro_rules! toy {
                         },
                     }
                 }
+            }
+
+            impl Law<$f> for Toy {
                 /// u = 100·(z_r − z) + v_r − v + a_r + j_r + φ
-                fn law(x: [$f; 3], r: [$f; 4]) -> $f {
+                fn law(&self, x: [$f; 3], r: [$f; 4]) -> $f {
                     100.0 * (r[0] - x[0]) + r[1] - x[1] + r[2] + r[3] + x[2]
                 }
             }
@@ -136,13 +148,13 @@ macro_rules! toy {
                 let mut c = Ctl::new(Operation::Opening);
                 let (z, v, phi) = (0.1, 0.2, 0.5);
                 let r = c.clone().reference(1.5);
-                let want = Toy::law([z, v, phi], r);
+                let want = Toy.law([z, v, phi], r);
                 assert!(want > -24.0 && want < 20.0, "{want}");
                 assert_eq!(c.step(1.5, z, v, phi), want);
                 // the guard at φ ≤ phi_guard: u_max without evaluating the law
                 assert_eq!(c.step(1.5, z, v, 1e-3), 20.0);
                 assert_eq!(c.step(1.5, z, v, -0.5), 20.0);
-                assert_eq!(guarded_law::<Toy, $f>([z, v, 0.0], r), 20.0);
+                assert_eq!(guarded_law(&Toy, [z, v, 0.0], r), 20.0);
                 // saturation of a large law value, a NaN law value → 0
                 assert_eq!(c.step(1.5, -10.0, v, phi), 20.0);
                 assert_eq!(c.step(1.5, 10.0, v, phi), -24.0);
@@ -185,7 +197,7 @@ macro_rules! toy {
                         }
                     }
                 }
-                let s = Toy::SETTINGS;
+                let s = SETTINGS;
                 assert_eq!(saturate($f::NAN, &s), 0.0);
                 assert_eq!(saturate($f::INFINITY, &s), 20.0);
                 assert_eq!(saturate($f::NEG_INFINITY, &s), -24.0);
