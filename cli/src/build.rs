@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use designer::design::LawDesign;
 use miette::Report;
 
 use crate::fail;
@@ -78,6 +79,25 @@ fn report_json(design: &designer::design::Design) -> String {
             (o.operation.name().to_string(), entry)
         })
         .collect();
-    let value = serde_json::json!({ "name": design.description.name, "gains": design.controller.as_ref().map(|c| c.gains), "operations": operations });
+    let law = design.controller.as_ref().map(|c| match c.law {
+        LawDesign::FeedbackLinearization { gains } => {
+            serde_json::json!({ "law": "feedback-linearization", "gains": gains })
+        }
+        LawDesign::SlidingMode {
+            lambda1,
+            lambda2,
+            nonnegative_current,
+        } => serde_json::json!({
+            "law": "sliding-mode",
+            "lambda1": lambda1,
+            "lambda2": lambda2,
+            "nonnegative_current": nonnegative_current,
+        }),
+    });
+    let gains = design.controller.as_ref().and_then(|c| match c.law {
+        LawDesign::FeedbackLinearization { gains } => Some(gains),
+        LawDesign::SlidingMode { .. } => None,
+    });
+    let value = serde_json::json!({ "name": design.description.name, "controller": law, "gains": gains, "operations": operations });
     serde_json::to_string_pretty(&value).unwrap_or_default() + "\n"
 }

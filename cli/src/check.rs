@@ -3,7 +3,7 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use designer::description::{Core, Description, Drive, FloatType, Gains, Gap, Shape};
+use designer::description::{Core, Description, Drive, FloatType, Gains, Gap, Law, Shape};
 use designer::model::{Model, ModelPlant, Statics, SwitchingPoint};
 use miette::Report;
 
@@ -115,9 +115,24 @@ fn design_text(d: &Description) -> String {
         );
     }
     if let Some(c) = &d.controller {
-        let gains = match c.gains {
-            Gains::SettlingTime(ts) => format!("5 % settling time {ts:e} s (triple pole)"),
-            Gains::Poles(p) => format!("poles {p:?} s⁻¹"),
+        let law = match c.law {
+            Law::FeedbackLinearization(Gains::SettlingTime(ts)) => {
+                format!("feedback linearization [PT 50], 5 % settling time {ts:e} s (triple pole)")
+            }
+            Law::FeedbackLinearization(Gains::Poles(p)) => {
+                format!("feedback linearization [PT 50], poles {p:?} s⁻¹")
+            }
+            Law::SlidingMode(m) => format!(
+                "model-free sliding mode [SM 34], λ₁ = {:e} s⁻¹, λ₂ = {:e} s⁻¹, η = {:e} m/s³{}",
+                m.lambda1,
+                m.lambda2,
+                m.eta,
+                if m.nonnegative_current {
+                    ", the current kept ≥ 0"
+                } else {
+                    ""
+                }
+            ),
         };
         let floats: Vec<&str> = c
             .floats
@@ -125,7 +140,7 @@ fn design_text(d: &Description) -> String {
             .map(|f| if *f == FloatType::F32 { "f32" } else { "f64" })
             .collect();
         let _ = writeln!(s, "\ncontroller");
-        let _ = writeln!(s, "  feedback linearization (eq. 50), {gains}");
+        let _ = writeln!(s, "  {law}");
         let _ = writeln!(
             s,
             "  sample period {:e} s, emitted for {}",

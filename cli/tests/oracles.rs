@@ -7,6 +7,9 @@
 //!   finite differences,
 //! - `check_linearization.py RELDESIGN examples/*.toml`: the feedback
 //!   linearization quantities of `eval` (α, β, L_f³h, L_gL_f²h, T) against CasADi,
+//! - `check_robustness.py RELDESIGN MODEL.toml`: `reldesign robustness --json`
+//!   against a CasADi/scipy computation from the TOML (root-found flux, AD jerk
+//!   terms; model-free-sliding-mode (13), (14), (48)–(52)),
 //! - `check_simulate.py RELDESIGN`: `reldesign simulate` on the three-pulse
 //!   record against a scipy `solve_ivp` hybrid automaton (i and φ to 1e-6),
 //! - `check_simulate.py --self-test`: the scipy automaton against closed forms.
@@ -131,5 +134,27 @@ fn energy_optimal_trajectories_agree_with_scipy_solve_bvp() {
         "check_optimal.py",
         &[model.into(), "--reldesign".into(), BIN.into()],
         "check_optimal: OK",
+    );
+}
+
+#[test]
+fn robustness_agrees_with_the_python_oracle() {
+    let model = "examples/sliding-mode-valve.toml";
+    oracle(
+        "check_robustness.py",
+        &[BIN.into(), model.into()],
+        "check_robustness: OK",
+    );
+    // τ_mov = 3 ms: the opening reference is infeasible (SM §4.1)
+    let dir = support::TempDir::new("oracle-robustness");
+    let text = std::fs::read_to_string(root().join(model))
+        .unwrap()
+        .replace("takeoff = 1e-3", "takeoff = 0.75e-3")
+        .replace("landing = 5e-3", "landing = 3.75e-3");
+    let short = dir.write("three-ms.toml", text);
+    oracle(
+        "check_robustness.py",
+        &[BIN.into(), short.into_os_string()],
+        "check_robustness: OK",
     );
 }

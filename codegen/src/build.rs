@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use designer::description::{parse_file, Estimator, FloatType};
-use designer::design::{Design, PlanError};
+use designer::design::{Design, LawDesign, PlanError};
 
 use crate::controller::{emit_controller, ControllerError, ControllerInput};
 use crate::emit::params_macro;
@@ -17,6 +17,7 @@ use crate::observer::{
     emit_ekf, emit_kalman_macro, emit_ukf, wrap_module, ObserverError, ObserverInput,
 };
 use crate::semera::{emit_semera, SemeraError, SemeraInput};
+use crate::sliding::emit_sliding_mode;
 use crate::Float;
 
 /// Why a description could not be built into code.
@@ -66,7 +67,11 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
             design: c,
             floats,
         };
-        modules.push(emit_controller(&input).map_err(|source| BuildError::Emit {
+        let emitted = match c.law {
+            LawDesign::FeedbackLinearization { .. } => emit_controller(&input),
+            LawDesign::SlidingMode { .. } => emit_sliding_mode(&input),
+        };
+        modules.push(emitted.map_err(|source| BuildError::Emit {
             file: file(),
             source,
         })?);
@@ -137,9 +142,13 @@ fn invokes_params(module: &str) -> bool {
 /// The file header: what the file holds, from which source.
 fn header(design: &Design) -> String {
     let d = &design.description;
-    let what = match design.controller {
-        Some(_) => format!(
+    let what = match design.controller.as_ref().map(|c| c.law) {
+        Some(LawDesign::FeedbackLinearization { .. }) => format!(
             "perfect-tracking soft-landing controller of `{}` (feedback linearization, [PT 50])",
+            d.name
+        ),
+        Some(LawDesign::SlidingMode { .. }) => format!(
+            "soft-landing controller of `{}` (model-free sliding mode, [SM 34])",
             d.name
         ),
         None => format!("observers of `{}`", d.name),

@@ -23,11 +23,10 @@
 //! rules. The emitted code has no `unwrap`, `expect`, indexing, `panic`,
 //! `as` or allocation, and depends only on `reldesign_runtime`.
 
-use designer::description::Operation;
-use designer::design::ControllerDesign;
+use designer::design::{ControllerDesign, LawDesign};
 use designer::model::Model;
 use designer::sym::{Graph, Id};
-use proc_macro2::{Literal, TokenStream};
+use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
 use crate::emit::{function_tokens_as, FunctionSpec, Inline};
@@ -35,6 +34,7 @@ use crate::error::EmitError;
 use crate::float::{Float, Scalar, MACRO_LITERALS};
 use crate::format::{comment_lets, format_items, macro_rules, space_items};
 use crate::names::const_name;
+use crate::operations::{documented_consts, plan_items, splice_tables, PLAN_CONSTS};
 use crate::param::Param;
 use crate::physical::{in_scope, of_model};
 
@@ -45,6 +45,10 @@ pub enum ControllerError {
     Emit(#[from] EmitError),
     #[error("no float type to emit")]
     NoFloat,
+    #[error("the {0} law has no gains K [PT 48]: it is emitted by its own module")]
+    NotFeedbackLinearization(&'static str),
+    #[error("internal error: the sliding-mode module was asked to emit another law")]
+    NotSlidingMode,
     #[error("the design value `{name}` = {value} is not finite in the float type")]
     BadValue { name: String, value: f64 },
     #[error(
@@ -63,24 +67,8 @@ pub struct ControllerInput<'a> {
     pub floats: Vec<Float>,
 }
 
-/// Names of the design constants (checked against the parameters' const names).
-const DESIGN_CONSTS: &[&str] = &[
-    "GAIN_K1",
-    "GAIN_K2",
-    "GAIN_K3",
-    "U_MIN",
-    "U_MAX",
-    "T_TAKEOFF",
-    "T_LANDING",
-    "SAMPLE_PERIOD",
-    "PHI_GUARD",
-    "LANDED_BAND",
-    "PRESS",
-    "CREEP",
-    "CREEP_MAX",
-    "REFERENCE_CLOSING",
-    "REFERENCE_OPENING",
-];
+/// Names of the law's own constants (checked against the parameters' const names).
+const GAIN_CONSTS: &[&str] = &["GAIN_K1", "GAIN_K2", "GAIN_K3"];
 
 /// Symbols of the law's reference inputs and gains (must be new to the graph).
 const REF_SYMBOLS: [&str; 4] = ["z_ref", "v_ref", "a_ref", "j_ref"];
@@ -102,7 +90,7 @@ pub fn emit_controller(input: &ControllerInput) -> Result<String, ControllerErro
     }
     for (name, _, _) in input.model.params.iter() {
         let cname = const_name(name)?;
-        if DESIGN_CONSTS.contains(&cname.as_str()) {
+        if GAIN_CONSTS.contains(&cname.as_str()) || PLAN_CONSTS.contains(&cname.as_str()) {
             return Err(ControllerError::NameTaken(cname));
         }
     }
@@ -234,7 +222,12 @@ fn law_terms(
     let model = input.model;
     let mut params: Vec<Param> = model.params.iter().map(Param::from).collect();
     params.extend_from_slice(physical);
-    for ((&id, name), &k) in law.gains.iter().zip(GAIN_SYMBOLS).zip(&input.design.gains) {
+    for ((&id, name), &k) in law
+        .gains
+        .iter()
+        .zip(GAIN_SYMBOLS)
+        .zip(&fl_gains(input.design)?)
+    {
         params.push(Param::from((name, id, k)));
     }
     let [z, v, phi] = [model.states[0], model.states[1], model.states[2]];
@@ -279,164 +272,27 @@ fn law_terms(
     Ok((tokens, comments))
 }
 
-/// Typed literal of `value` in `float`, or the error naming it.
-fn lit(float: Float, name: &str, value: f64) -> Result<TokenStream, ControllerError> {
-    float
-        .unsuffixed_signed(value)
-        .ok_or_else(|| ControllerError::BadValue {
-            name: format!("{name} ({})", float.name()),
-            value,
-        })
-}
-
-/// `#[doc = " line"]` per line.
-fn doc_attrs(text: &str) -> TokenStream {
-    let mut out = TokenStream::new();
-    for line in text.lines() {
-        let line = format!(" {line}");
-        out.extend(quote!(#[doc = #line]));
-    }
-    out
-}
-
-/// The design constants, documented.
-fn design_consts(d: &ControllerDesign, float: Float) -> Result<TokenStream, ControllerError> {
-    let [k1, k2, k3] = d.gains;
-    let consts = [
-        ("GAIN_K1", k1, "k1 of K = [k1, k2, k3] [PT 48]: s³ + k3·s² + k2·s + k1 is the characteristic polynomial of [PT 49]."),
-        ("GAIN_K2", k2, "k2 of K [PT 48]."),
-        ("GAIN_K3", k3, "k3 of K [PT 48]."),
-        ("U_MIN", d.u_min, "Lower supply limit u_min."),
-        ("U_MAX", d.u_max, "Upper supply limit u_max."),
-        ("T_TAKEOFF", d.takeoff, "t₀ [s] from the operation's start: end of the pre-movement stage [PT 51]."),
-        ("T_LANDING", d.landing, "t_f [s] from the operation's start: end of the motion [PT 51]."),
-        ("SAMPLE_PERIOD", d.sample_period, "T_s [s]: call `Controller::step` once per sample period."),
-        ("PHI_GUARD", d.phi_guard, "Guard at φ → 0 [Wb]: where φ ≤ PHI_GUARD the law is not evaluated and u = u_max\n(drives the flux into D₀⁺). 10⁻³ of the smallest flux the reference needs, rounded down."),
-        ("LANDED_BAND", d.landed_band, "Distance [m] to the end stop within which the armature counts as in contact\n(expert rules after t_f): 10⁻⁹ of the stroke, rounded down."),
-        ("PRESS", d.press, "After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes\nthe last gap gently and the contact is certain."),
-        ("CREEP", d.creep, "After t_f the reference creeps on beyond the stop at CREEP·stroke per second [1/s]:\nwhere the plant differs from the model and a pure hold would hover short of the\nstop, the armature still lands, at about that speed."),
-        ("CREEP_MAX", d.creep_max, "The creep stops CREEP_MAX·stroke beyond the end stop."),
-    ];
-    let ty = float.ty();
-    let mut items = TokenStream::new();
-    for (name, value, doc) in consts {
-        let id = format_ident!("{name}");
-        let value = lit(float, name, value)?;
-        let docs = doc_attrs(doc);
-        items.extend(quote!(#docs pub const #id: #ty = #value;));
-    }
-    Ok(items)
-}
-
-/// The rust names of an operation: (variant, table const, landing, doc).
-fn names(
-    op: Operation,
-) -> (
-    proc_macro2::Ident,
-    &'static str,
-    proc_macro2::Ident,
-    &'static str,
-) {
-    match op {
-        Operation::Closing => (
-            format_ident!("Closing"),
-            "REFERENCE_CLOSING",
-            format_ident!("Closing"),
-            "Closing: z_max → z_min.",
-        ),
-        Operation::Opening => (
-            format_ident!("Opening"),
-            "REFERENCE_OPENING",
-            format_ident!("Opening"),
-            "Opening: z_min → z_max.",
-        ),
-    }
-}
-
-/// One reference table as text: the const with one row per line (the
-/// formatter would put each number on a line of its own), at `indent`.
-fn table_text(
-    table: &str,
-    rows: &[[f64; 7]],
-    float: Float,
-    indent: &str,
-) -> Result<String, ControllerError> {
-    let ty = float.name();
-    let mut out = format!(
-        "{indent}pub const {table}: [[{ty}; 7]; {}] = [\n",
-        rows.len()
-    );
-    for row in rows {
-        let mut cells = Vec::with_capacity(row.len());
-        for &x in row {
-            cells.push(float.literal_text(x).ok_or(ControllerError::BadValue {
-                name: format!("{table} ({ty})"),
-                value: x,
-            })?);
+/// K of [PT 48].
+fn fl_gains(d: &ControllerDesign) -> Result<[f64; 3], ControllerError> {
+    match d.law {
+        LawDesign::FeedbackLinearization { gains } => Ok(gains),
+        LawDesign::SlidingMode { .. } => {
+            Err(ControllerError::NotFeedbackLinearization("sliding-mode"))
         }
-        out.push_str(&format!("{indent}    [{}],\n", cells.join(", ")));
     }
-    out.push_str(&format!("{indent}];\n"));
-    Ok(out)
 }
 
-/// The placeholder a table's rows stand in for until the module is formatted.
-fn placeholder(table: &str) -> String {
-    format!("__ROWS_OF_{table}__")
-}
-
-/// The per-operation items of a float module.
-struct Operations {
-    /// The table consts, their rows left to [`splice_table`].
-    tables: TokenStream,
-    /// The `Operation` variants.
-    variants: TokenStream,
-    /// The match arms of `Law::motion`.
-    motions: TokenStream,
-}
-
-fn operations(input: &ControllerInput, float: Float) -> Result<Operations, ControllerError> {
-    let ty = float.ty();
-    let mech = &input.model.description.mechanics;
-    // the end stops by the names params! gives them
-    let position = |name: &str, z: f64| -> Result<TokenStream, ControllerError> {
-        Ok(if z == mech.z_min {
-            quote!(Z_MIN)
-        } else if z == mech.z_max {
-            quote!(Z_MAX)
-        } else {
-            lit(float, name, z)?
-        })
-    };
-    let (mut tables, mut variants, mut motions) =
-        (TokenStream::new(), TokenStream::new(), TokenStream::new());
-    for op in &input.design.operations {
-        let (variant, table_name, landing, doc) = names(op.operation);
-        let table = format_ident!("{table_name}");
-        let n = Literal::usize_unsuffixed(op.table.segments.len());
-        let rows = format_ident!("{}", placeholder(table_name));
-        let table_doc = doc_attrs(&format!(
-            "Reference of the {} motion z_m on [t₀, t_f] [PT 51]: one row\n[t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;\na(τ) = c0 + c1·τ + c2·τ² + c3·τ³ with τ = t − t_k, v and z its integrals.",
-            variant.to_string().to_lowercase()
-        ));
-        tables.extend(quote!(#table_doc pub const #table: [[#ty; 7]; #n] = #rows;));
-        let doc = format!(" {doc}");
-        variants.extend(quote!(#[doc = #doc] #variant,));
-        let (z0, zf) = (position("z0", op.z0)?, position("zf", op.zf)?);
-        motions.extend(quote!(
-            Operation::#variant => control::Motion {
-                landing: control::Landing::#landing,
-                z0: #z0,
-                zf: #zf,
-                table: &#table,
-            },
-        ));
-    }
-    Ok(Operations {
-        tables,
-        variants,
-        motions,
-    })
+/// The gains K [PT 48], documented.
+fn gain_consts(d: &ControllerDesign, float: Float) -> Result<TokenStream, ControllerError> {
+    let [k1, k2, k3] = fl_gains(d)?;
+    documented_consts(
+        float,
+        &[
+            ("GAIN_K1", k1, "k1 of K = [k1, k2, k3] [PT 48]: s³ + k3·s² + k2·s + k1 is the characteristic polynomial of [PT 49]."),
+            ("GAIN_K2", k2, "k2 of K [PT 48]."),
+            ("GAIN_K3", k3, "k3 of K [PT 48]."),
+        ],
+    )
 }
 
 /// `macro_rules! law`: `law_terms` (the expression emitter's), `law` and
@@ -467,7 +323,7 @@ fn law_macro(
         /// ±∞ to the bounds).
         #[must_use]
         pub fn guarded_law(#law_args) -> #ty {
-            control::guarded_law::<Design, #ty>([z, v, phi], [zr, vr, ar, jr])
+            control::guarded_law(&Design, [z, v, phi], [zr, vr, ar, jr])
         }
     };
     let text = comment_lets(&space_items(&format_items(tokens)?), "law_terms", &comments);
@@ -485,12 +341,13 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
     let ty = float.ty();
     let module = format_ident!("{}", float.name());
     let design = input.design;
-    let consts = design_consts(design, float)?;
-    let Operations {
-        tables,
-        variants,
-        motions,
-    } = operations(input, float)?;
+    let gains = gain_consts(design, float)?;
+    let plan = plan_items(
+        input.model,
+        design,
+        float,
+        "This module's design (limits, timing, guards, tables; the law [PT 50] of\n`law!`) as the runtime's soft-landing logic reads it.",
+    )?;
     let tokens = quote! {
         #[doc = " The controller in this float type."]
         pub mod #module {
@@ -499,44 +356,13 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
             params!(#ty);
             law!(#ty);
 
-            #consts
+            #gains
 
-            #tables
-
-            /// A designed switching operation.
-            #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-            pub enum Operation {
-                #variants
-            }
-
-            /// This module's design (limits, timing, guards, tables, the law [PT 50] of
-            /// `law!`) as the runtime's soft-landing logic reads it.
-            #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-            pub struct Design;
+            #plan
 
             impl control::Law<#ty> for Design {
-                type Operation = Operation;
-
-                const SETTINGS: control::Settings<#ty> = control::Settings {
-                    u_min: U_MIN,
-                    u_max: U_MAX,
-                    takeoff: T_TAKEOFF,
-                    landing: T_LANDING,
-                    phi_guard: PHI_GUARD,
-                    landed_band: LANDED_BAND,
-                    press: PRESS,
-                    creep: CREEP,
-                    creep_max: CREEP_MAX,
-                };
-
-                fn motion(operation: Operation) -> control::Motion<#ty> {
-                    match operation {
-                        #motions
-                    }
-                }
-
                 #[inline(always)]
-                fn law([z, v, phi]: [#ty; 3], [zr, vr, ar, jr]: [#ty; 4]) -> #ty {
+                fn law(&self, [z, v, phi]: [#ty; 3], [zr, vr, ar, jr]: [#ty; 4]) -> #ty {
                     law_terms(z, v, phi, zr, vr, ar, jr).u
                 }
             }
@@ -549,37 +375,5 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
             pub type Controller = control::SoftLanding<Design, #ty>;
         }
     };
-    let mut text = space_items(&format_items(tokens)?);
-    for op in &design.operations {
-        let (_, table_name, _, _) = names(op.operation);
-        text = splice_table(&text, table_name, &op.table.segments, float)?;
-    }
-    Ok(text)
-}
-
-/// Replaces the formatted `pub const TABLE: … = __ROWS_OF_TABLE__;` line by
-/// the table with one row per line.
-fn splice_table(
-    text: &str,
-    table: &str,
-    rows: &[[f64; 7]],
-    float: Float,
-) -> Result<String, ControllerError> {
-    let marker = format!(" = {};", placeholder(table));
-    let mut out = String::with_capacity(text.len() + rows.len() * 160);
-    let mut spliced = false;
-    for line in text.split_inclusive('\n') {
-        if line.trim_end().ends_with(&marker) {
-            let indent = &line[..line.len() - line.trim_start().len()];
-            out.push_str(&table_text(table, rows, float, indent)?);
-            spliced = true;
-        } else {
-            out.push_str(line);
-        }
-    }
-    if !spliced {
-        let what = format!("the line of `{table}` was not found after formatting");
-        return Err(EmitError::Syntax(what).into());
-    }
-    Ok(out)
+    splice_tables(&space_items(&format_items(tokens)?), design, float)
 }

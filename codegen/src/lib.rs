@@ -26,7 +26,9 @@
 //! | `format.rs` | `prettyplease` formatting, `//` comments and `macro_rules!` bodies |
 //! | `error.rs` | [`EmitError`] |
 //! | `build.rs` | a description → the emitted file ([`build_file`], [`compile`], [`emit`]) |
+//! | `operations.rs` | what every controller module states: the plan's consts, tables, `Operation`, `Design` with `control::Plan` |
 //! | `controller.rs` | the feedback-linearizing controller: the `law!` macro and the float modules (over `reldesign_runtime::control`) |
+//! | `sliding.rs` | the model-free sliding-mode controller: λ₁, λ₂ and the float modules (over `reldesign_runtime::sliding`) |
 //! | `semera.rs` | the SEMERA and integral estimator modules |
 //! | `observer/` | the EKF and UKF: `model!` macros and float modules |
 
@@ -41,10 +43,12 @@ mod header;
 mod lower;
 mod names;
 mod observer;
+mod operations;
 mod param;
 mod physical;
 mod plan;
 mod semera;
+mod sliding;
 
 pub use build::{build_file, compile, emit, write_if_changed, BuildError};
 pub use controller::{emit_controller, ControllerError, ControllerInput};
@@ -59,3 +63,4 @@ pub use names::const_name;
 pub use observer::*;
 pub use param::Param;
 pub use semera::*;
+pub use sliding::emit_sliding_mode;

@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 
 use designer::description::{parse_str, Gains, Operation};
 use designer::design::{
-    check_feasibility, gains, ControllerDesign, ControllerSpec, DesignedOperation, Flat,
+    check_feasibility, gains, ControllerDesign, ControllerSpec, DesignedOperation, Flat, LawDesign,
     Linearization, Polynomial, Reference, Segments,
 };
 use designer::model::Model;
@@ -106,7 +106,9 @@ fn design(v: &Valve, both: bool) -> ControllerDesign {
         operations.push(operation(Operation::Opening, z_min, z_max, &v.opening));
     }
     let spec = ControllerSpec {
-        gains: gains(&Gains::SettlingTime(1e-3)),
+        law: LawDesign::FeedbackLinearization {
+            gains: gains(&Gains::SettlingTime(1e-3)),
+        },
         sample_period: 1e-5,
         u_min: d.supply.u_min,
         u_max: d.supply.u_max,

@@ -4,17 +4,21 @@
 //! - [`sym`]: the symbolic core (hash-consed expression DAG, simplification,
 //!   differentiation, CSE, flat-tape evaluation). Knows nothing of actuators.
 //! - [`design`]: controller derivations (Lie derivatives, feedback linearization).
+//! - [`closed_loop`]: the designed controller in a sampled loop on a plant (`loop`, `sweep`).
 //! - [`description`]: the validated actuator description (`valve.toml`).
 //! - [`model`]: the actuator's state-space model, built symbolically.
 //! - [`observe`]: observers (SEMERA, integral estimator, EKF, UKF).
+//! - [`random`]: seeded SplitMix64 draws (Monte Carlo, simulated noise).
 //! - [`record`]: recorded signals in the measured-data CSV format.
 //! - [`replay`]: an input replayed through the hybrid model (`simulate`).
 //! - [`sim`]: the hybrid-automaton simulator (knows nothing of magnetics).
 
+pub mod closed_loop;
 pub mod description;
 pub mod design;
 pub mod model;
 pub mod observe;
+pub mod random;
 pub mod record;
 pub mod replay;
 pub mod sim;

@@ -373,20 +373,34 @@ fn the_perfect_tracking_example_carries_the_papers_design() {
         let d = parse_file(&path).unwrap_or_else(|e| panic!("{e}"));
         let designed = path
             .file_name()
-            .is_some_and(|n| n == "perfect-tracking-valve.toml");
+            .is_some_and(|n| n == "perfect-tracking-valve.toml" || n == "sliding-mode-valve.toml");
         assert_eq!(
             d.trajectory.is_some() && d.controller.is_some(),
             designed,
             "{}",
             path.display()
         );
-        if designed {
+        if path.ends_with("sliding-mode-valve.toml") {
+            // model-free-sliding-mode §4.2: τ_mov = 4 ms, λ₁ = λ₂ = 2000, η = 1e5
+            let t = d.trajectory.unwrap();
+            assert_eq!(
+                (t.takeoff, t.landing, t.shape),
+                (1e-3, 5e-3, Shape::Polynomial)
+            );
+            let Law::SlidingMode(s) = d.controller.unwrap().law else {
+                panic!("sliding-mode-valve.toml: not the sliding-mode law");
+            };
+            assert_eq!((s.lambda1, s.lambda2, s.eta), (2000.0, 2000.0, 1e5));
+        } else if designed {
             let t = d.trajectory.unwrap();
             assert_eq!(
                 (t.takeoff, t.landing, t.u_bound, t.shape),
                 (1e-3, 6e-3, 20.0, Shape::EnergyOptimal)
             );
-            assert_eq!(d.controller.unwrap().gains, Gains::SettlingTime(1e-3));
+            assert_eq!(
+                d.controller.unwrap().law,
+                Law::FeedbackLinearization(Gains::SettlingTime(1e-3))
+            );
         }
     }
 }
@@ -410,11 +424,11 @@ fn both_sections_parse_into_the_expected_values() {
     assert_eq!(
         d.controller,
         Some(Controller {
-            law: Law::FeedbackLinearization,
-            gains: Gains::SettlingTime(1e-3),
+            law: Law::FeedbackLinearization(Gains::SettlingTime(1e-3)),
             sample_period: 1e-5,
             floats: vec![FloatType::F32, FloatType::F64],
             creep_speed: None,
+            estimator: None,
         }),
         "float defaults to both, creep_speed to the generator's"
     );
@@ -456,8 +470,8 @@ fn poles_are_an_alternative_to_the_settling_time() {
         &format!("{TRAJECTORY}{poles}"),
     );
     assert_eq!(
-        d.controller.unwrap().gains,
-        Gains::Poles([-6296.0, -5000.5, -7000.0]),
+        d.controller.unwrap().law,
+        Law::FeedbackLinearization(Gains::Poles([-6296.0, -5000.5, -7000.0])),
         "kept in the order given"
     );
 }

@@ -13,6 +13,11 @@
 #[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
 pub mod perfect_tracking_valve;
 
+/// `examples/sliding-mode-valve.toml`: the valve of
+/// model-free-sliding-mode-soft-landing Table 1 with the paper's §4.2 design.
+#[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
+pub mod sliding_mode_valve;
+
 /// `examples/semera-valve.toml`: the valve of semera-electromagnetic-estimation
 /// Table I with the SEMERA and integral estimators of its Table II.
 #[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact

@@ -219,7 +219,7 @@ macro_rules! law {
         /// ±∞ to the bounds).
         #[must_use]
         pub fn guarded_law(z: $f, v: $f, phi: $f, zr: $f, vr: $f, ar: $f, jr: $f) -> $f {
-            control::guarded_law::<Design, $f>([z, v, phi], [zr, vr, ar, jr])
+            control::guarded_law(&Design, [z, v, phi], [zr, vr, ar, jr])
         }
     };
 }
@@ -254,12 +254,13 @@ pub mod f32 {
     /// T_s [s]: call `Controller::step` once per sample period.
     pub const SAMPLE_PERIOD: f32 = 1e-5;
 
-    /// Guard at φ → 0 [Wb]: where φ ≤ PHI_GUARD the law is not evaluated and u = u_max
-    /// (drives the flux into D₀⁺). 10⁻³ of the smallest flux the reference needs, rounded down.
+    /// Guard at φ → 0 [Wb]: where φ ≤ PHI_GUARD the feedback-linearizing law is not
+    /// evaluated and u = u_max (drives the flux into D₀⁺). 10⁻³ of the smallest flux the
+    /// reference needs, rounded down. (The sliding-mode law has no singularity there.)
     pub const PHI_GUARD: f32 = 2e-9;
 
     /// Distance [m] to the end stop within which the armature counts as in contact
-    /// (expert rules after t_f): 10⁻⁹ of the stroke, rounded down.
+    /// (the expert rules [SM 43]): 10⁻⁹ of the stroke, rounded down.
     pub const LANDED_BAND: f32 = 1e-12;
 
     /// After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes
@@ -370,26 +371,34 @@ pub mod f32 {
         Opening,
     }
 
-    /// This module's design (limits, timing, guards, tables, the law [PT 50] of
+    /// This module's design (limits, timing, guards, tables; the law [PT 50] of
     /// `law!`) as the runtime's soft-landing logic reads it.
-    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
     pub struct Design;
 
-    impl control::Law<f32> for Design {
-        type Operation = Operation;
-        const SETTINGS: control::Settings<f32> = control::Settings {
-            u_min: U_MIN,
-            u_max: U_MAX,
-            takeoff: T_TAKEOFF,
-            landing: T_LANDING,
-            phi_guard: PHI_GUARD,
-            landed_band: LANDED_BAND,
-            press: PRESS,
-            creep: CREEP,
-            creep_max: CREEP_MAX,
-        };
+    impl control::ConstPlan for Design {
+        const PLAN: Self = Design;
+    }
 
-        fn motion(operation: Operation) -> control::Motion<f32> {
+    impl control::Plan<f32> for Design {
+        type Operation = Operation;
+
+        #[inline(always)]
+        fn settings(&self) -> control::Settings<f32> {
+            control::Settings {
+                u_min: U_MIN,
+                u_max: U_MAX,
+                takeoff: T_TAKEOFF,
+                landing: T_LANDING,
+                phi_guard: PHI_GUARD,
+                landed_band: LANDED_BAND,
+                press: PRESS,
+                creep: CREEP,
+                creep_max: CREEP_MAX,
+            }
+        }
+
+        fn motion(&self, operation: Operation) -> control::Motion<'_, f32> {
             match operation {
                 Operation::Closing => {
                     control::Motion {
@@ -409,9 +418,11 @@ pub mod f32 {
                 }
             }
         }
+    }
 
+    impl control::Law<f32> for Design {
         #[inline(always)]
-        fn law([z, v, phi]: [f32; 3], [zr, vr, ar, jr]: [f32; 4]) -> f32 {
+        fn law(&self, [z, v, phi]: [f32; 3], [zr, vr, ar, jr]: [f32; 4]) -> f32 {
             law_terms(z, v, phi, zr, vr, ar, jr).u
         }
     }
@@ -454,12 +465,13 @@ pub mod f64 {
     /// T_s [s]: call `Controller::step` once per sample period.
     pub const SAMPLE_PERIOD: f64 = 1e-5;
 
-    /// Guard at φ → 0 [Wb]: where φ ≤ PHI_GUARD the law is not evaluated and u = u_max
-    /// (drives the flux into D₀⁺). 10⁻³ of the smallest flux the reference needs, rounded down.
+    /// Guard at φ → 0 [Wb]: where φ ≤ PHI_GUARD the feedback-linearizing law is not
+    /// evaluated and u = u_max (drives the flux into D₀⁺). 10⁻³ of the smallest flux the
+    /// reference needs, rounded down. (The sliding-mode law has no singularity there.)
     pub const PHI_GUARD: f64 = 2e-9;
 
     /// Distance [m] to the end stop within which the armature counts as in contact
-    /// (expert rules after t_f): 10⁻⁹ of the stroke, rounded down.
+    /// (the expert rules [SM 43]): 10⁻⁹ of the stroke, rounded down.
     pub const LANDED_BAND: f64 = 1e-12;
 
     /// After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes
@@ -570,26 +582,34 @@ pub mod f64 {
         Opening,
     }
 
-    /// This module's design (limits, timing, guards, tables, the law [PT 50] of
+    /// This module's design (limits, timing, guards, tables; the law [PT 50] of
     /// `law!`) as the runtime's soft-landing logic reads it.
-    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
     pub struct Design;
 
-    impl control::Law<f64> for Design {
-        type Operation = Operation;
-        const SETTINGS: control::Settings<f64> = control::Settings {
-            u_min: U_MIN,
-            u_max: U_MAX,
-            takeoff: T_TAKEOFF,
-            landing: T_LANDING,
-            phi_guard: PHI_GUARD,
-            landed_band: LANDED_BAND,
-            press: PRESS,
-            creep: CREEP,
-            creep_max: CREEP_MAX,
-        };
+    impl control::ConstPlan for Design {
+        const PLAN: Self = Design;
+    }
 
-        fn motion(operation: Operation) -> control::Motion<f64> {
+    impl control::Plan<f64> for Design {
+        type Operation = Operation;
+
+        #[inline(always)]
+        fn settings(&self) -> control::Settings<f64> {
+            control::Settings {
+                u_min: U_MIN,
+                u_max: U_MAX,
+                takeoff: T_TAKEOFF,
+                landing: T_LANDING,
+                phi_guard: PHI_GUARD,
+                landed_band: LANDED_BAND,
+                press: PRESS,
+                creep: CREEP,
+                creep_max: CREEP_MAX,
+            }
+        }
+
+        fn motion(&self, operation: Operation) -> control::Motion<'_, f64> {
             match operation {
                 Operation::Closing => {
                     control::Motion {
@@ -609,9 +629,11 @@ pub mod f64 {
                 }
             }
         }
+    }
 
+    impl control::Law<f64> for Design {
         #[inline(always)]
-        fn law([z, v, phi]: [f64; 3], [zr, vr, ar, jr]: [f64; 4]) -> f64 {
+        fn law(&self, [z, v, phi]: [f64; 3], [zr, vr, ar, jr]: [f64; 4]) -> f64 {
             law_terms(z, v, phi, zr, vr, ar, jr).u
         }
     }

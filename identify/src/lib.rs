@@ -34,7 +34,7 @@ pub mod gap_fit;
 pub mod identifiability;
 pub mod lm;
 pub mod measured;
-pub mod params;
+pub use designer::description::params;
 pub mod sensitivity;
 pub mod weighted;
 

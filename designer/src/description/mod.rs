@@ -6,6 +6,7 @@
 //! Everything downstream (model, simulator, designers) reads only these types.
 
 mod error;
+pub mod params;
 mod parse;
 pub mod schema;
 
@@ -188,9 +189,8 @@ pub enum FloatType {
 /// `[controller]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Controller {
-    /// Only "feedback-linearization" ([PT 50]) for now.
+    /// The law and its own keys.
     pub law: Law,
-    pub gains: Gains,
     /// T_s [s] (> 0): the controller runs every sample period.
     pub sample_period: f64,
     /// Emitted variants, sorted, no duplicates (default: both).
@@ -200,12 +200,47 @@ pub struct Controller {
     /// from the model, a biased estimate) still lands, at about this speed.
     /// `None`: 2.5·10⁻³ of the stroke per motion time (`codegen`).
     pub creep_speed: Option<f64>,
+    /// The observer of `[observer]` that drives the controller in the closed
+    /// loops of `reldesign loop` and `sweep` (`Ekf` or `Ukf`); `None`: the
+    /// controller reads the plant's state.
+    pub estimator: Option<Estimator>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// `controller.law` with the keys of that law.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Law {
-    /// u = α + β·(K·(ξ_r − T(x)) + z_r⁽³⁾), perfect-tracking-soft-landing [PT 50].
-    FeedbackLinearization,
+    /// u = α + β·(K·(ξ_r − T(x)) + z_r⁽³⁾), perfect-tracking-soft-landing [PT 50],
+    /// with the gains K of [PT 48].
+    FeedbackLinearization(Gains),
+    /// u = u_max·sgn(φ)·sgn*(s), model-free-sliding-mode-soft-landing [SM 34–35],
+    /// with the expert rules [SM 43].
+    SlidingMode(SlidingSurface),
+}
+
+impl Law {
+    /// The `controller.law` value.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Law::FeedbackLinearization(_) => "feedback-linearization",
+            Law::SlidingMode(_) => "sliding-mode",
+        }
+    }
+}
+
+/// The sliding-mode law's keys (model-free-sliding-mode-soft-landing [SM §3]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlidingSurface {
+    /// λ₁ [1/s] (> 0) of s = (λ₁ + d/dt)(λ₂ + d/dt)z̃ [SM 17].
+    pub lambda1: f64,
+    /// λ₂ [1/s] (> 0).
+    pub lambda2: f64,
+    /// η [m/s³] (> 0): the reaching condition s·ṡ ≤ −η·|s| [SM 20]; it enters
+    /// the robustness bound [SM 49], not the emitted law.
+    pub eta: f64,
+    /// The current is kept ≥ 0 ([SM §5]): the emitted step reads the coil
+    /// current instead of φ's sign, takes sgn φ = +1 and never drives the
+    /// current below 0.
+    pub nonnegative_current: bool,
 }
 
 /// An estimator of `[observer].estimators`.

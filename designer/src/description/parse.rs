@@ -15,7 +15,7 @@ use super::schema;
 use super::{
     Coil, Controller, Core, Description, DescriptionError, Drive, Estimator, FloatType, Gains, Gap,
     IntegralSettings, JilesAtherton, KalmanSection, Law, Mechanics, Observer, Operation,
-    ResistanceEstimate, SemeraSettings, Shape, Source, Supply, Trajectory,
+    ResistanceEstimate, SemeraSettings, Shape, SlidingSurface, Source, Supply, Trajectory,
 };
 
 type Res<T> = Result<T, DescriptionError>;
@@ -81,6 +81,9 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         .opt_section("observer")?
         .map(|s| parse_observer(&s, &supply, &core_sect, &core))
         .transpose()?;
+    if let (Some(s), Some(c)) = (&controller_sect, &controller) {
+        check_estimator(s, c, observer.as_ref())?;
+    }
     let source = Source {
         file_name: file_name.to_string(),
         text: text.to_string(),
@@ -338,20 +341,64 @@ fn parse_trajectory(s: &Sect, supply: &Supply) -> Res<Trajectory> {
 }
 
 fn parse_controller(s: &Sect) -> Res<Controller> {
-    s.check_keys(None, "in [controller]")?;
-    s.choice("law", "control law")?;
-    let law = Law::FeedbackLinearization; // the only value of controller.law
-    let gains = parse_gains(s)?;
+    if s.entry("law").is_none() {
+        // an unknown key is the likelier mistake (`kind = …` for `law = …`)
+        s.check_keys_any_variant("in [controller]")?;
+    }
+    let name = s.choice("law", "control law")?;
+    s.check_keys(Some(name), &format!("in [controller] with law \"{name}\""))?;
+    let law = match name {
+        "feedback-linearization" => Law::FeedbackLinearization(parse_gains(s)?),
+        _ => Law::SlidingMode(SlidingSurface {
+            lambda1: s.req("lambda1")?,
+            lambda2: s.req("lambda2")?,
+            eta: s.req("eta")?,
+            nonnegative_current: s.opt_bool("nonnegative_current")?.unwrap_or(false),
+        }),
+    };
     let sample_period = s.req("sample_period")?;
     let floats = parse_floats(s)?;
     let creep_speed = s.opt("creep_speed")?;
+    let estimator = s.opt_choice("estimator", "estimator")?.map(|e| match e {
+        "ekf" => Estimator::Ekf,
+        _ => Estimator::Ukf,
+    });
     Ok(Controller {
         law,
-        gains,
         sample_period,
         floats,
         creep_speed,
+        estimator,
     })
+}
+
+/// `controller.estimator` names an observer that `[observer]` designs.
+fn check_estimator(s: &Sect, c: &Controller, observer: Option<&Observer>) -> Res<()> {
+    let Some(wanted) = c.estimator else {
+        return Ok(());
+    };
+    let name = if wanted == Estimator::Ekf {
+        "ekf"
+    } else {
+        "ukf"
+    };
+    match observer {
+        Some(o) if o.estimators.contains(&wanted) => Ok(()),
+        Some(_) => {
+            let msg = format!(
+                "controller.estimator = \"{name}\" needs \"{name}\" in observer.estimators: the \
+                 loop runs the observer that [observer] designs"
+            );
+            Err(s.err("estimator", msg, "not in observer.estimators"))
+        }
+        None => {
+            let msg = format!(
+                "controller.estimator = \"{name}\" needs an [observer] section listing \
+                 \"{name}\" in estimators (with [observer.kalman])"
+            );
+            Err(s.err("estimator", msg, "no [observer]"))
+        }
+    }
 }
 
 /// `float`: optional, default both; sorted, no duplicates.
@@ -532,16 +579,7 @@ fn parse_kalman(s: &Sect, core_sect: &Sect, core: &Core) -> Res<KalmanSection> {
 /// state [z, z_prev, φ, H_c, R] would exceed the filters' four states.
 fn parse_resistance_estimate(s: &Sect, ja: bool) -> Res<Option<ResistanceEstimate>> {
     const KEY: &str = "estimate_resistance";
-    let on = match s.entry(KEY) {
-        None => false,
-        Some((_, v)) => match v.get_ref() {
-            DeValue::Boolean(b) => *b,
-            _ => {
-                let msg = format!("expected a boolean, found {}", s.ctx.found(v));
-                return Err(s.err(KEY, msg, "expected true or false"));
-            }
-        },
-    };
+    let on = s.opt_bool(KEY)?.unwrap_or(false);
     let keys = ["resistance_rate_std", "initial_resistance_std"];
     if !on {
         if let Some(key) = keys.into_iter().find(|k| s.entry(k).is_some()) {
@@ -644,10 +682,12 @@ fn check_controller(
         return Err(root.err("controller", msg, "needs [trajectory]"));
     };
     if let Core::JilesAtherton(_) = core {
-        let msg = "the controller law \"feedback-linearization\" requires an input-affine \
-                   model, but the \"jiles-atherton\" core is not: its branch \
-                   δ = sign(dφ/dt) depends on the input u; design on a \"saturating\" or \
-                   \"linear\" core model of the same actuator";
+        let msg = format!(
+            "the controller law \"{}\" is designed on an input-affine model, but the \
+             \"jiles-atherton\" core is not: its branch δ = sign(dφ/dt) depends on the input \
+             u; design on a \"saturating\" or \"linear\" core model of the same actuator",
+            c.law.name()
+        );
         return Err(core_sect.err("model", msg, "not input-affine"));
     }
     let limit = (t.landing - t.takeoff) / MIN_SAMPLES_PER_MOTION;
@@ -1074,8 +1114,21 @@ impl<'a> Sect<'a> {
 
     /// Rejects keys the schema does not allow in this section (with its
     /// `model` = `variant`), reporting the first in document order.
+    /// Unknown keys, against the keys of every variant of the section.
+    fn check_keys_any_variant(&self, context: &str) -> Res<()> {
+        let allowed: Vec<&str> = schema::KEYS
+            .iter()
+            .filter(|k| k.section() == self.name)
+            .map(schema::Key::name)
+            .collect();
+        self.reject_unknown(&allowed, context)
+    }
+
     fn check_keys(&self, variant: Option<&str>, context: &str) -> Res<()> {
-        let allowed = schema::keys_of(self.name, variant);
+        self.reject_unknown(&schema::keys_of(self.name, variant), context)
+    }
+
+    fn reject_unknown(&self, allowed: &[&str], context: &str) -> Res<()> {
         let unknown = self
             .table
             .iter()
@@ -1090,7 +1143,7 @@ impl<'a> Sect<'a> {
         );
         let full = self.full_key(key.get_ref());
         let err = self.ctx.err(full, key.span(), msg, "unknown key");
-        match closest(key.get_ref(), &allowed) {
+        match closest(key.get_ref(), allowed) {
             Some(near) => Err(err.with_help(format!("did you mean `{near}`?"))),
             None => Err(err),
         }
@@ -1170,10 +1223,31 @@ impl<'a> Sect<'a> {
 
     /// A required string among `allowed`.
     fn choice(&self, key: &str, what: &str) -> Res<&'static str> {
+        let list = quoted_list(schema::values(&self.full_key(key)));
+        self.opt_choice(key, what)?
+            .ok_or_else(|| self.missing(key, &format!("one of {list}")))
+    }
+
+    /// An optional boolean.
+    fn opt_bool(&self, key: &str) -> Res<Option<bool>> {
+        let Some((_, value)) = self.entry(key) else {
+            return Ok(None);
+        };
+        match value.get_ref() {
+            DeValue::Boolean(b) => Ok(Some(*b)),
+            _ => {
+                let msg = format!("expected a boolean, found {}", self.ctx.found(value));
+                Err(self.err(key, msg, "expected true or false"))
+            }
+        }
+    }
+
+    /// An optional string among `allowed`.
+    fn opt_choice(&self, key: &str, what: &str) -> Res<Option<&'static str>> {
         let allowed = schema::values(&self.full_key(key));
         let list = quoted_list(allowed);
         let Some((_, value)) = self.entry(key) else {
-            return Err(self.missing(key, &format!("one of {list}")));
+            return Ok(None);
         };
         let Some(text) = value.get_ref().as_str() else {
             let msg = format!(
@@ -1183,7 +1257,7 @@ impl<'a> Sect<'a> {
             return Err(self.err(key, msg, "expected a string"));
         };
         match allowed.iter().find(|a| **a == text) {
-            Some(a) => Ok(a),
+            Some(a) => Ok(Some(a)),
             None => {
                 let msg = format!("unknown {what} \"{text}\"; expected one of {list}");
                 Err(self.err(key, msg, &format!("unknown {what}")))

@@ -113,7 +113,8 @@ pub enum Presence {
 pub struct Key {
     /// Dotted path: `coil.resistance`, `observer.kalman.process_z`, `name`.
     pub path: &'static str,
-    /// The section's `model` values this key belongs to (empty: every one).
+    /// The section's `model` values (`[controller]`'s `law` values) this key
+    /// belongs to (empty: every one).
     pub variants: &'static [&'static str],
     pub kind: Kind,
     pub domain: Domain,
@@ -144,6 +145,10 @@ impl Key {
         self.variants.is_empty() || variant.is_some_and(|v| self.variants.contains(&v))
     }
 }
+
+/// The `[controller]` keys of each law.
+const FL: &[&str] = &["feedback-linearization"];
+const SM: &[&str] = &["sliding-mode"];
 
 /// Every key, in the order of the reference (one key per line: a table).
 #[rustfmt::skip]
@@ -208,11 +213,16 @@ pub const KEYS: &[Key] = &[
     choice("trajectory.shape", &["energy-optimal", "polynomial"], "the motion: min ∫u² dt (Pontryagin), or the degree-5 polynomial"),
     number("trajectory.u_bound", Domain::Positive, "V", Presence::Required, "the design uses inputs in [max(u_min, −u_bound), u_bound]; max(0, u_min) < u_bound ≤ u_max; the rest is the feedback's (A with drive = \"current\")"),
     // [controller]
-    choice("controller.law", &["feedback-linearization"], "the control law"),
-    number("controller.settling_time", Domain::Positive, "s", Presence::When("exactly one of settling_time and poles"), "5 % settling time of the error dynamics with a triple real pole"),
-    numbers("controller.poles", &[], Domain::Negative, "1/s", Presence::When("exactly one of settling_time and poles"), "the three real closed-loop poles of the error dynamics"),
+    choice("controller.law", &["feedback-linearization", "sliding-mode"], "the control law: feedback linearization [PT 50], or the model-free sliding mode [SM 34–35] with the expert rules [SM 43]"),
+    Key { variants: FL, ..number("controller.settling_time", Domain::Positive, "s", Presence::When("exactly one of settling_time and poles"), "5 % settling time of the error dynamics with a triple real pole") },
+    numbers("controller.poles", FL, Domain::Negative, "1/s", Presence::When("exactly one of settling_time and poles"), "the three real closed-loop poles of the error dynamics"),
+    Key { variants: SM, ..number("controller.lambda1", Domain::Positive, "1/s", Presence::Required, "λ₁ of the sliding surface s = (λ₁ + d/dt)(λ₂ + d/dt)(z − z_r) [SM 17]") },
+    Key { variants: SM, ..number("controller.lambda2", Domain::Positive, "1/s", Presence::Required, "λ₂ of the sliding surface [SM 17]") },
+    Key { variants: SM, ..number("controller.eta", Domain::Positive, "m/s³", Presence::Required, "η of the reaching condition s·ṡ ≤ −η·|s| [SM 20]: enters the robustness bound [SM 49], not the emitted law") },
+    Key { variants: SM, kind: Kind::Bool, ..number("controller.nonnegative_current", Domain::Any, "", Presence::Optional("false: the step reads φ (measured or estimated) for its sign"), "the current is kept ≥ 0 [SM §5]: the step reads the coil current instead of φ, takes sgn φ = +1 and never drives the current below 0") },
     number("controller.sample_period", Domain::Positive, "s", Presence::Required, "T_s: the emitted step runs once per sample; at most (landing − takeoff)/10"),
     names("controller.float", &["f32", "f64"], Presence::Optional("both"), "the float types to emit code for"),
+    Key { kind: Kind::Choice(&["ekf", "ukf"]), ..number("controller.estimator", Domain::Any, "", Presence::Optional("the closed loops of `loop` and `sweep` feed the controller the plant's state"), "the observer of [observer] that drives the controller in `reldesign loop` and `sweep` from the measured voltage and current (it must be listed in observer.estimators)") },
     number("controller.creep_speed", Domain::Positive, "m/s", Presence::Optional("2.5e-3 of the stroke per motion time"), "after t_f the reference creeps beyond the stop at this speed, so that a loop held short still lands"),
     // [observer]
     names("observer.estimators", &["semera", "integral", "ekf", "ukf"], Presence::Required, "the estimators to design and emit"),

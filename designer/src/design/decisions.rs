@@ -1,5 +1,6 @@
-//! The controller's design decisions as plain data: the gains K of [PT 48], the
-//! guard at φ → 0, the landed band, the press and the creep after t_f
+//! The controller's design decisions as plain data: the law's values (the gains
+//! K of [PT 48], or the sliding surface [SM 17]), the guard at φ → 0, the
+//! landed band, the press and the creep after t_f
 //! (perfect-tracking-soft-landing [PT §3.2] and [PT §4]). Code generation only renders
 //! a [`ControllerDesign`]; the runtime's `control` module applies it.
 
@@ -86,11 +87,40 @@ pub struct DesignedOperation {
     pub optimal: Option<OptimalTrajectory>,
 }
 
+/// The law's own design values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LawDesign {
+    /// K = [k1, k2, k3] of [PT 48] (see [`gains`]).
+    FeedbackLinearization { gains: [f64; 3] },
+    /// λ₁, λ₂ of the surface [SM 17]; with `nonnegative_current` the step
+    /// reads the current and keeps it ≥ 0 ([SM §5]).
+    SlidingMode {
+        lambda1: f64,
+        lambda2: f64,
+        nonnegative_current: bool,
+    },
+}
+
+impl LawDesign {
+    /// The values that must be positive and finite, by name.
+    fn positive_values(&self) -> Vec<(String, f64)> {
+        match *self {
+            LawDesign::FeedbackLinearization { gains } => gains
+                .iter()
+                .enumerate()
+                .map(|(k, &g)| (format!("k{}", k + 1), g))
+                .collect(),
+            LawDesign::SlidingMode {
+                lambda1, lambda2, ..
+            } => vec![("lambda1".into(), lambda1), ("lambda2".into(), lambda2)],
+        }
+    }
+}
+
 /// What the description asks of the controller: the inputs of the decisions.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ControllerSpec {
-    /// K = [k1, k2, k3] (see [`gains`]).
-    pub gains: [f64; 3],
+    pub law: LawDesign,
     /// T_s [s].
     pub sample_period: f64,
     /// Supply limits [V or A].
@@ -103,13 +133,12 @@ pub struct ControllerSpec {
     pub creep_speed: Option<f64>,
 }
 
-/// The designed feedback-linearizing controller: everything the emitted
-/// module states, as numbers.
+/// The designed controller: everything the emitted module states, as numbers.
 #[derive(Debug, Clone)]
 pub struct ControllerDesign {
     pub linearization: Linearization,
-    /// K = [k1, k2, k3] of [PT 48].
-    pub gains: [f64; 3],
+    /// The law and its design values.
+    pub law: LawDesign,
     /// T_s [s]: the controller runs once per sample period.
     pub sample_period: f64,
     /// Supply limits: every output is saturated to [u_min, u_max].
@@ -152,7 +181,7 @@ impl ControllerDesign {
         };
         Ok(ControllerDesign {
             linearization,
-            gains: spec.gains,
+            law: spec.law,
             sample_period: spec.sample_period,
             u_min: spec.u_min,
             u_max: spec.u_max,
@@ -180,8 +209,8 @@ fn check(spec: &ControllerSpec, operations: &[DesignedOperation]) -> Result<f64,
     let positive =
         |name: &str, v: f64| (v.is_finite() && v > 0.0).then_some(()).ok_or(bad(name, v));
     let finite = |name: &str, v: f64| v.is_finite().then_some(()).ok_or(bad(name, v));
-    for (k, &g) in spec.gains.iter().enumerate() {
-        positive(&format!("k{}", k + 1), g)?;
+    for (name, value) in spec.law.positive_values() {
+        positive(&name, value)?;
     }
     positive("sample_period", spec.sample_period)?;
     positive("takeoff", spec.takeoff)?;

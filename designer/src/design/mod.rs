@@ -15,7 +15,13 @@
 //!   band, press, creep) as plain data, [`ControllerDesign`];
 //! - `plan.rs`: description → [`Design`] (controller and Kalman model), the
 //!   pipeline up to code generation;
-//! - `report.rs`: the design report of `reldesign build`.
+//! - `report.rs`: the design report of `reldesign build`;
+//! - `robustness.rs`: the sliding-mode law's supply bound along a reference
+//!   [SM 48–52];
+//! - `monte_carlo.rs`: that bound for a whole design, nominal and over
+//!   parameter bounds;
+//! - `runtime.rs`: a design as the runtime runs it (its `Plan`, `Law`,
+//!   `Surface` traits), for the designer's closed loops.
 
 mod bvp;
 mod decisions;
@@ -24,12 +30,15 @@ mod fit_segments;
 mod lie;
 mod limits;
 mod linearization;
+mod monte_carlo;
 mod optimal;
 mod optimal_guess;
 mod optimal_search;
 mod plan;
 mod reference;
 mod report;
+mod robustness;
+mod runtime;
 mod segments;
 
 pub use bvp::{
@@ -38,6 +47,7 @@ pub use bvp::{
 };
 pub use decisions::{
     gains, triple_pole_settling_product, ControllerDesign, ControllerSpec, DesignedOperation,
+    LawDesign,
 };
 pub use feasibility::{check as check_feasibility, Condition, Feasibility};
 pub use fit_segments::{
@@ -47,10 +57,15 @@ pub use fit_segments::{
 pub use lie::{lie, vanishing_factors, AffineSystem, OutputDerivatives};
 pub use limits::{motion_limits, CostPoint, MotionLimits};
 pub use linearization::{DesignError, Linearization};
+pub use monte_carlo::{Analysis, Draw, MonteCarlo, Nominal, RobustnessError, Variation};
 pub use optimal::{
     energy_optimal, CostateGuess, HamiltonianSystem, OptimalError, OptimalSpec, OptimalTrajectory,
     Switch,
 };
-pub use plan::{design_controller, design_kalman, Design, PlanError};
+pub use plan::{
+    design_controller, design_kalman, design_reference, Design, PlanError, SharedReference,
+};
 pub use reference::{Flat, Polynomial, Reference};
+pub use robustness::{operation_end, ErrorBounds, Evaluator, Robustness, Sample};
+pub use runtime::{RuntimeController, RuntimePlan};
 pub use segments::{Segment, Segments};

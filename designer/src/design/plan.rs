@@ -4,20 +4,27 @@
 //!
 //! description → model → feedback linearization (α, β, T, T⁻¹) → per
 //! operation a reference (polynomial or energy-optimal) → feasibility [PT 54],
-//! [PT 56], [PT 57] → reference table → the decisions of `decisions.rs`; and the
+//! [PT 56], [PT 57] → reference table → (sliding mode: u_max > max u* [SM 48])
+//! → the decisions of `decisions.rs`; and the
 //! discretised model [JA 84–87] of the EKF/UKF. An infeasible design is an
 //! error that says which condition fails, where, and what to try.
 
-use crate::description::{Description, Drive, Estimator, Operation, Shape};
+use crate::description::{
+    Description, Drive, Estimator, Law, Operation, Shape, SlidingSurface, Trajectory,
+};
 use crate::model::Model;
 use crate::observe::discrete::{DiscreteModel, KalmanSettings, ResistanceSettings};
 
-use super::decisions::{gains, ControllerDesign, ControllerSpec, DesignedOperation};
+use super::decisions::{gains, ControllerDesign, ControllerSpec, DesignedOperation, LawDesign};
 use super::feasibility::check as check_feasibility;
 use super::fit_segments::{fit_segments, SegmentTolerance};
 use super::linearization::{DesignError, Linearization};
 use super::optimal::{energy_optimal, OptimalError, OptimalSpec, OptimalTrajectory};
 use super::reference::{Polynomial, Reference};
+use super::robustness::{operation_end, ErrorBounds, Evaluator};
+
+/// Instants of the sliding-mode supply check per operation.
+const ROBUSTNESS_SAMPLES: usize = 4000;
 
 /// Why a description could not be designed (the file name is the caller's).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -71,6 +78,20 @@ pub enum PlanError {
     BadValue { name: String, value: f64 },
     #[error("the reference never needs a positive, finite flux: no guard threshold for φ → 0 can be derived")]
     NoFluxFloor,
+    #[error(
+        "the sliding-mode law cannot track the {operation} reference: it needs \
+         u_max > max u* = {max_u_star:.4} (model-free-sliding-mode (48), worst at t = {:.4} ms \
+         from the operation's start), but supply.u_max = {u_max}; give a longer motion \
+         (trajectory.landing − trajectory.takeoff) or a larger supply.u_max, and see \
+         `reldesign robustness` for the sufficient bound (49)",
+        at * 1e3
+    )]
+    SlidingSupply {
+        operation: &'static str,
+        max_u_star: f64,
+        at: f64,
+        u_max: f64,
+    },
     #[error("internal error: the symbol `{0}` of the linearization is unbound")]
     UnboundSymbol(String),
 }
@@ -138,8 +159,19 @@ pub fn design_controller(
             operation,
         )?);
     }
+    let law = match controller.law {
+        Law::FeedbackLinearization(g) => LawDesign::FeedbackLinearization { gains: gains(&g) },
+        Law::SlidingMode(surface) => {
+            check_sliding_supply(model, &linearization, &operations, &surface, trajectory)?;
+            LawDesign::SlidingMode {
+                lambda1: surface.lambda1,
+                lambda2: surface.lambda2,
+                nonnegative_current: surface.nonnegative_current,
+            }
+        }
+    };
     let spec = ControllerSpec {
-        gains: gains(&controller.gains),
+        law,
         sample_period: controller.sample_period,
         u_min: description.supply.u_min,
         u_max: description.supply.u_max,
@@ -148,6 +180,71 @@ pub fn design_controller(
         creep_speed: controller.creep_speed,
     };
     ControllerDesign::decide(model, linearization, &spec, operations)
+}
+
+/// A reference of `[trajectory]`, shareable across threads.
+pub type SharedReference = Box<dyn Reference + Send + Sync>;
+
+/// The reference of `operation` as `[trajectory]` asks (polynomial or
+/// energy-optimal), not checked for feasibility; the energy-optimal solution
+/// too, where that is the shape.
+pub fn design_reference(
+    description: &Description,
+    model: &mut Model,
+    linearization: &Linearization,
+    operation: Operation,
+) -> Result<(SharedReference, Option<OptimalTrajectory>), PlanError> {
+    let Some(trajectory) = &description.trajectory else {
+        return Err(PlanError::NothingToBuild);
+    };
+    let (bounds, polynomial) = design_bounds(description, trajectory, operation);
+    match trajectory.shape {
+        Shape::Polynomial => Ok((Box::new(polynomial), None)),
+        Shape::EnergyOptimal => {
+            let spec = OptimalSpec {
+                u_max_limit: description.supply.u_max,
+                ..OptimalSpec::new(
+                    polynomial.z0,
+                    polynomial.zf,
+                    trajectory.takeoff,
+                    trajectory.landing,
+                    bounds.0,
+                    bounds.1,
+                )
+            };
+            let solution =
+                energy_optimal(model, linearization, &spec).map_err(|e| PlanError::Optimal {
+                    operation: operation.name(),
+                    message: optimal_message(&e, description),
+                })?;
+            Ok((Box::new(solution.clone()), Some(solution)))
+        }
+    }
+}
+
+/// The input bounds the reference is designed within, and the polynomial
+/// reference of `operation` (the shape's fallback and remedy).
+fn design_bounds(
+    description: &Description,
+    trajectory: &Trajectory,
+    operation: Operation,
+) -> ((f64, f64), Polynomial) {
+    let mech = &description.mechanics;
+    let bounds = (
+        description.supply.u_min.max(-trajectory.u_bound),
+        trajectory.u_bound,
+    );
+    let (z0, zf) = match operation {
+        Operation::Closing => (mech.z_max, mech.z_min),
+        Operation::Opening => (mech.z_min, mech.z_max),
+    };
+    let polynomial = Polynomial {
+        z0,
+        zf,
+        t0: trajectory.takeoff,
+        tf: trajectory.landing,
+    };
+    (bounds, polynomial)
 }
 
 /// One operation of `[trajectory]`: its reference (polynomial or
@@ -161,46 +258,10 @@ fn design_operation(
     let Some(trajectory) = &description.trajectory else {
         return Err(PlanError::NothingToBuild);
     };
-    let mech = &description.mechanics;
-    let bounds = (
-        description.supply.u_min.max(-trajectory.u_bound),
-        trajectory.u_bound,
-    );
-    let (z0, zf) = match operation {
-        Operation::Closing => (mech.z_max, mech.z_min),
-        Operation::Opening => (mech.z_min, mech.z_max),
-    };
     let name = operation.name();
-    let polynomial = Polynomial {
-        z0,
-        zf,
-        t0: trajectory.takeoff,
-        tf: trajectory.landing,
-    };
-    let (reference, optimal): (Box<dyn Reference>, Option<OptimalTrajectory>) = match trajectory
-        .shape
-    {
-        Shape::Polynomial => (Box::new(polynomial), None),
-        Shape::EnergyOptimal => {
-            let spec = OptimalSpec {
-                u_max_limit: description.supply.u_max,
-                ..OptimalSpec::new(
-                    z0,
-                    zf,
-                    trajectory.takeoff,
-                    trajectory.landing,
-                    bounds.0,
-                    bounds.1,
-                )
-            };
-            let solution =
-                energy_optimal(model, linearization, &spec).map_err(|e| PlanError::Optimal {
-                    operation: name,
-                    message: optimal_message(&e, description),
-                })?;
-            (Box::new(solution.clone()), Some(solution))
-        }
-    };
+    let (bounds, polynomial) = design_bounds(description, trajectory, operation);
+    let (z0, zf) = (polynomial.z0, polynomial.zf);
+    let (reference, optimal) = design_reference(description, model, linearization, operation)?;
     let feasibility = check_feasibility(model, linearization, reference.as_ref(), bounds, 4000);
     if !feasibility.is_feasible() {
         let mut report = feasibility.report();
@@ -233,6 +294,41 @@ fn design_operation(
         table: fit.table,
         optimal,
     })
+}
+
+/// The sliding-mode law's necessary condition u_max > max u* [SM 48] along
+/// each designed reference (the tables the emitted code tracks).
+fn check_sliding_supply(
+    model: &Model,
+    lin: &Linearization,
+    operations: &[DesignedOperation],
+    surface: &SlidingSurface,
+    trajectory: &Trajectory,
+) -> Result<(), PlanError> {
+    let evaluator = Evaluator::new(model, lin);
+    let params = evaluator.values(model).map_err(PlanError::UnboundSymbol)?;
+    let u_max = model.description.supply.u_max;
+    let t_end = operation_end(trajectory.takeoff, trajectory.landing);
+    for op in operations {
+        let r = evaluator.analyse(
+            &op.table,
+            t_end,
+            ROBUSTNESS_SAMPLES,
+            surface,
+            &ErrorBounds::default(),
+            &params,
+        );
+        if r.feasible && u_max > r.max_u_star {
+            continue;
+        }
+        return Err(PlanError::SlidingSupply {
+            operation: op.operation.name(),
+            max_u_star: r.max_u_star,
+            at: r.max_u_star_t,
+            u_max,
+        });
+    }
+    Ok(())
 }
 
 /// `[observer.kalman]` → the discretised model [JA 84–87] of the EKF/UKF.

@@ -6,6 +6,7 @@ use std::fmt::Write as _;
 
 use crate::description::Estimator;
 
+use super::decisions::LawDesign;
 use super::optimal::OptimalTrajectory;
 use super::plan::Design;
 
@@ -14,11 +15,7 @@ impl Design {
     pub fn report(&self) -> String {
         let mut s = String::new();
         if let Some(c) = &self.controller {
-            let _ = writeln!(
-                s,
-                "gains K = [{:e}, {:e}, {:e}] (eq. 48)",
-                c.gains[0], c.gains[1], c.gains[2]
-            );
+            let _ = writeln!(s, "{}", law_text(&c.law));
             let _ = writeln!(s, "{}", c.linearization.singularity_text(&self.model.graph));
             for o in &c.operations {
                 let _ = writeln!(s, "\n{} ({:e} m → {:e} m):", o.operation.name(), o.z0, o.zf);
@@ -92,4 +89,27 @@ fn rest_text(opt: &OptimalTrajectory) -> Option<String> {
         (tb - ta) * 1e3,
         opt.rest_cost,
     ))
+}
+
+/// The law's line of the report.
+fn law_text(law: &LawDesign) -> String {
+    match *law {
+        LawDesign::FeedbackLinearization {
+            gains: [k1, k2, k3],
+        } => {
+            format!("feedback linearization: gains K = [{k1:e}, {k2:e}, {k3:e}] [PT 48]")
+        }
+        LawDesign::SlidingMode {
+            lambda1,
+            lambda2,
+            nonnegative_current,
+        } => format!(
+            "sliding mode (model-free): λ₁ = {lambda1:e} s⁻¹, λ₂ = {lambda2:e} s⁻¹ [SM 17]{}",
+            if nonnegative_current {
+                ", the current kept ≥ 0 [SM §5]"
+            } else {
+                ""
+            }
+        ),
+    }
 }

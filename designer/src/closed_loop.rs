@@ -1,0 +1,508 @@
+//! The designed controller in a sampled loop on a plant: the library call
+//! behind `reldesign loop` (and `sweep`).
+//!
+//! The controller is the runtime's own operation logic on the run-time
+//! design (`design::RuntimePlan`), called every sample period with the
+//! plant's state, its output held until the next sample (zero-order hold,
+//! `sim::simulate_sampled`). The plant is the hybrid model of a description:
+//! the design's own or another one (a mismatched device). The operations of
+//! `[trajectory]` run one after the other, each for takeoff + landing
+//! (model-free-sliding-mode [SM 45]: as long a rest after landing as before
+//! takeoff); the loop starts at rest at the first operation's z₀: at z_max
+//! without flux, or held at z_min with 1.2× the flux that balances the spring.
+//! Where `[controller] estimator` names an observer, it drives the controller
+//! from the measured voltage and current, with the noise of `[observer]`
+//! (seeded); otherwise the controller reads the plant's state.
+
+use crate::description::{Description, Operation};
+use crate::design::{operation_end, Design, RuntimeController, RuntimePlan};
+use crate::model::{Model, ModelPlant, Statics};
+use crate::observe::discrete::Estimate;
+use crate::observe::ekf::Ekf;
+use crate::observe::ukf::Ukf;
+use crate::random::SplitMix64;
+use crate::sim::{
+    simulate, simulate_sampled, EventKind, Limit, Measurement, Mode, Options, PiecewiseLinear,
+    Plant, SimError, State, Trajectory,
+};
+
+/// Why a loop could not run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LoopError {
+    #[error("the description designs no controller: add [trajectory] and [controller]")]
+    NoController,
+    #[error("the plant's state has {plant} entries, the design's {design}: a Jiles–Atherton plant needs a Jiles–Atherton design")]
+    PlantMismatch { plant: usize, design: usize },
+    #[error("the design at T_s = {sample_period:e} s: {message}")]
+    Design { sample_period: f64, message: String },
+    #[error("the loop's observer: {0}")]
+    Observer(String),
+    #[error("the switching input: {0}")]
+    Input(String),
+    #[error("the loop's simulation failed: {0}")]
+    Sim(#[from] SimError),
+}
+
+/// One closed-loop run.
+#[derive(Debug, Clone)]
+pub struct LoopRun {
+    /// At every sample: time, held input, state, mode.
+    pub trajectory: Trajectory,
+    /// The coil current at every sample.
+    pub current: Vec<f64>,
+    /// The reference position at every sample.
+    pub z_ref: Vec<f64>,
+    /// Each operation and its start time [s].
+    pub operations: Vec<(Operation, f64)>,
+    /// The length of one operation [s].
+    pub operation_length: f64,
+    /// The observer's estimate at every sample, where one drives the controller.
+    pub estimates: Option<Vec<Estimate>>,
+}
+
+/// The observer that drives the controller from the measured voltage and
+/// current (`[controller] estimator`), with the seeded measurement noise of
+/// `[observer]`.
+struct Observer {
+    filter: Filter,
+    noise: SplitMix64,
+    sigma_v: f64,
+    sigma_i: f64,
+    /// The voltage applied over the last sample period.
+    held: f64,
+}
+
+enum Filter {
+    Ekf(Box<Ekf>),
+    Ukf(Box<Ukf>),
+}
+
+impl Observer {
+    /// The estimate after measuring the current `i` now (the voltage held
+    /// over the last sample), and the measured current.
+    fn step(&mut self, i: f64) -> (Estimate, f64) {
+        let u = self.held + self.sigma_v * self.noise.normal();
+        let i = i + self.sigma_i * self.noise.normal();
+        let e = match &mut self.filter {
+            Filter::Ekf(f) => f.step(u, i),
+            Filter::Ukf(f) => f.step(u, i),
+        };
+        (e, i)
+    }
+}
+
+/// The controller and where the loop stands.
+struct Sequencer<'a> {
+    plan: Vec<RuntimeController<'a>>,
+    operations: Vec<(Operation, f64)>,
+    current: usize,
+    plant: &'a ModelPlant,
+    nonnegative_current: bool,
+    observer: Option<Observer>,
+    z_ref: Vec<(f64, f64)>,
+    estimates: Vec<(f64, Estimate)>,
+}
+
+impl Sequencer<'_> {
+    /// The input at the sample `m`: the operation it falls in, its controller.
+    fn control(&mut self, m: &Measurement) -> f64 {
+        let next = self
+            .operations
+            .iter()
+            .rposition(|(_, start)| *start <= m.t)
+            .unwrap_or(0);
+        if next != self.current {
+            self.current = next;
+            if let (Some(c), Some((_, start))) =
+                (self.plan.get_mut(next), self.operations.get(next))
+            {
+                c.start(*start);
+            }
+        }
+        let Some(c) = self.plan.get_mut(self.current) else {
+            return 0.0;
+        };
+        let x = &m.x;
+        let [z, v, a, phi] = match &mut self.observer {
+            Some(o) => {
+                // the ADC samples i just before the new voltage is applied
+                let (i, _) = self.plant.current_and_voltage(m.t, x, o.held);
+                let (e, i) = o.step(i);
+                self.estimates.push((m.t, e));
+                [
+                    e.z,
+                    e.v,
+                    e.a,
+                    if self.nonnegative_current { i } else { e.phi },
+                ]
+            }
+            None => {
+                let mut dx: State = [0.0; crate::sim::MAX_DIM];
+                self.plant.deriv(m.t, x, 0.0, &mut dx);
+                // a: the free-motion acceleration, 0 against a stop
+                let a = if m.mode == Mode::Free { dx[1] } else { 0.0 };
+                let phi = if self.nonnegative_current {
+                    self.plant.current_and_voltage(m.t, x, 0.0).0
+                } else {
+                    x[2]
+                };
+                [x[0], x[1], a, phi]
+            }
+        };
+        self.z_ref.push((m.t, c.reference(m.t)[0]));
+        let u = c.step(m.t, z, v, a, phi);
+        if let Some(o) = &mut self.observer {
+            o.held = u;
+        }
+        u
+    }
+}
+
+/// Runs `design`'s controller at `sample_period` for `duration` (default: every
+/// operation once) on the model of `plant` (default: the design's own); where
+/// `[controller] estimator` names one, its observer drives the controller from
+/// the voltage and current measured with the noise of `[observer]` (seeded by
+/// `seed`).
+pub fn run_loop(
+    design: &Design,
+    plant: Option<&Description>,
+    sample_period: f64,
+    duration: Option<f64>,
+    seed: u64,
+    options: &Options,
+) -> Result<LoopRun, LoopError> {
+    let (Some(c), Some(t)) = (&design.controller, &design.description.trajectory) else {
+        return Err(LoopError::NoController);
+    };
+    let plant_description = plant.unwrap_or(&design.description);
+    let mut plant_model = Model::build(plant_description);
+    if plant_model.dim() != design.model.dim() {
+        return Err(LoopError::PlantMismatch {
+            plant: plant_model.dim(),
+            design: design.model.dim(),
+        });
+    }
+    let model_plant = ModelPlant::new(&mut plant_model);
+    let length = operation_end(t.takeoff, t.landing);
+    let operations: Vec<(Operation, f64)> = t
+        .operations
+        .iter()
+        .enumerate()
+        .map(|(k, &op)| (op, k as f64 * length))
+        .collect();
+    let mut design_model = design.model.clone();
+    let controllers = operations
+        .iter()
+        .map(|&(op, _)| RuntimePlan::new(&mut design_model, c).controller(op))
+        .collect();
+    let nonnegative_current = matches!(
+        c.law,
+        crate::design::LawDesign::SlidingMode {
+            nonnegative_current: true,
+            ..
+        }
+    );
+    let mut sequencer = Sequencer {
+        plan: controllers,
+        operations: operations.clone(),
+        current: 0,
+        plant: &model_plant,
+        nonnegative_current,
+        observer: observer(design, sample_period, seed)?,
+        z_ref: Vec::new(),
+        estimates: Vec::new(),
+    };
+    let (x0, mode0) = start_state(&mut plant_model, operations.first().map(|o| o.0));
+    let t_end = duration.unwrap_or(length * operations.len() as f64);
+    let mut control = |_t: f64, m: &Measurement| sequencer.control(m);
+    let trajectory = simulate_sampled(
+        &model_plant,
+        &mut control,
+        sample_period,
+        t_end,
+        x0,
+        mode0,
+        options,
+    )?;
+    let (current, _) =
+        model_plant.currents_and_voltages(&trajectory.t, &trajectory.x, &trajectory.u);
+    let z_ref = trajectory
+        .t
+        .iter()
+        .map(|t| {
+            sequencer
+                .z_ref
+                .iter()
+                .rev()
+                .find(|(ts, _)| ts <= t)
+                .map_or(f64::NAN, |(_, z)| *z)
+        })
+        .collect();
+    let estimates = sequencer.observer.is_some().then(|| {
+        trajectory
+            .t
+            .iter()
+            .map(|t| {
+                sequencer
+                    .estimates
+                    .iter()
+                    .rev()
+                    .find(|(ts, _)| ts <= t)
+                    .map_or(NO_ESTIMATE, |(_, e)| *e)
+            })
+            .collect()
+    });
+    Ok(LoopRun {
+        trajectory,
+        current,
+        z_ref,
+        operations,
+        operation_length: length,
+        estimates,
+    })
+}
+
+/// Before the first sample.
+const NO_ESTIMATE: Estimate = Estimate {
+    z: f64::NAN,
+    v: f64::NAN,
+    a: f64::NAN,
+    phi: f64::NAN,
+    hc: None,
+    r: None,
+    mode: Mode::Free,
+};
+
+/// The observer `[controller] estimator` names, at the loop's sample period.
+fn observer(design: &Design, sample_period: f64, seed: u64) -> Result<Option<Observer>, LoopError> {
+    let d = &design.description;
+    let Some(wanted) = d.controller.as_ref().and_then(|c| c.estimator) else {
+        return Ok(None);
+    };
+    let (Some(o), Some(discrete)) = (&d.observer, &design.kalman) else {
+        return Err(LoopError::Observer(
+            "controller.estimator needs [observer] with [observer.kalman]".into(),
+        ));
+    };
+    if (o.sample_period - sample_period).abs() > 1e-12 * sample_period {
+        return Err(LoopError::Observer(format!(
+            "the observer runs every observer.sample_period = {:e} s, the loop every {sample_period:e} s: \
+             they must be equal (`sweep` sets both)",
+            o.sample_period
+        )));
+    }
+    let filter = match wanted {
+        crate::description::Estimator::Ekf => Filter::Ekf(Box::new(Ekf::new(discrete))),
+        _ => Filter::Ukf(Box::new(Ukf::new(discrete))),
+    };
+    Ok(Some(Observer {
+        filter,
+        noise: SplitMix64::new(seed),
+        sigma_v: o.voltage_noise,
+        sigma_i: o.current_noise,
+        held: 0.0,
+    }))
+}
+
+/// At rest at the first operation's z₀: z_max without flux, or z_min held by
+/// 1.2× the flux that balances the passive force there.
+fn start_state(model: &mut Model, first: Option<Operation>) -> (State, Mode) {
+    let mut x0: State = [0.0; crate::sim::MAX_DIM];
+    let (z_min, z_max) = (
+        model.description.mechanics.z_min,
+        model.description.mechanics.z_max,
+    );
+    match first {
+        Some(Operation::Opening) => {
+            let balance = Statics::of(model).drop_out.map_or(0.0, |p| p.flux);
+            x0[0] = z_min;
+            x0[2] = 1.2 * balance;
+            (x0, Mode::StuckMin)
+        }
+        _ => {
+            x0[0] = z_max;
+            (x0, Mode::StuckMax)
+        }
+    }
+}
+
+/// What one operation of a loop did, in the figures of the papers' sampling
+/// studies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OperationOutcome {
+    pub operation: Operation,
+    /// The velocity [m/s] of the first impact at the operation's end stop
+    /// after its takeoff (signed); `None`: it never got there in time.
+    pub impact_velocity: Option<f64>,
+    /// perfect-tracking-soft-landing [PT 69] (with the errata's square root):
+    /// the RMS of z − z_r over the samples of the motion [t₀, t_f].
+    pub rmse_z: f64,
+    /// Impacts at the end stop within the operation that bounced.
+    pub bounces: usize,
+}
+
+impl LoopRun {
+    /// The outcome of each operation, with `takeoff` and `landing` of `[trajectory]`.
+    pub fn outcomes(&self, takeoff: f64, landing: f64) -> Vec<OperationOutcome> {
+        self.operations
+            .iter()
+            .map(|&(operation, start)| {
+                let end = start + self.operation_length;
+                let (impact_velocity, bounces) =
+                    impacts(&self.trajectory, operation, start + takeoff, end);
+                let tr = &self.trajectory;
+                let (mut sum, mut n) = (0.0, 0usize);
+                for ((t, x), zr) in tr.t.iter().zip(&tr.x).zip(&self.z_ref) {
+                    if (start + takeoff..=start + landing).contains(t) {
+                        sum += (x[0] - zr).powi(2);
+                        n += 1;
+                    }
+                }
+                OperationOutcome {
+                    operation,
+                    impact_velocity,
+                    rmse_z: (sum / n.max(1) as f64).sqrt(),
+                    bounces,
+                }
+            })
+            .collect()
+    }
+}
+
+/// The first impact's velocity at `operation`'s end stop in (from, to], and
+/// the number of bouncing impacts there.
+fn impacts(tr: &Trajectory, operation: Operation, from: f64, to: f64) -> (Option<f64>, usize) {
+    let destination = match operation {
+        Operation::Closing => Limit::Min,
+        Operation::Opening => Limit::Max,
+    };
+    let mut first = None;
+    let mut bounces = 0;
+    for e in &tr.events {
+        if let EventKind::Impact {
+            limit,
+            v_before,
+            v_after,
+            ..
+        } = e.kind
+        {
+            if limit == destination && e.t > from && e.t <= to {
+                first = first.or(Some(v_before));
+                bounces += usize::from(v_after != 0.0);
+            }
+        }
+    }
+    (first, bounces)
+}
+
+/// The uncontrolled switching the papers compare with: u_max over each
+/// closing operation, 0 over each opening one, on the plant (default: the
+/// design's own), from the loop's start state. The first impact of each
+/// within its window; the last window is open-ended (up to
+/// `BASELINE_TAIL` operation lengths), since a coil left at 0 V may release
+/// long after the motion time the design was given.
+pub fn switching_baseline(
+    design: &Design,
+    plant: Option<&Description>,
+    options: &Options,
+) -> Result<Vec<(Operation, Option<f64>)>, LoopError> {
+    let Some(t) = &design.description.trajectory else {
+        return Err(LoopError::NoController);
+    };
+    let plant_description = plant.unwrap_or(&design.description);
+    let mut model = Model::build(plant_description);
+    let length = operation_end(t.takeoff, t.landing);
+    let u_max = design.description.supply.u_max;
+    let (mut times, mut values) = (Vec::new(), Vec::new());
+    for (k, op) in t.operations.iter().enumerate() {
+        let u = match op {
+            Operation::Closing => u_max,
+            Operation::Opening => 0.0,
+        };
+        times.extend([k as f64 * length, (k + 1) as f64 * length]);
+        values.extend([u, u]);
+    }
+    let input = PiecewiseLinear::new(times, values).map_err(|e| LoopError::Input(e.to_string()))?;
+    let (x0, mode0) = start_state(&mut model, t.operations.first().copied());
+    let plant = ModelPlant::new(&mut model);
+    let n = t.operations.len();
+    let end = length * (n as f64 - 1.0 + BASELINE_TAIL);
+    let tr = simulate(&plant, &input, x0, mode0, &[0.0, end], options)?;
+    Ok(t.operations
+        .iter()
+        .enumerate()
+        .map(|(k, &op)| {
+            let start = k as f64 * length;
+            let to = if k + 1 == n { end } else { start + length };
+            (op, impacts(&tr, op, start, to).0)
+        })
+        .collect())
+}
+
+/// A sample period the description's motion allows: the motion [t₀, t_f]
+/// spans at least 10 of them (the parser's rule for `controller.sample_period`).
+pub fn check_sample_period(description: &Description, ts: f64) -> Result<(), LoopError> {
+    let Some(t) = &description.trajectory else {
+        return Err(LoopError::NoController);
+    };
+    let limit = (t.landing - t.takeoff) / 10.0;
+    if ts.is_finite() && ts > 0.0 && ts <= limit {
+        Ok(())
+    } else {
+        Err(LoopError::Design {
+            sample_period: ts,
+            message: format!(
+                "a sample period must be > 0 and at most (trajectory.landing − trajectory.takeoff)/10 \
+                 = {limit:e} s: the motion must span at least 10 samples"
+            ),
+        })
+    }
+}
+
+/// The last operation of the switching baseline runs for this many operation
+/// lengths.
+const BASELINE_TAIL: f64 = 10.0;
+
+/// One row of a sampling-period sweep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepRow {
+    pub sample_period: f64,
+    pub outcomes: Vec<OperationOutcome>,
+}
+
+/// The description's design redone at each sample period (controller, and
+/// the observer's period with it), each in closed loop on the plant; rows in
+/// the order of `periods` (run in parallel).
+pub fn sweep(
+    description: &Description,
+    plant: Option<&Description>,
+    periods: &[f64],
+    options: &Options,
+) -> Result<Vec<SweepRow>, LoopError> {
+    use rayon::prelude::*;
+    let Some(t) = &description.trajectory else {
+        return Err(LoopError::NoController);
+    };
+    periods
+        .par_iter()
+        .map(|&ts| {
+            check_sample_period(description, ts)?;
+            let mut d = description.clone();
+            if let Some(c) = &mut d.controller {
+                c.sample_period = ts;
+            }
+            if let Some(o) = &mut d.observer {
+                o.sample_period = ts;
+            }
+            let design = Design::new(&d).map_err(|e| LoopError::Design {
+                sample_period: ts,
+                message: e.to_string(),
+            })?;
+            let run = run_loop(&design, plant, ts, None, 0, options)?;
+            Ok(SweepRow {
+                sample_period: ts,
+                outcomes: run.outcomes(t.takeoff, t.landing),
+            })
+        })
+        .collect()
+}
