@@ -6,6 +6,7 @@
 mod atomic;
 mod build;
 mod check;
+mod closed_loop;
 mod diagnose;
 mod diagnose_plot;
 mod eval;
@@ -13,7 +14,9 @@ mod fit;
 mod limits;
 mod observe;
 mod plot;
+mod robustness;
 mod simulate;
+mod sweep;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -58,6 +61,12 @@ enum Command {
     Diagnose(diagnose::Args),
     /// The device's limits: shortest energy-optimal motion per operation, its peak current and flux, J against the motion time.
     Limits(limits::Args),
+    /// Run the designed controller in a sampled loop on the hybrid model (of the description or of --plant).
+    Loop(closed_loop::Args),
+    /// Closed loops of the design at several sample periods, against the uncontrolled switching.
+    Sweep(sweep::Args),
+    /// The sliding-mode law's supply bound along the design's references, and its Monte-Carlo worst case over parameter bounds.
+    Robustness(robustness::Args),
 }
 
 fn main() -> ExitCode {
@@ -76,6 +85,9 @@ fn main() -> ExitCode {
         Command::Fit(args) => fit::run(&args),
         Command::Diagnose(args) => diagnose::run(&args),
         Command::Limits(args) => limits::run(&args),
+        Command::Robustness(args) => robustness::run(&args),
+        Command::Loop(args) => closed_loop::run(&args),
+        Command::Sweep(args) => sweep::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

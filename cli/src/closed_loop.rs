@@ -1,0 +1,249 @@
+//! `reldesign loop MODEL.toml --out OUT.csv [--plant PLANT.toml] [--sample-period S]
+//! [--duration S] [--plot FILE.svg]`: the designed controller (whichever law) in a
+//! sampled loop with zero-order hold on the hybrid model of the plant, the
+//! operations of `[trajectory]` one after the other. Writes
+//! `t,u,i,z,vz,phi[,Hc],mode,z_ref` at each sample, plus
+//! `z_hat,v_hat,phi_hat[,Hc_hat]` where `[controller] estimator` names the
+//! observer that drives the controller, and prints, per operation, the first
+//! impact, RMSE_z during the motion and the bounces.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use designer::closed_loop::{check_sample_period, run_loop, LoopRun, OperationOutcome};
+use designer::design::Design;
+use designer::sim::Options;
+use miette::Report;
+use plotters::prelude::*;
+
+use crate::{atomic, fail};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The actuator description, with [trajectory] and [controller]
+    model: PathBuf,
+    /// Output CSV (written atomically)
+    #[arg(long)]
+    out: PathBuf,
+    /// The plant's description (default: MODEL itself): a device other than the design's
+    #[arg(long)]
+    plant: Option<PathBuf>,
+    /// Sample period T_s [s] (default: controller.sample_period)
+    #[arg(long, allow_hyphen_values = true)]
+    sample_period: Option<f64>,
+    /// Simulated time [s] (default: every operation once, takeoff + landing each)
+    #[arg(long, allow_hyphen_values = true)]
+    duration: Option<f64>,
+    /// Also draw position and reference, input and current to this SVG file
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// Seed of the measurement noise, where an observer drives the controller
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+pub fn run(args: &Args) -> Result<(), Report> {
+    let description = crate::load(&args.model)?;
+    let file = args.model.display().to_string();
+    let plant = args.plant.as_deref().map(crate::load).transpose()?;
+    let Some(controller) = &description.controller else {
+        return Err(fail(format!(
+            "{file}: `loop` runs the designed controller: the description needs [trajectory] and [controller]"
+        )));
+    };
+    let ts = positive("--sample-period", args.sample_period)?.unwrap_or(controller.sample_period);
+    let duration = positive("--duration", args.duration)?;
+    check_sample_period(&description, ts).map_err(|e| fail(format!("{file}: {e}")))?;
+    let mut designed = description.clone();
+    if let Some(c) = &mut designed.controller {
+        c.sample_period = ts;
+    }
+    if let (Some(o), Some(_)) = (&mut designed.observer, args.sample_period) {
+        o.sample_period = ts;
+    }
+    let design = Design::new(&designed).map_err(|e| fail(format!("{file}: {e}")))?;
+    let run = run_loop(
+        &design,
+        plant.as_ref(),
+        ts,
+        duration,
+        args.seed,
+        &Options::default(),
+    )
+    .map_err(|e| fail(format!("{file}: {e}")))?;
+    let csv = to_csv(&run, design.model.dim() > 3);
+    let svg = match &args.plot {
+        Some(_) => Some(plot(&run, &description.name, ts).map_err(fail)?),
+        None => None,
+    };
+    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(args.out.as_path(), csv.as_bytes())];
+    if let (Some(path), Some(svg)) = (&args.plot, &svg) {
+        files.push((path.as_path(), svg.as_bytes()));
+    }
+    atomic::write_all(&files).map_err(fail)?;
+    let t = description
+        .trajectory
+        .as_ref()
+        .map_or((0.0, 0.0), |t| (t.takeoff, t.landing));
+    print!(
+        "{}",
+        summary(&run.outcomes(t.0, t.1), controller.law.name(), ts)
+    );
+    Ok(())
+}
+
+/// `Some(x)` must be positive and finite.
+pub fn positive(name: &str, x: Option<f64>) -> Result<Option<f64>, Report> {
+    match x {
+        Some(v) if !(v.is_finite() && v > 0.0) => Err(fail(format!(
+            "{name}: expected a positive number of seconds, found {v}"
+        ))),
+        other => Ok(other),
+    }
+}
+
+fn summary(outcomes: &[OperationOutcome], law: &str, ts: f64) -> String {
+    let mut s = format!("{law} at T_s = {ts:e} s\n");
+    for o in outcomes {
+        let impact = o
+            .impact_velocity
+            .map_or("never reached the stop".to_string(), |v| {
+                format!("{v:+.4e} m/s")
+            });
+        let _ = writeln!(
+            s,
+            "  {:<8} first impact {impact}, RMSE_z {:.3e} m during the motion, {} bounce(s)",
+            o.operation.name(),
+            o.rmse_z,
+            o.bounces
+        );
+    }
+    s
+}
+
+fn to_csv(run: &LoopRun, with_field: bool) -> String {
+    let tr = &run.trajectory;
+    let mut s = String::from(if with_field {
+        "t,u,i,z,vz,phi,Hc,mode,z_ref"
+    } else {
+        "t,u,i,z,vz,phi,mode,z_ref"
+    });
+    if run.estimates.is_some() {
+        s.push_str(if with_field {
+            ",z_hat,v_hat,phi_hat,Hc_hat"
+        } else {
+            ",z_hat,v_hat,phi_hat"
+        });
+    }
+    s.push('\n');
+    for k in 0..tr.t.len() {
+        let x = &tr.x[k];
+        let _ = write!(
+            s,
+            "{:?},{:?},{:?},{:?},{:?},{:?}",
+            tr.t[k], tr.u[k], run.current[k], x[0], x[1], x[2]
+        );
+        if with_field {
+            let _ = write!(s, ",{:?}", x[3]);
+        }
+        let _ = write!(s, ",{},{:?}", tr.mode[k].number(), run.z_ref[k]);
+        if let Some(e) = run.estimates.as_ref().and_then(|e| e.get(k)) {
+            let _ = write!(s, ",{:?},{:?},{:?}", e.z, e.v, e.phi);
+            if with_field {
+                let _ = write!(s, ",{:?}", e.hc.unwrap_or(f64::NAN));
+            }
+        }
+        s.push('\n');
+    }
+    s
+}
+
+fn plot(run: &LoopRun, name: &str, ts: f64) -> Result<String, String> {
+    let mut out = String::new();
+    {
+        let e = |e: plotters::drawing::DrawingAreaErrorKind<std::io::Error>| e.to_string();
+        let root = SVGBackend::with_string(&mut out, (900, 800)).into_drawing_area();
+        root.fill(&WHITE).map_err(e)?;
+        let root = root
+            .titled(
+                &format!("{name}: closed loop at T_s = {ts:e} s"),
+                ("sans-serif", 22),
+            )
+            .map_err(e)?;
+        let panels = root.split_evenly((3, 1));
+        let tr = &run.trajectory;
+        let t: Vec<f64> = tr.t.iter().map(|t| t * 1e3).collect();
+        let z: Vec<f64> = tr.x.iter().map(|x| x[0] * 1e3).collect();
+        let zr: Vec<f64> = run.z_ref.iter().map(|z| z * 1e3).collect();
+        let series: [(&str, Vec<(&[f64], RGBColor, &str)>); 3] = [
+            ("position [mm]", vec![(&zr, RED, "z_ref"), (&z, BLACK, "z")]),
+            ("input u", vec![(&tr.u, BLUE, "u")]),
+            ("current i [A]", vec![(&run.current, GREEN, "i")]),
+        ];
+        for (panel, (label, lines)) in panels.iter().zip(series) {
+            draw(panel, &t, &lines, label)?;
+        }
+        root.present().map_err(e)?;
+    }
+    Ok(out)
+}
+
+fn draw(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    t: &[f64],
+    lines: &[(&[f64], RGBColor, &str)],
+    label: &str,
+) -> Result<(), String> {
+    let e = |e: plotters::drawing::DrawingAreaErrorKind<std::io::Error>| e.to_string();
+    let (t0, t1) = (
+        t.first().copied().unwrap_or(0.0),
+        t.last().copied().unwrap_or(1.0),
+    );
+    let finite = lines
+        .iter()
+        .flat_map(|(y, _, _)| y.iter())
+        .filter(|v| v.is_finite());
+    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+        (a.min(v), b.max(v))
+    });
+    let (lo, hi) = if lo < hi {
+        (lo, hi)
+    } else {
+        (lo - 1.0, lo + 1.0)
+    };
+    let pad = 0.05 * (hi - lo);
+    let mut chart = ChartBuilder::on(area)
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(70)
+        .build_cartesian_2d(t0..t1.max(t0 + 1e-9), (lo - pad)..(hi + pad))
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc("t [ms]")
+        .y_desc(label)
+        .draw()
+        .map_err(e)?;
+    for &(y, color, name) in lines {
+        chart
+            .draw_series(LineSeries::new(
+                t.iter()
+                    .zip(y.iter())
+                    .filter(|(_, v)| v.is_finite())
+                    .map(|(&a, &b)| (a, b)),
+                color.stroke_width(2),
+            ))
+            .map_err(e)?
+            .label(name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+    }
+    if lines.len() > 1 {
+        chart
+            .configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.8))
+            .draw()
+            .map_err(e)?;
+    }
+    Ok(())
+}
