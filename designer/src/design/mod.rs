@@ -5,7 +5,7 @@
 //!   the jerk terms;
 //! - `reference.rs`: soft-landing position references (polynomial);
 //! - `feasibility.rs`: conditions [PT 54], [PT 56], [PT 57] along a reference;
-//! - `bvp.rs`: a collocation two-point BVP solver (generic);
+//! - `bvp.rs` (and `bvp/`): a collocation two-point BVP solver (generic);
 //! - `optimal.rs`: the energy-optimal reference (Pontryagin, [PT 58–66]);
 //! - `optimal_guess.rs`: rest states and the polynomial initial guess of an arc;
 //! - `optimal_search.rs`: rest, move, rest: the optimum within the stroke [PT 57];

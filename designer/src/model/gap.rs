@@ -19,7 +19,7 @@
 //! collocation solvers then fail to converge.
 
 use crate::description::Gap;
-use crate::sym::{Graph, Id};
+use crate::sym::{Graph, Id, E};
 
 use super::params::Params;
 use super::table::Spline;
@@ -40,8 +40,10 @@ pub fn reluctance(g: &mut Graph, params: &mut Params, gap: &Gap, z: Id, names: &
         Gap::Linear { slope, offset } => {
             let k = params.key(g, "gap.slope", *slope);
             let r0 = params.key(g, "gap.offset", *offset);
-            let kz = g.mul(k, z);
-            g.add(r0, kz)
+            g.with(|s| {
+                let [k, r0, z] = s.exprs([k, r0, z]);
+                (r0 + k * z).id()
+            })
         }
         Gap::McLyman {
             area,
@@ -58,12 +60,10 @@ pub fn reluctance(g: &mut Graph, params: &mut Params, gap: &Gap, z: Id, names: &
 }
 
 /// ln(k / (z + Z_EPS)): the regularised McLyman logarithm.
-fn fringing_log(g: &mut Graph, k: Id, z: Id, names: &mut Names) -> Id {
-    let eps = g.constant(Z_EPS);
-    let ze = g.add(z, eps);
-    let q = g.div(k, ze);
-    let log = g.ln(q);
-    names.extend([("z_reg", ze), ("fringe_log", log)]);
+fn fringing_log<'s>(k: E<'s>, z: E<'s>, names: &mut Names) -> E<'s> {
+    let z_reg = z + Z_EPS;
+    let log = (k / z_reg).ln();
+    names.extend([("z_reg", z_reg.id()), ("fringe_log", log.id())]);
     log
 }
 
@@ -78,19 +78,15 @@ fn mclyman(
 ) -> Id {
     let a = params.key(g, "gap.area", area);
     let lw = params.key(g, "gap.winding_length", winding_length);
-    let mu0 = g.constant(MU0);
-    let two = g.constant(2.0);
-    let two_lw = g.mul(two, lw);
-    let log = fringing_log(g, two_lw, z, names);
-    let sqrt_a = g.sqrt(a);
-    let ratio = g.div(z, sqrt_a);
-    let fringe = g.mul(ratio, log);
-    let one = g.one();
-    let den = g.add(one, fringe);
-    names.push(("fringe_den", den));
-    let mu0_a = g.mul(mu0, a);
-    let num = g.div(z, mu0_a);
-    g.div(num, den)
+    g.with(|s| {
+        let [a, lw, z] = s.exprs([a, lw, z]);
+        // μ0 made first: a node's place in the graph orders the generated code
+        let mu0 = s.constant(MU0);
+        let log = fringing_log(2.0 * lw, z, names);
+        let den = 1.0 + z / a.sqrt() * log;
+        names.push(("fringe_den", den.id()));
+        (z / (mu0 * a) / den).id()
+    })
 }
 
 /// jiles-atherton-actuator-model [JA 11]: R_gap = R_g0 + R'_g0·z / (1 + k1·z·ln(k2/z)).
@@ -105,13 +101,11 @@ fn mclyman_fit(
     let r0p = params.key(g, "gap.r0_prime", r0p);
     let k1 = params.key(g, "gap.k1", k1);
     let k2 = params.key(g, "gap.k2", k2);
-    let log = fringing_log(g, k2, z, names);
-    let k1z = g.mul(k1, z);
-    let fringe = g.mul(k1z, log);
-    let one = g.one();
-    let den = g.add(one, fringe);
-    names.push(("fringe_den", den));
-    let num = g.mul(r0p, z);
-    let frac = g.div(num, den);
-    g.add(r0, frac)
+    g.with(|s| {
+        let [r0, r0p, k1, k2, z] = s.exprs([r0, r0p, k1, k2, z]);
+        let log = fringing_log(k2, z, names);
+        let den = 1.0 + k1 * z * log;
+        names.push(("fringe_den", den.id()));
+        (r0 + r0p * z / den).id()
+    })
 }
