@@ -234,6 +234,23 @@ mod tests {
         assert!(text.contains(&include), "{text}");
     }
 
+    /// The sliding-mode law goes the same way in: its module, the runtime's
+    /// `sliding::SlidingMode` as `Controller`.
+    #[test]
+    fn expands_the_sliding_mode_example() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let out = expand(quote!("../examples/sliding-mode-valve.toml"), Some(dir));
+        assert!(error_of(&out).is_none(), "{out}");
+        let text = out.to_string();
+        assert!(text.contains("pub mod sliding_mode_valve {"), "{text}");
+        for item in [
+            "pub const LAMBDA1",
+            "sliding :: SlidingMode < Design , f32 >",
+        ] {
+            assert!(text.contains(item), "{item} missing from {text}");
+        }
+    }
+
     #[test]
     fn a_missing_file_names_the_resolved_path() {
         let out = expand(
