@@ -231,7 +231,7 @@ fn emitted_estimators_compile_pass_clippy_and_match_the_reference() {
     krate.write("src/main.rs", &main);
 
     krate.clippy_panic_free();
-    // the algorithms: the runtime's modules deny the same lints (their `#![deny]`)
+    // the algorithms: the runtime crate denies the same lints (`#![deny]` in runtime/src/lib.rs)
     support::scratch::cargo(&root().join("runtime"), &["clippy", "--offline", "--lib"]);
     krate.cargo(&["build", "--offline", "--quiet", "--release"]);
     let truth = truth(&d);

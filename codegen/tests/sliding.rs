@@ -25,9 +25,15 @@ fn emission_is_deterministic_and_small() {
     let (a, b) = (emitted(&example_text()), emitted(&example_text()));
     assert_eq!(a, b);
     assert!(a.lines().count() <= 400, "{} lines", a.lines().count());
-    let code: Vec<&str> = a.lines().filter(|l| !l.trim_start().starts_with("//")).collect();
+    let code: Vec<&str> = a
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect();
     for word in [" as ", "unwrap", "expect(", "panic", "[0]"] {
-        assert!(code.iter().all(|l| !l.contains(word)), "`{word}` in the emitted code");
+        assert!(
+            code.iter().all(|l| !l.contains(word)),
+            "`{word}` in the emitted code"
+        );
     }
     // the law is the runtime's: no model function is emitted
     assert!(!a.contains("fn law") && a.contains("sliding::SlidingMode<Design, f32>"));

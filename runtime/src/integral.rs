@@ -42,15 +42,6 @@
 //! No allocation, no panic path; the divisions are S_u/S_ι (checked), λ̂/ι
 //! (only outside the noise interval), 1/N and N²/l̂.
 
-// the emitted code's panic-free gate, here where its algorithm lives (codegen/tests/semera.rs)
-#![deny(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::indexing_slicing,
-    clippy::panic,
-    clippy::as_conversions
-)]
-
 use crate::linalg::Scalar;
 use crate::math::Real;
 use crate::semera::Estimate;

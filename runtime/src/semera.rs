@@ -57,15 +57,6 @@
 //! No allocation, no panic path, no division except 1/s (s ≥ σ_v² > 0) and
 //! N²/l̂.
 
-// the emitted code's panic-free gate, here where its algorithm lives (codegen/tests/semera.rs)
-#![deny(
-    clippy::unwrap_used,
-    clippy::expect_used,
-    clippy::indexing_slicing,
-    clippy::panic,
-    clippy::as_conversions
-)]
-
 use crate::linalg::Scalar;
 use crate::math::Real;
 
