@@ -10,7 +10,9 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use designer::closed_loop::{check_sample_period, run_loop, LoopRun, OperationOutcome};
+use designer::closed_loop::{
+    check_sample_period, resample_observer, run_loop, LoopRun, OperationOutcome,
+};
 use designer::design::Design;
 use designer::sim::Options;
 use miette::Report;
@@ -59,7 +61,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
         c.sample_period = ts;
     }
     if let (Some(o), Some(_)) = (&mut designed.observer, args.sample_period) {
-        o.sample_period = ts;
+        resample_observer(o, ts);
     }
     let design = Design::new(&designed).map_err(|e| fail(format!("{file}: {e}")))?;
     let run = run_loop(

@@ -439,6 +439,19 @@ pub fn switching_baseline(
         .collect())
 }
 
+/// The observer at the sample period `ts`: the process noise per step of
+/// `[observer.kalman]` (tuned at the description's period) scaled ∝ T_s, as
+/// the bundled descriptions tune it.
+pub fn resample_observer(o: &mut crate::description::Observer, ts: f64) {
+    let scale = ts / o.sample_period;
+    o.sample_period = ts;
+    if let Some(k) = &mut o.kalman {
+        k.process_z *= scale;
+        k.process_phi *= scale;
+        k.process_hc = k.process_hc.map(|q| q * scale);
+    }
+}
+
 /// A sample period the description's motion allows: the motion [t₀, t_f]
 /// spans at least 10 of them (the parser's rule for `controller.sample_period`).
 pub fn check_sample_period(description: &Description, ts: f64) -> Result<(), LoopError> {
@@ -471,8 +484,8 @@ pub struct SweepRow {
 }
 
 /// The description's design redone at each sample period (controller, and
-/// the observer's period with it), each in closed loop on the plant; rows in
-/// the order of `periods` (run in parallel).
+/// the observer's period with it, its process noise per step ∝ T_s), each in
+/// closed loop on the plant; rows in the order of `periods` (run in parallel).
 pub fn sweep(
     description: &Description,
     plant: Option<&Description>,
@@ -492,7 +505,7 @@ pub fn sweep(
                 c.sample_period = ts;
             }
             if let Some(o) = &mut d.observer {
-                o.sample_period = ts;
+                resample_observer(o, ts);
             }
             let design = Design::new(&d).map_err(|e| LoopError::Design {
                 sample_period: ts,
