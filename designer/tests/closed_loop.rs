@@ -114,3 +114,28 @@ fn sweeps_are_deterministic() {
     assert_eq!(a, b);
     assert_eq!(a[0].sample_period, 2e-5);
 }
+
+/// The reference may be energy-optimal too: with `u_bound` = u_max the
+/// optimal input touches the supply, u* = u_max, and the design is refused
+/// with the hint; with u_bound = 30 V it designs and lands softly.
+#[test]
+fn sliding_mode_tracks_an_energy_optimal_reference() {
+    let text = std::fs::read_to_string(example_path("sliding-mode-valve.toml"))
+        .unwrap()
+        .replace("shape = \"polynomial\"", "shape = \"energy-optimal\"");
+    let full = designer::description::parse_str(&text, "eo.toml").unwrap();
+    let e = Design::new(&full).err().expect("refused").to_string();
+    assert!(
+        e.contains("u_max > max u*") && e.contains("trajectory.u_bound = 40"),
+        "{e}"
+    );
+    let margin = text.replace("u_bound = 40.0", "u_bound = 30.0");
+    let d = designer::description::parse_str(&margin, "eo.toml").unwrap();
+    let design = Design::new(&d).unwrap_or_else(|e| panic!("{e}"));
+    let run = run_loop(&design, None, 1e-5, None, 0, &Options::default()).unwrap();
+    let t = d.trajectory.as_ref().unwrap();
+    for o in run.outcomes(t.takeoff, t.landing) {
+        let v = o.impact_velocity.expect("lands").abs();
+        assert!(v < 0.1, "{o:?}");
+    }
+}

@@ -82,7 +82,7 @@ pub enum PlanError {
         "the sliding-mode law cannot track the {operation} reference: it needs \
          u_max > max u* = {max_u_star:.4} (model-free-sliding-mode (48), worst at t = {:.4} ms \
          from the operation's start), but supply.u_max = {u_max}; give a longer motion \
-         (trajectory.landing − trajectory.takeoff) or a larger supply.u_max, and see \
+         (trajectory.landing − trajectory.takeoff) or a larger supply.u_max{hint}; see \
          `reldesign robustness` for the sufficient bound (49)",
         at * 1e3
     )]
@@ -91,6 +91,7 @@ pub enum PlanError {
         max_u_star: f64,
         at: f64,
         u_max: f64,
+        hint: String,
     },
     #[error("internal error: the symbol `{0}` of the linearization is unbound")]
     UnboundSymbol(String),
@@ -321,11 +322,20 @@ fn check_sliding_supply(
         if r.feasible && u_max > r.max_u_star {
             continue;
         }
+        let hint = match trajectory.shape {
+            Shape::EnergyOptimal => format!(
+                "; the energy-optimal reference uses inputs up to trajectory.u_bound = {}: \
+                 a smaller u_bound leaves the switching law a margin",
+                trajectory.u_bound
+            ),
+            Shape::Polynomial => String::new(),
+        };
         return Err(PlanError::SlidingSupply {
             operation: op.operation.name(),
             max_u_star: r.max_u_star,
             at: r.max_u_star_t,
             u_max,
+            hint,
         });
     }
     Ok(())
