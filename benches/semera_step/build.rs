@@ -44,7 +44,11 @@ fn main() {
     let mut csv = String::new();
     for k in 0..t.len() {
         let mid = t[k] - 0.5 * dt;
-        let v = if mid >= 0.0 && (mid / 20e-3).fract() < 0.5 { 30.0 } else { 0.0 };
+        let v = if mid >= 0.0 && (mid / 20e-3).fract() < 0.5 {
+            30.0
+        } else {
+            0.0
+        };
         let _ = writeln!(
             csv,
             "{:?} {:?}",
