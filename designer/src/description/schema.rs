@@ -4,11 +4,11 @@
 //!
 //! This table is the single source of the description's keys. It feeds the
 //! parser (the keys a section allows, each number's domain and unit, each
-//! default), `fit`'s parameter domains (`identify::params`), the unit
-//! comments of the TOML editor (`edit.rs`), the model's symbols
-//! (`model::Params::key`), the docs of the emitted parameter consts, and the
-//! generated reference `docs/reference/description.md` (kept fresh by a
-//! test, as `generated/` is).
+//! default; what a domain admits and its "expected …" text are written here,
+//! once), `fit`'s parameter domains (`identify::params`), the unit comments
+//! of the TOML editor (`edit.rs`), the model's symbols (`model::Params::key`),
+//! the docs of the emitted parameter consts, and the generated reference
+//! `docs/reference/description.md` (kept fresh by a test, as `generated/` is).
 
 use std::fmt::Write as _;
 
@@ -37,6 +37,12 @@ impl Domain {
     /// Whether `x` lies in the domain. `Above` is checked against the other
     /// key's value by the parser; here it asks only for a finite number.
     pub fn contains(self, x: f64) -> bool {
+        self.admits(x, None)
+    }
+
+    /// Whether `x` lies in the domain, an `Above` domain's other key having
+    /// the value `lower` (the parser's check; without it, any finite number).
+    pub fn admits(self, x: f64, lower: Option<f64>) -> bool {
         x.is_finite()
             && match self {
                 Domain::Any => true,
@@ -46,11 +52,15 @@ impl Domain {
                 Domain::Unit => (0.0..=1.0).contains(&x),
                 Domain::UnitOpen => (0.0..1.0).contains(&x),
                 Domain::UnitLeftOpen => x > 0.0 && x <= 1.0,
-                Domain::Above(_) => true,
+                Domain::Above(_) => match lower {
+                    Some(lower) => x > lower,
+                    None => true,
+                },
             }
     }
 
-    /// The bound alone ("> 0", "in [0, 1)"), none for `Any`.
+    /// The bound alone ("> 0", "in [0, 1)"), none for `Any`: the rule
+    /// column of the reference page.
     pub fn bound(self) -> Option<String> {
         match self {
             Domain::Any => None,
@@ -64,8 +74,15 @@ impl Domain {
         }
     }
 
-    /// The "expected …" text of messages and of the reference.
+    /// The "expected …" text of messages ("a number > 0").
     pub fn text(self) -> String {
+        self.expected(None)
+    }
+
+    /// The "expected …" text, an `Above` domain's other key having the value
+    /// `lower`: the parser names that key within its section and gives the
+    /// value ("a number > z_min (= 0.001)"); without it, the key's path.
+    pub fn expected(self, lower: Option<f64>) -> String {
         match self {
             Domain::Any => "a number".into(),
             Domain::Positive => "a number > 0".into(),
@@ -74,7 +91,13 @@ impl Domain {
             Domain::Unit => "a number in [0, 1]".into(),
             Domain::UnitOpen => "a number in [0, 1)".into(),
             Domain::UnitLeftOpen => "a number in (0, 1]".into(),
-            Domain::Above(other) => format!("a number > {other}"),
+            Domain::Above(other) => match lower {
+                Some(lower) => {
+                    let name = other.rsplit_once('.').map_or(other, |(_, k)| k);
+                    format!("a number > {name} (= {lower})")
+                }
+                None => format!("a number > {other}"),
+            },
         }
     }
 }

@@ -1,0 +1,205 @@
+//! The rules between sections, checked once both sides are read: the gap
+//! over the stroke, the drive against the coil, the trajectory's input
+//! against the supply, the controller against its trajectory and core, and
+//! the controller's estimator against `[observer]`.
+
+use super::sect::{Res, Sect};
+use crate::description::{Coil, Controller, Core, Drive, Estimator, Gap, Mechanics, Observer};
+use crate::description::{Supply, Trajectory};
+
+/// The motion [takeoff, landing] must last at least this many sample periods.
+const MIN_SAMPLES_PER_MOTION: f64 = 10.0;
+/// Grid size of the fringing-denominator check on (0, z_max].
+const DENOMINATOR_GRID: usize = 1000;
+
+/// R_gap(z) is defined and positive on the stroke: a fringing denominator
+/// stays > 0, a table covers [z_min, z_max].
+pub(super) fn check_gap_range(s: &Sect, gap: &Gap, m: &Mechanics) -> Res<()> {
+    match gap {
+        Gap::Linear { .. } => Ok(()),
+        Gap::McLyman {
+            area,
+            winding_length,
+        } => {
+            let sqrt_a = area.sqrt();
+            let f = |z: f64| 1.0 + z / sqrt_a * (2.0 * winding_length / z).ln();
+            check_denominator(s, "winding_length", "1 + z/√A·ln(2·l_w/z)", m.z_max, f)
+        }
+        Gap::McLymanFit { k1, k2, .. } => {
+            let f = |z: f64| 1.0 + k1 * z * (k2 / z).ln();
+            check_denominator(s, "k2", "1 + k1·z·ln(k2/z)", m.z_max, f)
+        }
+        Gap::Table { z, .. } => check_coverage(s, z, m),
+    }
+}
+
+/// The fringing denominator must stay > 0 on (0, z_max]. It is concave in z
+/// with limit 1 at 0⁺, so a uniform grid that ends at z_max finds any failure.
+fn check_denominator(
+    s: &Sect,
+    key: &str,
+    formula: &str,
+    z_max: f64,
+    f: impl Fn(f64) -> f64,
+) -> Res<()> {
+    for k in 1..=DENOMINATOR_GRID {
+        let z = z_max * k as f64 / DENOMINATOR_GRID as f64;
+        let d = f(z);
+        if d.is_nan() || d <= 0.0 {
+            let msg = format!(
+                "the gap denominator {formula} must stay > 0 on (0, z_max = {z_max:e} m], \
+                 but it is {d:.4} at z = {z:.4e} m (R_gap would be singular or negative)"
+            );
+            return Err(s.err(key, msg, "makes the gap denominator <= 0"));
+        }
+    }
+    Ok(())
+}
+
+/// A gap table spans [z_min, z_max].
+fn check_coverage(s: &Sect, z: &[f64], m: &Mechanics) -> Res<()> {
+    let last = z.len() - 1;
+    if z[0] > m.z_min {
+        let msg = format!(
+            "expected a number <= z_min = {} [m] (the table must cover [z_min, z_max]), found {}",
+            m.z_min, z[0]
+        );
+        return Err(s.elem_err("z", 0, msg, "table starts above z_min"));
+    }
+    if z[last] < m.z_max {
+        let msg = format!(
+            "expected a number >= z_max = {} [m] (the table must cover [z_min, z_max]), found {}",
+            m.z_max, z[last]
+        );
+        return Err(s.elem_err("z", last, msg, "table ends below z_max"));
+    }
+    Ok(())
+}
+
+/// A current drive needs the flux as a state, i.e. eddy currents.
+pub(super) fn check_drive(s: &Sect, supply: &Supply, coil: &Coil) -> Res<()> {
+    if supply.drive == Drive::Current && coil.eddy <= 0.0 {
+        let msg = "drive \"current\" requires coil.eddy > 0: with k_e = 0 the flux is an \
+                   algebraic function of the current, not a state, so a current-driven model \
+                   has no flux dynamics; use drive = \"voltage\" or give coil.eddy > 0";
+        return Err(s.err("drive", msg, "needs coil.eddy > 0"));
+    }
+    Ok(())
+}
+
+/// The trajectory is designed with inputs in [max(u_min, −u_bound), u_bound]:
+/// that interval must lie within the supply and contain positive inputs
+/// (closing needs them), i.e. max(0, u_min) < u_bound ≤ u_max.
+pub(super) fn check_u_bound(s: &Sect, u_bound: f64, supply: &Supply, unit: &str) -> Res<()> {
+    let (u_min, u_max) = (supply.u_min, supply.u_max);
+    let lower = u_min.max(0.0);
+    if u_bound > lower && u_bound <= u_max {
+        return Ok(());
+    }
+    let found = s
+        .entry("u_bound")
+        .map_or_else(|| u_bound.to_string(), |(_, v)| s.ctx.found(v));
+    let design = "the trajectory is designed with inputs in [max(u_min, -u_bound), u_bound], \
+                  which must lie within the supply and include positive inputs (closing needs \
+                  them)";
+    let msg = if u_max <= 0.0 {
+        format!(
+            "found {found}, but no u_bound can work: supply.u_max = {u_max} gives no positive \
+             input; {design}"
+        )
+    } else if u_bound > u_max {
+        format!(
+            "expected a number in ({lower}, supply.u_max = {u_max}] [{unit}], found {found}: \
+             it exceeds supply.u_max; {design}, leaving the rest to the feedback"
+        )
+    } else {
+        format!(
+            "expected a number in (supply.u_min = {u_min}, {u_max}] [{unit}], found {found}: \
+             with u_bound <= supply.u_min no input is left to design with; {design}"
+        )
+    };
+    Err(s.err("u_bound", msg, "outside the supply"))
+}
+
+/// A trajectory is designed in the feedback-linearizing coordinates, which
+/// need an input-affine core model.
+pub(super) fn check_trajectory_core(core_sect: &Sect, core: &Core) -> Res<()> {
+    if let Core::JilesAtherton(_) = core {
+        let msg = "a [trajectory] is designed through the feedback-linearizing coordinates \
+                   (x = T⁻¹(ξ), perfect-tracking-soft-landing eqs. 41–42), which need an \
+                   input-affine model, but the \"jiles-atherton\" core is not: its branch \
+                   δ = sign(dφ/dt) depends on the input u; design on a \"saturating\" or \
+                   \"linear\" core model of the same actuator";
+        return Err(core_sect.err("model", msg, "not input-affine"));
+    }
+    Ok(())
+}
+
+/// A controller tracks a `[trajectory]`, on an input-affine core, sampled
+/// at least 10 times per motion.
+pub(super) fn check_controller(
+    root: &Sect,
+    s: &Sect,
+    c: &Controller,
+    trajectory: Option<&Trajectory>,
+    core_sect: &Sect,
+    core: &Core,
+) -> Res<()> {
+    let Some(t) = trajectory else {
+        let msg = "section [controller] requires a [trajectory] section: the controller tracks \
+                   a reference trajectory, so give [trajectory] (operations, takeoff, landing, \
+                   shape, u_bound)";
+        return Err(root.err("controller", msg, "needs [trajectory]"));
+    };
+    if let Core::JilesAtherton(_) = core {
+        let msg = format!(
+            "the controller law \"{}\" is designed on an input-affine model, but the \
+             \"jiles-atherton\" core is not: its branch δ = sign(dφ/dt) depends on the input \
+             u; design on a \"saturating\" or \"linear\" core model of the same actuator",
+            c.law.name()
+        );
+        return Err(core_sect.err("model", msg, "not input-affine"));
+    }
+    let limit = (t.landing - t.takeoff) / MIN_SAMPLES_PER_MOTION;
+    if c.sample_period > limit {
+        let found = s
+            .entry("sample_period")
+            .map_or_else(|| c.sample_period.to_string(), |(_, v)| s.ctx.found(v));
+        let msg = format!(
+            "expected a number <= (trajectory.landing - trajectory.takeoff)/10 = {limit:e} [s], \
+             found {found}: the motion must span at least 10 sample periods for the sampled \
+             controller to track it"
+        );
+        return Err(s.err("sample_period", msg, "too long for the motion"));
+    }
+    Ok(())
+}
+
+/// `controller.estimator` names an observer that `[observer]` designs.
+pub(super) fn check_estimator(s: &Sect, c: &Controller, observer: Option<&Observer>) -> Res<()> {
+    let Some(wanted) = c.estimator else {
+        return Ok(());
+    };
+    let name = if wanted == Estimator::Ekf {
+        "ekf"
+    } else {
+        "ukf"
+    };
+    match observer {
+        Some(o) if o.estimators.contains(&wanted) => Ok(()),
+        Some(_) => {
+            let msg = format!(
+                "controller.estimator = \"{name}\" needs \"{name}\" in observer.estimators: the \
+                 loop runs the observer that [observer] designs"
+            );
+            Err(s.err("estimator", msg, "not in observer.estimators"))
+        }
+        None => {
+            let msg = format!(
+                "controller.estimator = \"{name}\" needs an [observer] section listing \
+                 \"{name}\" in estimators (with [observer.kalman])"
+            );
+            Err(s.err("estimator", msg, "no [observer]"))
+        }
+    }
+}
