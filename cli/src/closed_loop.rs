@@ -114,9 +114,10 @@ fn summary(outcomes: &[OperationOutcome], law: &str, ts: f64) -> String {
             });
         let _ = writeln!(
             s,
-            "  {:<8} first impact {impact}, RMSE_z {:.3e} m during the motion, {} bounce(s)",
+            "  {:<8} first impact {impact}, RMSE_z {} during the motion, {} bounce(s)",
             o.operation.name(),
-            o.rmse_z,
+            o.rmse_z
+                .map_or("— (no sample)".into(), |r| format!("{r:.3e} m")),
             o.bounces
         );
     }

@@ -21,9 +21,9 @@ pub struct Args {
     /// Vary a model parameter uniformly within ±P % of its value (repeatable), e.g. coil.resistance=±10%
     #[arg(long, value_name = "KEY=±P%")]
     vary: Vec<String>,
-    /// Monte-Carlo draws (with --vary)
-    #[arg(long, default_value_t = 1000)]
-    draws: usize,
+    /// Monte-Carlo draws (with --vary), at most 10 000 000
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(1..=10_000_000))]
+    draws: u32,
     /// Seed of the draws: the same seed gives the same draws, whatever the thread count
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -33,9 +33,9 @@ pub struct Args {
     /// Acceleration error bound |ã| as a percentage of max |a_ref| [SM 52]
     #[arg(long, default_value_t = 20.0, value_name = "P")]
     acceleration_error: f64,
-    /// Instants per operation
-    #[arg(long, default_value_t = 2000)]
-    samples: usize,
+    /// Instants per operation (10 to 1 000 000)
+    #[arg(long, default_value_t = 2000, value_parser = clap::value_parser!(u32).range(10..=1_000_000))]
+    samples: u32,
     /// Print JSON instead of text
     #[arg(long)]
     json: bool,
@@ -45,7 +45,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
     let description = crate::load(&args.model)?;
     let file = args.model.display().to_string();
     let bounds = error_bounds(args)?;
-    let analysis = Analysis::new(&description, bounds, args.samples.max(10))
+    let analysis = Analysis::new(&description, bounds, args.samples as usize)
         .map_err(|e| fail(format!("{file}: {e}")))?;
     let variations = args
         .vary
@@ -91,14 +91,15 @@ fn run_draws(
 ) -> Result<MonteCarlo, designer::design::RobustnessError> {
     let done = AtomicUsize::new(0);
     let terminal = std::io::stderr().is_terminal();
-    let step = (args.draws / 100).max(1);
+    let draws = args.draws as usize;
+    let step = (draws / 100).max(1);
     let progress = || {
         let k = done.fetch_add(1, Ordering::Relaxed) + 1;
-        if terminal && (k % step == 0 || k == args.draws) {
-            eprint!("\r  draws {k}/{}", args.draws);
+        if terminal && (k % step == 0 || k == draws) {
+            eprint!("\r  draws {k}/{draws}");
         }
     };
-    let result = analysis.monte_carlo(variations, args.draws, args.seed, &progress);
+    let result = analysis.monte_carlo(variations, draws, args.seed, &progress);
     if terminal {
         eprintln!();
     }
@@ -128,8 +129,10 @@ fn json_report(nominal: &Nominal, mc: Option<&MonteCarlo>, args: &Args) -> Strin
                 "min_b_j": number(r.min_b_j),
                 "max_epsilon": number(r.max_epsilon),
                 "required_u_max": number(r.required_u_max),
+                "required_u_min": number(r.required_u_min),
                 "u_max": nominal.u_max,
-                "met": r.met(nominal.u_max),
+                "u_min": nominal.u_min,
+                "met": r.met(nominal.u_min, nominal.u_max),
             })
         })
         .collect();
@@ -165,7 +168,11 @@ fn text(nominal: &Nominal, mc: Option<&MonteCarlo>, args: &Args, file: &str) -> 
         args.acceleration_error / 100.0
     );
     for (op, r) in &nominal.operations {
-        let _ = write!(s, "{}", operation_text(op.name(), r, nominal.u_max));
+        let _ = write!(
+            s,
+            "{}",
+            operation_text(op.name(), r, nominal.u_min, nominal.u_max)
+        );
     }
     if let Some(mc) = mc {
         let _ = writeln!(
@@ -201,7 +208,7 @@ fn volts(x: f64) -> String {
     }
 }
 
-fn operation_text(name: &str, r: &Robustness, u_max: f64) -> String {
+fn operation_text(name: &str, r: &Robustness, u_min: f64, u_max: f64) -> String {
     let mut s = format!("\n{name}:\n");
     if let Some((a, b)) = r.infeasible {
         let _ = writeln!(
@@ -226,9 +233,22 @@ fn operation_text(name: &str, r: &Robustness, u_max: f64) -> String {
     let _ = writeln!(s, "  max |ε| (50)          {:.6e} m/s³", r.max_epsilon);
     let _ = writeln!(
         s,
-        "  required u_max (49)   {}; the supply's u_max = {u_max}: {}",
-        volts(r.required_u_max),
-        if r.met(u_max) { "met" } else { "NOT met" }
+        "  required u_max (49)   {}; the supply's u_max = {u_max}",
+        volts(r.required_u_max)
+    );
+    let _ = writeln!(
+        s,
+        "  required u_min        {} (the same margin below min u_r); the supply's u_min = {u_min}",
+        volts(r.required_u_min)
+    );
+    let _ = writeln!(
+        s,
+        "  the supply [{u_min}, {u_max}]: {}",
+        if r.met(u_min, u_max) {
+            "met"
+        } else {
+            "NOT met"
+        }
     );
     s
 }

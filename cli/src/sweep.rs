@@ -127,7 +127,7 @@ fn to_json(sweeps: &[&Swept], baseline: &[(Operation, Option<f64>)]) -> String {
                         "sample_period": r.sample_period,
                         "operation": o.operation.name(),
                         "impact_velocity": number(o.impact_velocity),
-                        "rmse_z": o.rmse_z,
+                        "rmse_z": number(o.rmse_z),
                         "bounces": o.bounces,
                     })
                 })
@@ -158,10 +158,10 @@ fn text(sweeps: &[&Swept], baseline: &[(Operation, Option<f64>)]) -> String {
                     .map_or("never".into(), |v| format!("{v:+.4e}"));
                 let _ = writeln!(
                     s,
-                    "  {:>10.1e}  {:<8} {v:>14} {:>12.3e} {:>8}",
+                    "  {:>10.1e}  {:<8} {v:>14} {:>12} {:>8}",
                     r.sample_period,
                     o.operation.name(),
-                    o.rmse_z,
+                    o.rmse_z.map_or("—".into(), |r| format!("{r:.3e}")),
                     o.bounces
                 );
             }

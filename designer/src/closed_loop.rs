@@ -99,6 +99,9 @@ struct Sequencer<'a> {
     plant: &'a ModelPlant,
     nonnegative_current: bool,
     observer: Option<Observer>,
+    /// The input held over the last sample period (the current depends on it
+    /// through the eddy-current term).
+    held: f64,
     z_ref: Vec<(f64, f64)>,
     estimates: Vec<(f64, Estimate)>,
 }
@@ -142,7 +145,7 @@ impl Sequencer<'_> {
                 // a: the free-motion acceleration, 0 against a stop
                 let a = if m.mode == Mode::Free { dx[1] } else { 0.0 };
                 let phi = if self.nonnegative_current {
-                    self.plant.current_and_voltage(m.t, x, 0.0).0
+                    self.plant.current_and_voltage(m.t, x, self.held).0
                 } else {
                     x[2]
                 };
@@ -151,6 +154,7 @@ impl Sequencer<'_> {
         };
         self.z_ref.push((m.t, c.reference(m.t)[0]));
         let u = c.step(m.t, z, v, a, phi);
+        self.held = u;
         if let Some(o) = &mut self.observer {
             o.held = u;
         }
@@ -209,6 +213,7 @@ pub fn run_loop(
         plant: &model_plant,
         nonnegative_current,
         observer: observer(design, sample_period, seed)?,
+        held: 0.0,
         z_ref: Vec::new(),
         estimates: Vec::new(),
     };
@@ -226,32 +231,11 @@ pub fn run_loop(
     )?;
     let (current, _) =
         model_plant.currents_and_voltages(&trajectory.t, &trajectory.x, &trajectory.u);
-    let z_ref = trajectory
-        .t
-        .iter()
-        .map(|t| {
-            sequencer
-                .z_ref
-                .iter()
-                .rev()
-                .find(|(ts, _)| ts <= t)
-                .map_or(f64::NAN, |(_, z)| *z)
-        })
-        .collect();
-    let estimates = sequencer.observer.is_some().then(|| {
-        trajectory
-            .t
-            .iter()
-            .map(|t| {
-                sequencer
-                    .estimates
-                    .iter()
-                    .rev()
-                    .find(|(ts, _)| ts <= t)
-                    .map_or(NO_ESTIMATE, |(_, e)| *e)
-            })
-            .collect()
-    });
+    let z_ref = at_samples(&trajectory.t, &sequencer.z_ref, f64::NAN);
+    let estimates = sequencer
+        .observer
+        .is_some()
+        .then(|| at_samples(&trajectory.t, &sequencer.estimates, NO_ESTIMATE));
     Ok(LoopRun {
         trajectory,
         current,
@@ -260,6 +244,26 @@ pub fn run_loop(
         operation_length: length,
         estimates,
     })
+}
+
+/// The value recorded at or last before each output time (both in time
+/// order), `before` ahead of the first record: one walk, not a search per time.
+fn at_samples<T: Copy>(times: &[f64], records: &[(f64, T)], before: T) -> Vec<T> {
+    let mut k = 0;
+    let mut value = before;
+    times
+        .iter()
+        .map(|&t| {
+            while let Some(&(tr, v)) = records.get(k) {
+                if tr > t {
+                    break;
+                }
+                value = v;
+                k += 1;
+            }
+            value
+        })
+        .collect()
 }
 
 /// Before the first sample.
@@ -335,8 +339,9 @@ pub struct OperationOutcome {
     /// after its takeoff (signed); `None`: it never got there in time.
     pub impact_velocity: Option<f64>,
     /// perfect-tracking-soft-landing [PT 69] (with the errata's square root):
-    /// the RMS of z − z_r over the samples of the motion [t₀, t_f].
-    pub rmse_z: f64,
+    /// the RMS of z − z_r over the samples of the motion [t₀, t_f]; `None`
+    /// when no sample falls there (a run cut short).
+    pub rmse_z: Option<f64>,
     /// Impacts at the end stop within the operation that bounced.
     pub bounces: usize,
 }
@@ -361,7 +366,7 @@ impl LoopRun {
                 OperationOutcome {
                     operation,
                     impact_velocity,
-                    rmse_z: (sum / n.max(1) as f64).sqrt(),
+                    rmse_z: (n > 0).then(|| (sum / n as f64).sqrt()),
                     bounces,
                 }
             })
@@ -440,8 +445,9 @@ pub fn switching_baseline(
 }
 
 /// The observer at the sample period `ts`: the process noise per step of
-/// `[observer.kalman]` (tuned at the description's period) scaled ∝ T_s, as
-/// the bundled descriptions tune it.
+/// `[observer.kalman]` (tuned at the description's period) scaled ∝ T_s, the
+/// convention the bundled descriptions were tuned with (a white-noise random
+/// walk would scale ∝ √T_s; the filters here are tuned, not identified).
 pub fn resample_observer(o: &mut crate::description::Observer, ts: f64) {
     let scale = ts / o.sample_period;
     o.sample_period = ts;
@@ -496,10 +502,12 @@ pub fn sweep(
     let Some(t) = &description.trajectory else {
         return Err(LoopError::NoController);
     };
-    periods
+    for &ts in periods {
+        check_sample_period(description, ts)?;
+    }
+    let rows: Vec<Result<SweepRow, LoopError>> = periods
         .par_iter()
         .map(|&ts| {
-            check_sample_period(description, ts)?;
             let mut d = description.clone();
             if let Some(c) = &mut d.controller {
                 c.sample_period = ts;
@@ -517,5 +525,7 @@ pub fn sweep(
                 outcomes: run.outcomes(t.takeoff, t.landing),
             })
         })
-        .collect()
+        .collect();
+    // the first failing period in the order given, whatever the threads did
+    rows.into_iter().collect()
 }

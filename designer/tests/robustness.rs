@@ -46,7 +46,7 @@ fn the_papers_three_motion_times() {
                 let (a, b) = ((a - takeoff) / tau, (b - takeoff) / tau);
                 eprintln!("3 ms opening infeasible on t/τ after takeoff ∈ [{a:.3}, {b:.3}]");
                 assert!(a > 0.0 && b < 0.5 && a < 0.25 && b > 0.25, "[{a}, {b}]");
-                assert!(!r.met(1e3));
+                assert!(!r.met(-1e3, 1e3));
             }
         }
     }
@@ -145,4 +145,38 @@ fn variations_name_what_is_wrong() {
         .unwrap()
         .to_string();
     assert!(e.contains("law = \"feedback-linearization\""), "{e}");
+}
+
+/// The law's negative switch is u_min: a supply [0, u_max] cannot brake the
+/// flux as the reference needs, whatever u_max; the analysis says so on its
+/// negative side, and `build` refuses it (the reference's input bound [PT 54]).
+#[test]
+fn a_unipolar_supply_is_judged_on_its_negative_side_too() {
+    let d = valve(4.0);
+    let n = Analysis::new(&d, ErrorBounds::default(), 500)
+        .unwrap()
+        .nominal();
+    for (_, r) in &n.operations {
+        let min_u_ref = r
+            .samples
+            .iter()
+            .map(|s| s.u_ref)
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            min_u_ref < 0.0,
+            "the reference brakes the flux: {min_u_ref}"
+        );
+        assert!(r.required_u_min < min_u_ref);
+        assert!(r.met(-40.0, 40.0) == (40.0 >= r.required_u_max && -40.0 <= r.required_u_min));
+        assert!(!r.met(0.0, 1e3), "u_min = 0 cannot meet it");
+    }
+    let text = std::fs::read_to_string(example_path("sliding-mode-valve.toml"))
+        .unwrap()
+        .replace("u_min = -40.0", "u_min = 0.0");
+    let unipolar = parse_str(&text, "unipolar.toml").unwrap();
+    let e = designer::design::Design::new(&unipolar)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(e.contains("FAIL") && e.contains("≥ u_min: violated"), "{e}");
 }

@@ -16,7 +16,9 @@
 //! - with `nonnegative_current` [SM §5] the step reads the coil current: φ ≥ 0
 //!   is taken (sgn φ = +1) and the current is never driven below 0 (u = 0
 //!   where i ≤ 0 and the law asks for u < 0);
-//! - every output is saturated to [u_min, u_max]; a NaN input gives u = 0.
+//! - every output is saturated to [u_min, u_max]; a NaN z, v, a or φ gives
+//!   u = 0 away from the end stops (at a stop the expert rule needs only z and
+//!   φ); a NaN time counts as the pre-movement stage, as in `control`.
 //!
 //! No model function is evaluated: the law is two comparisons and a
 //! multiplication, with the reference lookup.

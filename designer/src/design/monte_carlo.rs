@@ -44,6 +44,9 @@ pub enum RobustnessError {
     Parameter { draw: usize, name: String },
 }
 
+/// Keys that act at the impacts only, not along the reference.
+const IMPACT_ONLY: [&str; 2] = ["mechanics.restitution", "mechanics.bounce_threshold"];
+
 /// `KEY=±P%`: the key's value varies uniformly within ±P % of its nominal.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variation {
@@ -65,6 +68,12 @@ impl Variation {
             .ok_or_else(|| bad("expected KEY=±P% (e.g. coil.resistance=±10%)".into()))?;
         let path = path.trim();
         params::domain(d, path).map_err(|e| bad(e.to_string()))?;
+        if IMPACT_ONLY.contains(&path) {
+            return Err(bad(format!(
+                "`{path}` acts at impacts only and does not enter the bound (49); vary a key of \
+                 the coil, gap, core or the motion"
+            )));
+        }
         let number = amount
             .trim()
             .trim_start_matches('±')
@@ -89,7 +98,8 @@ impl Variation {
 #[derive(Debug, Clone)]
 pub struct Nominal {
     pub operations: Vec<(Operation, Robustness)>,
-    /// The supply's u_max.
+    /// The supply [u_min, u_max].
+    pub u_min: f64,
     pub u_max: f64,
 }
 
@@ -102,6 +112,52 @@ pub struct Draw {
     /// The largest required u_max over the operations (∞ where a reference
     /// is infeasible for this device).
     pub required_u_max: f64,
+    /// The supply meets [SM 49] on both sides for every operation.
+    pub met: bool,
+}
+
+/// The running summary of draws: the worst so far (the lowest index among
+/// equals) and how many the supply meets.
+struct Tally {
+    worst: Option<Draw>,
+    met: usize,
+}
+
+impl Tally {
+    fn empty() -> Tally {
+        Tally {
+            worst: None,
+            met: 0,
+        }
+    }
+
+    fn of(d: Draw) -> Tally {
+        Tally {
+            met: usize::from(d.met),
+            worst: Some(d),
+        }
+    }
+
+    fn merge(self, other: Tally) -> Tally {
+        let worst = match (self.worst, other.worst) {
+            (Some(a), Some(b)) => Some(worse(a, b)),
+            (a, b) => a.or(b),
+        };
+        Tally {
+            worst,
+            met: self.met + other.met,
+        }
+    }
+}
+
+/// The draw needing the larger u_max; on a tie the lower index.
+fn worse(a: Draw, b: Draw) -> Draw {
+    match a.required_u_max.total_cmp(&b.required_u_max) {
+        std::cmp::Ordering::Greater => a,
+        std::cmp::Ordering::Less => b,
+        std::cmp::Ordering::Equal if a.index <= b.index => a,
+        std::cmp::Ordering::Equal => b,
+    }
 }
 
 /// The Monte-Carlo summary.
@@ -197,6 +253,7 @@ impl<'a> Analysis<'a> {
         let p = self.evaluator.values(&self.model).unwrap_or_default();
         Nominal {
             operations: self.operations(&p),
+            u_min: self.description.supply.u_min,
             u_max: self.description.supply.u_max,
         }
     }
@@ -213,32 +270,21 @@ impl<'a> Analysis<'a> {
         if draws == 0 {
             return Err(RobustnessError::NoDraws);
         }
-        let results: Vec<Result<Draw, RobustnessError>> = (0..draws)
+        // reduced as they come (no list of every draw), associatively, so the
+        // answer is the same whatever the split between threads
+        let tally = (0..draws)
             .into_par_iter()
             .map(|k| {
                 let draw = self.draw(variations, seed, k);
                 progress();
-                draw
+                draw.map(Tally::of)
             })
-            .collect();
-        let draws_done: Vec<Draw> = results.into_iter().collect::<Result<_, _>>()?;
-        let u_max = self.description.supply.u_max;
-        let met = draws_done
-            .iter()
-            .filter(|d| u_max >= d.required_u_max)
-            .count();
-        let worst = draws_done
-            .iter()
-            .fold(None::<&Draw>, |w, d| match w {
-                Some(w) if w.required_u_max >= d.required_u_max => Some(w),
-                _ => Some(d),
-            })
-            .cloned()
-            .ok_or(RobustnessError::NoDraws)?;
+            .try_reduce(Tally::empty, |a, b| Ok(a.merge(b)))?;
+        let worst = tally.worst.ok_or(RobustnessError::NoDraws)?;
         Ok(MonteCarlo {
             draws,
             worst,
-            share_met: met as f64 / draws as f64,
+            share_met: tally.met as f64 / draws as f64,
         })
     }
 
@@ -268,8 +314,8 @@ impl<'a> Analysis<'a> {
             .evaluator
             .values(&model)
             .map_err(|name| RobustnessError::Parameter { draw: k, name })?;
-        let required_u_max = self
-            .operations(&p)
+        let operations = self.operations(&p);
+        let required_u_max = operations
             .iter()
             .map(|(_, r)| {
                 if r.feasible {
@@ -279,10 +325,14 @@ impl<'a> Analysis<'a> {
                 }
             })
             .fold(f64::NEG_INFINITY, f64::max);
+        let supply = &self.description.supply;
         Ok(Draw {
             index: k,
             values,
             required_u_max,
+            met: operations
+                .iter()
+                .all(|(_, r)| r.met(supply.u_min, supply.u_max)),
         })
     }
 }

@@ -319,6 +319,8 @@ fn check_sliding_supply(
             &ErrorBounds::default(),
             &params,
         );
+        // (the negative side, u_min below the reference's inputs, is the
+        // feasibility check [PT 54] the reference already passed)
         if r.feasible && u_max > r.max_u_star {
             continue;
         }

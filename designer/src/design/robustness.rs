@@ -59,7 +59,10 @@ pub struct Sample {
     pub force: f64,
     /// [SM 14] −½·R_g′(z_r)·φ_sat² [N] (−∞ without saturation).
     pub force_bound: f64,
-    /// [SM 48] u* [V or A]; +∞ where the reference is infeasible.
+    /// The input of ideal tracking, signed: u_r = (f_j − j_r)/B_j = α + β·j_r
+    /// [PT 32]; NaN where the reference is infeasible.
+    pub u_ref: f64,
+    /// [SM 48] u* = |u_r| [V or A]; +∞ where the reference is infeasible.
     pub u_star: f64,
     /// [SM 26] |B_j| [1/(s³·V)·m]; 0 where the reference is infeasible.
     pub b_j: f64,
@@ -80,15 +83,21 @@ pub struct Robustness {
     pub min_b_j_t: f64,
     /// [SM 50] the bound of |ε|.
     pub max_epsilon: f64,
-    /// [SM 49] the sufficient u_max.
+    /// [SM 49] the sufficient u_max: max u* + (max|ε| + η)/min|B_j|, the
+    /// paper's form for a supply ±u_max.
     pub required_u_max: f64,
+    /// The same condition [SM 27] on the negative side, for a supply whose
+    /// u_min is not −u_max: the law's negative switch is u_min (saturated), so
+    /// it must reach min u_r − (max|ε| + η)/min|B_j| (≤ 0 where the reference
+    /// ever needs a negative input or margin).
+    pub required_u_min: f64,
     pub samples: Vec<Sample>,
 }
 
 impl Robustness {
-    /// Whether a supply of `u_max` meets [SM 49].
-    pub fn met(&self, u_max: f64) -> bool {
-        self.feasible && u_max >= self.required_u_max
+    /// Whether the supply [u_min, u_max] meets [SM 49] on both sides.
+    pub fn met(&self, u_min: f64, u_max: f64) -> bool {
+        self.feasible && u_max >= self.required_u_max && u_min <= self.required_u_min
     }
 }
 
@@ -182,13 +191,14 @@ impl Evaluator {
             None => f64::NEG_INFINITY,
         };
         let feasible = phi2[0] > 0.0 && force <= 0.0 && force >= force_bound;
-        let (u_star, b_j) = if feasible {
+        let (u_ref, b_j) = if feasible {
             let [alpha, beta, _] = at_flux(phi2[0].sqrt());
-            // u_r = α + β·j_r = (j_r − f_j)/(−B_j) [PT 32], [SM 48]
-            ((alpha + beta * f.jerk).abs(), (1.0 / beta).abs())
+            // u_r = α + β·j_r = (f_j − j_r)/B_j [PT 32], [SM 48]
+            (alpha + beta * f.jerk, (1.0 / beta).abs())
         } else {
-            (f64::INFINITY, 0.0)
+            (f64::NAN, 0.0)
         };
+        let u_star = if feasible { u_ref.abs() } else { f64::INFINITY };
         Sample {
             t,
             z: f.z,
@@ -197,6 +207,7 @@ impl Evaluator {
             jerk: f.jerk,
             force,
             force_bound,
+            u_ref,
             u_star,
             b_j,
         }
@@ -279,8 +290,14 @@ fn summarise(samples: Vec<Sample>, surface: &SlidingSurface, bounds: &ErrorBound
         .copied();
     let (max_u_star, max_u_star_t) = worst_u.map_or((f64::NAN, f64::NAN), |s| (s.u_star, s.t));
     let (min_b_j, min_b_j_t) = weakest.map_or((f64::NAN, f64::NAN), |s| (s.b_j, s.t));
-    // [SM 49]
-    let required_u_max = max_u_star + (max_epsilon + eta) / min_b_j;
+    // [SM 49], and its negative side
+    let margin = (max_epsilon + eta) / min_b_j;
+    let required_u_max = max_u_star + margin;
+    let min_u_ref = samples
+        .iter()
+        .map(|s| s.u_ref)
+        .fold(f64::INFINITY, f64::min);
+    let required_u_min = min_u_ref - margin;
     Robustness {
         feasible: infeasible.is_empty(),
         infeasible: infeasible
@@ -293,6 +310,7 @@ fn summarise(samples: Vec<Sample>, surface: &SlidingSurface, bounds: &ErrorBound
         min_b_j_t,
         max_epsilon,
         required_u_max,
+        required_u_min,
         samples,
     }
 }
