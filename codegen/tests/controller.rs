@@ -115,6 +115,7 @@ fn design(v: &Valve, both: bool) -> ControllerDesign {
         takeoff: T0,
         landing: TF,
         creep_speed: None,
+        landed_band: None,
     };
     ControllerDesign::decide(&v.model, v.lin.clone(), &spec, operations)
         .unwrap_or_else(|e| panic!("{e}"))

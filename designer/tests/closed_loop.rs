@@ -139,3 +139,28 @@ fn sliding_mode_tracks_an_energy_optimal_reference() {
         assert!(v < 0.1, "{o:?}");
     }
 }
+
+/// `[controller] landed_band` sizes the contact band of the expert rules
+/// [SM 43] to the measurement: at 0.5 µm short of z_max, the opening holds
+/// 0 V with a 1 µm band and keeps switching with the default (1 pm) one.
+#[test]
+fn the_landed_band_is_the_descriptions() {
+    use designer::description::Operation;
+    use designer::design::RuntimePlan;
+    let text = std::fs::read_to_string(example_path("sliding-mode-valve.toml")).unwrap();
+    let with_band = text.replace("eta = 1e5", "eta = 1e5\nlanded_band = 1e-6");
+    let step = |text: &str| {
+        let d = designer::description::parse_str(text, "band.toml").unwrap();
+        let design = Design::new(&d).unwrap();
+        let c = design.controller.as_ref().unwrap();
+        let mut model = design.model.clone();
+        let mut opening = RuntimePlan::new(&mut model, c).controller(Operation::Opening);
+        (
+            c.landed_band,
+            opening.step(6e-3, 1e-3 - 5e-7, 0.0, 0.0, 1e-5),
+        )
+    };
+    assert_eq!(step(&with_band), (1e-6, 0.0));
+    let (band, u) = step(&text);
+    assert!(band < 1e-11 && u != 0.0, "{band} {u}");
+}

@@ -428,6 +428,7 @@ fn both_sections_parse_into_the_expected_values() {
             sample_period: 1e-5,
             floats: vec![FloatType::F32, FloatType::F64],
             creep_speed: None,
+            landed_band: None,
             estimator: None,
         }),
         "float defaults to both, creep_speed to the generator's"

@@ -200,6 +200,9 @@ pub struct Controller {
     /// from the model, a biased estimate) still lands, at about this speed.
     /// `None`: 2.5·10⁻³ of the stroke per motion time (`codegen`).
     pub creep_speed: Option<f64>,
+    /// [m] (> 0): within this distance of its end stop the armature counts as
+    /// in contact. `None`: 10⁻⁹ of the stroke (`design::decisions`).
+    pub landed_band: Option<f64>,
     /// The observer of `[observer]` that drives the controller in the closed
     /// loops of `reldesign loop` and `sweep` (`Ekf` or `Ukf`); `None`: the
     /// controller reads the plant's state.

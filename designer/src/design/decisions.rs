@@ -131,6 +131,8 @@ pub struct ControllerSpec {
     pub landing: f64,
     /// `[controller] creep_speed` [m/s]; `None`: the default creep.
     pub creep_speed: Option<f64>,
+    /// `[controller] landed_band` [m]; `None`: 10⁻⁹ of the stroke.
+    pub landed_band: Option<f64>,
 }
 
 /// The designed controller: everything the emitted module states, as numbers.
@@ -188,7 +190,9 @@ impl ControllerDesign {
             takeoff: spec.takeoff,
             landing: spec.landing,
             phi_guard: round_down_1sig(GUARD_FRACTION * phi_min),
-            landed_band: round_down_1sig(LANDED_FRACTION * stroke),
+            landed_band: spec
+                .landed_band
+                .unwrap_or_else(|| round_down_1sig(LANDED_FRACTION * stroke)),
             press: PRESS_FRACTION,
             creep,
             creep_max: CREEP_MAX_FRACTION,
@@ -218,6 +222,9 @@ fn check(spec: &ControllerSpec, operations: &[DesignedOperation]) -> Result<f64,
     finite("u_min", spec.u_min)?;
     finite("u_max", spec.u_max)?;
     positive("u_max - u_min", spec.u_max - spec.u_min)?;
+    if let Some(band) = spec.landed_band {
+        positive("landed_band", band)?;
+    }
     if let Some(speed) = spec.creep_speed {
         positive("creep_speed", speed)?;
     }

@@ -179,6 +179,7 @@ pub fn design_controller(
         takeoff: trajectory.takeoff,
         landing: trajectory.landing,
         creep_speed: controller.creep_speed,
+        landed_band: controller.landed_band,
     };
     ControllerDesign::decide(model, linearization, &spec, operations)
 }

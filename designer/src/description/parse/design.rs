@@ -59,6 +59,7 @@ pub(super) fn parse_controller(s: &Sect) -> Res<Controller> {
     let sample_period = s.req("sample_period")?;
     let floats = parse_floats(s)?;
     let creep_speed = s.opt("creep_speed")?;
+    let landed_band = s.opt("landed_band")?;
     let estimator = s.opt_choice("estimator", "estimator")?.map(|e| match e {
         "ekf" => Estimator::Ekf,
         _ => Estimator::Ukf,
@@ -68,6 +69,7 @@ pub(super) fn parse_controller(s: &Sect) -> Res<Controller> {
         sample_period,
         floats,
         creep_speed,
+        landed_band,
         estimator,
     })
 }
