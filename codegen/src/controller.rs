@@ -33,8 +33,7 @@ use crate::emit::{function_tokens_as, FunctionSpec, Inline};
 use crate::error::EmitError;
 use crate::float::{Float, Scalar, MACRO_LITERALS};
 use crate::format::{comment_lets, format_items, macro_rules, space_items};
-use crate::names::const_name;
-use crate::operations::{documented_consts, plan_items, splice_tables, PLAN_CONSTS};
+use crate::operations::{checked_floats, documented_consts, plan_items, splice_tables};
 use crate::param::Param;
 use crate::physical::{in_scope, of_model};
 
@@ -79,21 +78,7 @@ const GAIN_SYMBOLS: [&str; 3] = ["gain_k1", "gain_k2", "gain_k3"];
 /// each module invokes the file's `params!` macro too (which must precede
 /// them).
 pub fn emit_controller(input: &ControllerInput) -> Result<String, ControllerError> {
-    let mut floats: Vec<Float> = Vec::new();
-    for &f in &input.floats {
-        if !floats.contains(&f) {
-            floats.push(f);
-        }
-    }
-    if floats.is_empty() {
-        return Err(ControllerError::NoFloat);
-    }
-    for (name, _, _) in input.model.params.iter() {
-        let cname = const_name(name)?;
-        if GAIN_CONSTS.contains(&cname.as_str()) || PLAN_CONSTS.contains(&cname.as_str()) {
-            return Err(ControllerError::NameTaken(cname));
-        }
-    }
+    let floats = checked_floats(input, GAIN_CONSTS)?;
     let mut graph = input.model.graph.clone();
     let law = LawSymbols::build(&mut graph, input.design, &input.model.named)?;
     // MU0, Z_EPS as the file's params! declares them

@@ -13,12 +13,13 @@ use designer::model::Model;
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::controller::ControllerError;
+use crate::controller::{ControllerError, ControllerInput};
 use crate::error::EmitError;
 use crate::float::Float;
+use crate::names::const_name;
 
 /// Names of the plan's constants (checked against the parameters' const names).
-pub const PLAN_CONSTS: &[&str] = &[
+const PLAN_CONSTS: &[&str] = &[
     "U_MIN",
     "U_MAX",
     "T_TAKEOFF",
@@ -32,6 +33,31 @@ pub const PLAN_CONSTS: &[&str] = &[
     "REFERENCE_CLOSING",
     "REFERENCE_OPENING",
 ];
+
+/// The float types of `input`, each once in the order given (at least one),
+/// after checking that no model parameter's const takes the name of a plan
+/// const or of one of the law's own `law_consts`.
+pub fn checked_floats(
+    input: &ControllerInput,
+    law_consts: &[&str],
+) -> Result<Vec<Float>, ControllerError> {
+    let mut floats: Vec<Float> = Vec::new();
+    for &f in &input.floats {
+        if !floats.contains(&f) {
+            floats.push(f);
+        }
+    }
+    if floats.is_empty() {
+        return Err(ControllerError::NoFloat);
+    }
+    for (name, _, _) in input.model.params.iter() {
+        let cname = const_name(name)?;
+        if law_consts.contains(&cname.as_str()) || PLAN_CONSTS.contains(&cname.as_str()) {
+            return Err(ControllerError::NameTaken(cname));
+        }
+    }
+    Ok(floats)
+}
 
 /// `pub const NAME: f = value;` per entry, each with its doc.
 pub fn documented_consts(

@@ -17,8 +17,7 @@ use quote::{format_ident, quote};
 use crate::controller::{ControllerError, ControllerInput};
 use crate::float::Float;
 use crate::format::{format_items, space_items};
-use crate::names::const_name;
-use crate::operations::{documented_consts, plan_items, splice_tables, PLAN_CONSTS};
+use crate::operations::{checked_floats, documented_consts, plan_items, splice_tables};
 
 /// Names of the law's own constants.
 const SURFACE_CONSTS: &[&str] = &["LAMBDA1", "LAMBDA2", "NONNEGATIVE_CURRENT"];
@@ -26,21 +25,7 @@ const SURFACE_CONSTS: &[&str] = &["LAMBDA1", "LAMBDA2", "NONNEGATIVE_CURRENT"];
 /// The sliding-mode controller's float modules, formatted and deterministic;
 /// each invokes the file's `params!` macro (which must precede them).
 pub fn emit_sliding_mode(input: &ControllerInput) -> Result<String, ControllerError> {
-    let mut floats: Vec<Float> = Vec::new();
-    for &f in &input.floats {
-        if !floats.contains(&f) {
-            floats.push(f);
-        }
-    }
-    if floats.is_empty() {
-        return Err(ControllerError::NoFloat);
-    }
-    for (name, _, _) in input.model.params.iter() {
-        let cname = const_name(name)?;
-        if SURFACE_CONSTS.contains(&cname.as_str()) || PLAN_CONSTS.contains(&cname.as_str()) {
-            return Err(ControllerError::NameTaken(cname));
-        }
-    }
+    let floats = checked_floats(input, SURFACE_CONSTS)?;
     let mut out = String::new();
     for (k, float) in floats.into_iter().enumerate() {
         if k > 0 {
