@@ -183,70 +183,10 @@ fn plot(run: &LoopRun, name: &str, ts: f64) -> Result<String, String> {
             ("input u", vec![(&tr.u, BLUE, "u")]),
             ("current i [A]", vec![(&run.current, GREEN, "i")]),
         ];
-        for (panel, (label, lines)) in panels.iter().zip(series) {
-            draw(panel, &t, &lines, label)?;
+        for (area, (label, lines)) in panels.iter().zip(series) {
+            crate::plot::panel(area, &t, &lines, label)?;
         }
         root.present().map_err(e)?;
     }
     Ok(out)
-}
-
-fn draw(
-    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
-    t: &[f64],
-    lines: &[(&[f64], RGBColor, &str)],
-    label: &str,
-) -> Result<(), String> {
-    let e = |e: plotters::drawing::DrawingAreaErrorKind<std::io::Error>| e.to_string();
-    let (t0, t1) = (
-        t.first().copied().unwrap_or(0.0),
-        t.last().copied().unwrap_or(1.0),
-    );
-    let finite = lines
-        .iter()
-        .flat_map(|(y, _, _)| y.iter())
-        .filter(|v| v.is_finite());
-    let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-        (a.min(v), b.max(v))
-    });
-    let (lo, hi) = if lo < hi {
-        (lo, hi)
-    } else {
-        (lo - 1.0, lo + 1.0)
-    };
-    let pad = 0.05 * (hi - lo);
-    let mut chart = ChartBuilder::on(area)
-        .margin(10)
-        .x_label_area_size(35)
-        .y_label_area_size(70)
-        .build_cartesian_2d(t0..t1.max(t0 + 1e-9), (lo - pad)..(hi + pad))
-        .map_err(e)?;
-    chart
-        .configure_mesh()
-        .x_desc("t [ms]")
-        .y_desc(label)
-        .draw()
-        .map_err(e)?;
-    for &(y, color, name) in lines {
-        chart
-            .draw_series(LineSeries::new(
-                t.iter()
-                    .zip(y.iter())
-                    .filter(|(_, v)| v.is_finite())
-                    .map(|(&a, &b)| (a, b)),
-                color.stroke_width(2),
-            ))
-            .map_err(e)?
-            .label(name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
-    }
-    if lines.len() > 1 {
-        chart
-            .configure_series_labels()
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.8))
-            .draw()
-            .map_err(e)?;
-    }
-    Ok(())
 }

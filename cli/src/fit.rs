@@ -24,7 +24,7 @@ use reldesign_identify::params::{self, Domain};
 use reldesign_identify::{current_wnrmse, fit, FitOptions, FitParam, Measured};
 use serde_json::{json, Value};
 
-use crate::fail;
+use crate::{fail, finite};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -275,15 +275,6 @@ fn fit_json(d: &Description, r: &FitReport, before: f64, written: Option<&str>) 
         "weak_directions": weak,
         "out": written,
     })
-}
-
-/// JSON has no ∞ or NaN: those become null.
-fn finite(x: f64) -> Value {
-    if x.is_finite() {
-        json!(x)
-    } else {
-        Value::Null
-    }
 }
 
 fn run_gap(args: &Args, description: &Description, model: &str) -> Result<(), Report> {

@@ -103,6 +103,15 @@ pub fn load(path: &Path) -> Result<Description, Report> {
     parse_file(path).map_err(Report::new)
 }
 
+/// A number for JSON, which has no ∞ or NaN: those become null.
+pub fn finite(x: f64) -> serde_json::Value {
+    if x.is_finite() {
+        serde_json::json!(x)
+    } else {
+        serde_json::Value::Null
+    }
+}
+
 /// A plain error message as a report.
 pub fn fail(message: impl std::fmt::Display) -> Report {
     miette::miette!("{message}")

@@ -1,4 +1,5 @@
-//! `--plot out.svg`: current, flux and position of a replay, stacked.
+//! `--plot out.svg`: current, flux and position of a replay, stacked; the
+//! panel against time that `simulate` and `loop` draw.
 
 use designer::replay::Replay;
 use plotters::prelude::*;
@@ -20,28 +21,30 @@ pub fn svg(r: &Replay, title: &str) -> Result<String, String> {
             ("flux φ [µWb]", &flux, RED),
             ("position z [mm]", &z, BLACK),
         ];
-        for (panel, (label, ys, color)) in panels.iter().zip(series) {
-            draw(panel, &t_ms, ys, label, color)?;
+        for (area, (label, ys, color)) in panels.iter().zip(series) {
+            panel(area, &t_ms, &[(ys, color, label)], label)?;
         }
         root.present().map_err(|e| e.to_string())?;
     }
     Ok(out)
 }
 
-fn draw<'a>(
-    area: &DrawingArea<SVGBackend<'a>, plotters::coord::Shift>,
+/// One panel against t [ms]: each line (values, colour, name) where finite,
+/// with a legend when there is more than one.
+pub fn panel(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
     t: &[f64],
-    y: &[f64],
+    lines: &[(&[f64], RGBColor, &str)],
     label: &str,
-    color: RGBColor,
 ) -> Result<(), String> {
     let e = |e: plotters::drawing::DrawingAreaErrorKind<std::io::Error>| e.to_string();
     let (t0, t1) = (
         t.first().copied().unwrap_or(0.0),
         t.last().copied().unwrap_or(1.0),
     );
-    let (lo, hi) = y
+    let (lo, hi) = lines
         .iter()
+        .flat_map(|(y, _, _)| y.iter())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
             (a.min(v), b.max(v))
         });
@@ -58,11 +61,28 @@ fn draw<'a>(
         .y_desc(label)
         .draw()
         .map_err(e)?;
-    chart
-        .draw_series(LineSeries::new(
-            t.iter().copied().zip(y.iter().copied()),
-            &color,
-        ))
-        .map_err(e)?;
+    for &(y, color, name) in lines {
+        let points = t
+            .iter()
+            .copied()
+            .zip(y.iter().copied())
+            .filter(|(_, v)| v.is_finite());
+        let series = chart
+            .draw_series(LineSeries::new(points, &color))
+            .map_err(e)?;
+        if lines.len() > 1 {
+            series
+                .label(name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        }
+    }
+    if lines.len() > 1 {
+        chart
+            .configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.8))
+            .draw()
+            .map_err(e)?;
+    }
     Ok(())
 }

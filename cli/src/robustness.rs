@@ -12,7 +12,7 @@ use designer::design::{Analysis, ErrorBounds, MonteCarlo, Nominal, Robustness, V
 use miette::Report;
 use serde_json::{json, Value};
 
-use crate::fail;
+use crate::{fail, finite};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -106,15 +106,6 @@ fn run_draws(
     result
 }
 
-/// A finite number, or JSON null (an infeasible reference needs an infinite u_max).
-fn number(x: f64) -> Value {
-    if x.is_finite() {
-        json!(x)
-    } else {
-        Value::Null
-    }
-}
-
 fn json_report(nominal: &Nominal, mc: Option<&MonteCarlo>, args: &Args) -> String {
     let operations: Vec<Value> = nominal
         .operations
@@ -124,12 +115,12 @@ fn json_report(nominal: &Nominal, mc: Option<&MonteCarlo>, args: &Args) -> Strin
                 "operation": op.name(),
                 "feasible": r.feasible,
                 "infeasible_between": r.infeasible.map(|(a, b)| [a, b]),
-                "max_u_star": number(r.max_u_star),
-                "max_u_star_t": number(r.max_u_star_t),
-                "min_b_j": number(r.min_b_j),
-                "max_epsilon": number(r.max_epsilon),
-                "required_u_max": number(r.required_u_max),
-                "required_u_min": number(r.required_u_min),
+                "max_u_star": finite(r.max_u_star),
+                "max_u_star_t": finite(r.max_u_star_t),
+                "min_b_j": finite(r.min_b_j),
+                "max_epsilon": finite(r.max_epsilon),
+                "required_u_max": finite(r.required_u_max),
+                "required_u_min": finite(r.required_u_min),
                 "u_max": nominal.u_max,
                 "u_min": nominal.u_min,
                 "met": r.met(nominal.u_min, nominal.u_max),
@@ -149,7 +140,7 @@ fn json_report(nominal: &Nominal, mc: Option<&MonteCarlo>, args: &Args) -> Strin
             json!({
                 "draws": mc.draws,
                 "seed": args.seed,
-                "worst_required_u_max": number(mc.worst.required_u_max),
+                "worst_required_u_max": finite(mc.worst.required_u_max),
                 "worst_draw": worst,
                 "worst_draw_index": mc.worst.index,
                 "share_met": mc.share_met,
