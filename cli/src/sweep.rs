@@ -10,13 +10,12 @@ use std::path::PathBuf;
 
 use designer::closed_loop::{sweep, switching_baseline, SweepRow};
 use designer::description::{Description, Operation};
-use designer::design::Design;
 use designer::sim::Options;
 use miette::Report;
 use plotters::prelude::*;
 use serde_json::{json, Value};
 
-use crate::{atomic, fail};
+use crate::{atomic, fail, finite};
 
 /// The paper's range, 1 µs to 100 µs.
 const DEFAULT_PERIODS: [f64; 7] = [1e-6, 2e-6, 5e-6, 1e-5, 2e-5, 5e-5, 1e-4];
@@ -59,8 +58,8 @@ pub fn run(args: &Args) -> Result<(), Report> {
         None => None,
     };
     let file = args.model.display().to_string();
-    let design = Design::new(&description).map_err(|e| fail(format!("{file}: {e}")))?;
-    let baseline = switching_baseline(&design, plant.as_ref(), &Options::default())
+    // the uncontrolled switching needs no design: the supply and the timing
+    let baseline = switching_baseline(&description, plant.as_ref(), &Options::default())
         .map_err(|e| fail(format!("{file}: {e}")))?;
     let sweeps: Vec<&Swept> = std::iter::once(&main).chain(other.as_ref()).collect();
     if let Some(path) = &args.plot {
@@ -110,9 +109,9 @@ fn swept(
     })
 }
 
+/// An optional number for JSON: absent or not finite → null.
 fn number(x: Option<f64>) -> Value {
-    x.filter(|v| v.is_finite())
-        .map_or(Value::Null, |v| json!(v))
+    x.map_or(Value::Null, finite)
 }
 
 fn to_json(sweeps: &[&Swept], baseline: &[(Operation, Option<f64>)]) -> String {

@@ -402,22 +402,21 @@ fn impacts(tr: &Trajectory, operation: Operation, from: f64, to: f64) -> (Option
 
 /// The uncontrolled switching the papers compare with: u_max over each
 /// closing operation, 0 over each opening one, on the plant (default: the
-/// design's own), from the loop's start state. The first impact of each
+/// description's own), from the loop's start state. The first impact of each
 /// within its window; the last window is open-ended (up to
 /// `BASELINE_TAIL` operation lengths), since a coil left at 0 V may release
 /// long after the motion time the design was given.
 pub fn switching_baseline(
-    design: &Design,
+    description: &Description,
     plant: Option<&Description>,
     options: &Options,
 ) -> Result<Vec<(Operation, Option<f64>)>, LoopError> {
-    let Some(t) = &design.description.trajectory else {
+    let Some(t) = &description.trajectory else {
         return Err(LoopError::NoController);
     };
-    let plant_description = plant.unwrap_or(&design.description);
-    let mut model = Model::build(plant_description);
+    let mut model = Model::build(plant.unwrap_or(description));
     let length = operation_end(t.takeoff, t.landing);
-    let u_max = design.description.supply.u_max;
+    let u_max = description.supply.u_max;
     let (mut times, mut values) = (Vec::new(), Vec::new());
     for (k, op) in t.operations.iter().enumerate() {
         let u = match op {
@@ -458,13 +457,15 @@ pub fn resample_observer(o: &mut crate::description::Observer, ts: f64) {
     }
 }
 
-/// A sample period the description's motion allows: the motion [t₀, t_f]
-/// spans at least 10 of them (the parser's rule for `controller.sample_period`).
+/// A sample period the description's motion allows (the parser's rule for
+/// `controller.sample_period`, [`Trajectory::longest_sample_period`]).
+///
+/// [`Trajectory::longest_sample_period`]: crate::description::Trajectory::longest_sample_period
 pub fn check_sample_period(description: &Description, ts: f64) -> Result<(), LoopError> {
     let Some(t) = &description.trajectory else {
         return Err(LoopError::NoController);
     };
-    let limit = (t.landing - t.takeoff) / 10.0;
+    let limit = t.longest_sample_period();
     if ts.is_finite() && ts > 0.0 && ts <= limit {
         Ok(())
     } else {

@@ -80,8 +80,7 @@ fn sampling_sweep_follows_the_papers_trend() {
             .collect()
     };
     let (sm_speeds, fl_speeds) = (speeds(&sm), speeds(&fl));
-    let design = Design::new(&sm).unwrap();
-    let baseline = switching_baseline(&design, None, &options).unwrap();
+    let baseline = switching_baseline(&sm, None, &options).unwrap();
     eprintln!(
         "sliding mode {sm_speeds:?}\nfeedback linearization {fl_speeds:?}\nswitching {baseline:?}"
     );

@@ -170,6 +170,18 @@ pub struct Trajectory {
     pub u_bound: f64,
 }
 
+impl Trajectory {
+    /// The motion [t₀, t_f] must span at least this many sample periods for
+    /// a sampled controller to track it.
+    pub const MIN_SAMPLES_PER_MOTION: f64 = 10.0;
+
+    /// The longest sample period the motion allows:
+    /// (t_f − t₀)/[`Trajectory::MIN_SAMPLES_PER_MOTION`].
+    pub fn longest_sample_period(&self) -> f64 {
+        (self.landing - self.takeoff) / Self::MIN_SAMPLES_PER_MOTION
+    }
+}
+
 /// How the gains K of the tracking law [PT 48] are given.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Gains {

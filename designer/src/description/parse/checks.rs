@@ -7,8 +7,6 @@ use super::sect::{Res, Sect};
 use crate::description::{Coil, Controller, Core, Drive, Estimator, Gap, Mechanics, Observer};
 use crate::description::{Supply, Trajectory};
 
-/// The motion [takeoff, landing] must last at least this many sample periods.
-const MIN_SAMPLES_PER_MOTION: f64 = 10.0;
 /// Grid size of the fringing-denominator check on (0, z_max].
 const DENOMINATOR_GRID: usize = 1000;
 
@@ -160,7 +158,7 @@ pub(super) fn check_controller(
         );
         return Err(core_sect.err("model", msg, "not input-affine"));
     }
-    let limit = (t.landing - t.takeoff) / MIN_SAMPLES_PER_MOTION;
+    let limit = t.longest_sample_period();
     if c.sample_period > limit {
         let found = s
             .entry("sample_period")
