@@ -336,7 +336,8 @@ fn start_state(model: &mut Model, first: Option<Operation>) -> (State, Mode) {
 pub struct OperationOutcome {
     pub operation: Operation,
     /// The velocity [m/s] of the first impact at the operation's end stop
-    /// after its takeoff (signed); `None`: it never got there in time.
+    /// after its takeoff (signed; 0 where the armature arrives at rest and
+    /// sticks); `None`: it never got there in time.
     pub impact_velocity: Option<f64>,
     /// perfect-tracking-soft-landing [PT 69] (with the errata's square root):
     /// the RMS of z − z_r over the samples of the motion [t₀, t_f]; `None`
@@ -383,18 +384,20 @@ fn impacts(tr: &Trajectory, operation: Operation, from: f64, to: f64) -> (Option
     };
     let mut first = None;
     let mut bounces = 0;
-    for e in &tr.events {
-        if let EventKind::Impact {
-            limit,
-            v_before,
-            v_after,
-            ..
-        } = e.kind
-        {
-            if limit == destination && e.t > from && e.t <= to {
+    for e in tr.events.iter().filter(|e| e.t > from && e.t <= to) {
+        match e.kind {
+            EventKind::Impact {
+                limit,
+                v_before,
+                v_after,
+                ..
+            } if limit == destination => {
                 first = first.or(Some(v_before));
                 bounces += usize::from(v_after != 0.0);
             }
+            // arriving at rest: the softest landing there is
+            EventKind::Stick { limit } if limit == destination => first = first.or(Some(0.0)),
+            _ => {}
         }
     }
     (first, bounces)
@@ -529,4 +532,50 @@ pub fn sweep(
         .collect();
     // the first failing period in the order given, whatever the threads did
     rows.into_iter().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::Event;
+
+    fn trajectory(events: Vec<Event>) -> Trajectory {
+        Trajectory {
+            events,
+            ..Trajectory::default()
+        }
+    }
+
+    /// Arriving at the stop at rest (a stick, no impact) is a landing at
+    /// 0 m/s, not "never"; impacts elsewhere or outside the window do not count.
+    #[test]
+    fn a_stick_at_the_destination_is_a_landing_at_rest() {
+        let stick = |t, limit| Event {
+            t,
+            kind: EventKind::Stick { limit },
+            mode_after: Mode::StuckMin,
+        };
+        let impact = |t, limit, v_before, v_after| Event {
+            t,
+            kind: EventKind::Impact {
+                limit,
+                v_before,
+                v_after,
+                zeno: false,
+            },
+            mode_after: Mode::Free,
+        };
+        let tr = trajectory(vec![stick(2e-3, Limit::Min)]);
+        assert_eq!(impacts(&tr, Operation::Closing, 1e-3, 6e-3), (Some(0.0), 0));
+        assert_eq!(impacts(&tr, Operation::Opening, 1e-3, 6e-3), (None, 0));
+        let tr = trajectory(vec![
+            impact(0.5e-3, Limit::Min, -1.0, 0.3),
+            impact(2e-3, Limit::Min, -0.02, 0.006),
+            stick(2.1e-3, Limit::Min),
+        ]);
+        assert_eq!(
+            impacts(&tr, Operation::Closing, 1e-3, 6e-3),
+            (Some(-0.02), 1)
+        );
+    }
 }
