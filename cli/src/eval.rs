@@ -43,7 +43,7 @@ fn quantities(model: &mut Model) -> Vec<Quantity> {
         ("r_gap_dz2", 1, vec![r_gap_dz2]),
         ("df_dx", n * n, jacobian),
     ];
-    // Controller quantities exist for the input-affine (non-hysteretic) models.
+    // The chain z, v, a (H_c exogenous on the Jiles–Atherton core).
     if let Ok(lin) = Linearization::derive(model) {
         q.extend([
             ("alpha", 1, vec![lin.alpha]),

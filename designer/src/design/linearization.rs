@@ -10,11 +10,18 @@
 //! - model-free-sliding-mode-soft-landing [SM 25–26]: jerk j = f_j − B_j·u with
 //!   f_j = L_f³h and B_j = −L_g L_f²h.
 //!
-//! Parameters stay symbolic. The Jiles–Atherton core is excluded: its branch
-//! δ = sign(φ̇) depends on u, so f is not input-affine; design on a reluctance
-//! model of the same actuator instead.
+//! Parameters stay symbolic.
+//!
+//! **The Jiles–Atherton core** (state [z, v, φ, H_c]) is not input-affine as a
+//! whole: Ḣ_c's branch δ = sign(φ̇) depends on u. The output chain does not
+//! need that row: the force, so a = L_f²z, depends on (z, v, φ) only (checked),
+//! so L_f³z = ∂a/∂z·v + ∂a/∂v·a + ∂a/∂φ·φ̇ reads Ḣ_c nowhere, and φ̇ is affine in
+//! u with H_c in its drift (the MMF H_c·l_c, jiles-atherton-actuator-model
+//! [JA 15], [JA 92]). The chain is derived on the rows (z, v, φ) with H_c an
+//! exogenous state: α, β, L_f³z depend on H_c, which the observer supplies;
+//! T and T⁻¹ do not (T⁻¹ is given H_c: (ξ, H_c) ↦ (z, v, φ, H_c)), and Ḣ_c
+//! is the internal dynamics the linearization leaves alone.
 
-use crate::description::Core;
 use crate::model::Model;
 use crate::sym::{Graph, Id};
 
@@ -47,12 +54,15 @@ pub struct Linearization {
     pub flux_squared: Id,
     /// States whose zero makes L_g L_f²h vanish (relative degree lost), e.g. φ.
     pub singular_at: Vec<Id>,
+    /// States outside the chain (z, v, φ) that α, β and the jerk terms read:
+    /// H_c with the Jiles–Atherton core, none otherwise.
+    pub exogenous: Vec<Id>,
 }
 
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum DesignError {
-    #[error("the Jiles–Atherton core is not input-affine (its branch δ = sign(dφ/dt) depends on u): design the controller on a reluctance model of the same actuator (core.model = \"saturating\" or \"linear\")")]
-    Hysteretic,
+    #[error("the acceleration depends on the core's field state H_c: the chain z, v, a does not close on (z, v, φ)")]
+    FieldInForce,
     #[error("the model is not affine in the input u, so it cannot be feedback-linearized")]
     NotAffine,
     #[error("the output z does not have relative degree 3 (L_g L_f^k z ≡ 0 for k < 3): the input does not reach the position through the flux")]
@@ -64,12 +74,12 @@ pub enum DesignError {
 impl Linearization {
     /// Derives the linearization of `model` for y = z.
     pub fn derive(model: &mut Model) -> Result<Linearization, DesignError> {
-        if matches!(model.description.core, Core::JilesAtherton(_)) {
-            return Err(DesignError::Hysteretic);
-        }
         let (states, f, u) = (model.states.clone(), model.f.clone(), model.input);
+        // the chain's rows (z, v, φ); a field state H_c stays exogenous
+        let (chain_states, exogenous) = states.split_at(states.len().min(3));
         let g = &mut model.graph;
-        let system = AffineSystem::split(g, &states, &f, u).ok_or(DesignError::NotAffine)?;
+        let system = AffineSystem::split(g, chain_states, &f[..chain_states.len()], u)
+            .ok_or(DesignError::NotAffine)?;
         let z = states[0];
         let chain = system
             .output_derivatives(g, z, 3)
@@ -80,6 +90,10 @@ impl Linearization {
             });
         }
         let (accel, lf3h, lglf2h) = (chain.lf[2], chain.lf[3], chain.gain);
+        // [JA 39] the force reads φ, not H_c: L_f³z needs no Ḣ_c
+        if exogenous.iter().any(|&s| g.depends_on(accel, s)) {
+            return Err(DesignError::FieldInForce);
+        }
         // [PT 32]
         let ratio = g.div(lf3h, lglf2h);
         let alpha = g.neg(ratio);
@@ -101,6 +115,7 @@ impl Linearization {
             inverse,
             flux_squared,
             singular_at,
+            exogenous: exogenous.to_vec(),
             system,
         })
     }

@@ -103,7 +103,7 @@ impl OptimalSpec {
 /// Why [`energy_optimal`] failed.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum OptimalError {
-    #[error("the model has {0} states: the energy-optimal design needs the 3-state input-affine model [z, v, φ] (the Jiles–Atherton core is not input-affine)")]
+    #[error("the model has {0} states: the energy-optimal design (Pontryagin) needs a costate for every state, and the Jiles–Atherton core's Ḣ_c switches branch with sign(dφ/dt), which depends on u, so the Hamiltonian is not differentiable there; design the reference with trajectory.shape = \"polynomial\", or solve it on a \"saturating\" core fitted to the same valve and track it on this model")]
     NotAffine(usize),
     #[error("invalid optimal-control problem: {0}")]
     InvalidSpec(String),
