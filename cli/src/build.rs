@@ -93,11 +93,30 @@ fn report_json(design: &designer::design::Design) -> String {
             "lambda2": lambda2,
             "nonnegative_current": nonnegative_current,
         }),
+        LawDesign::ModelSlidingMode { p, k } => serde_json::json!({
+            "law": "model-sliding-mode",
+            "p": p,
+            "k": k,
+            "gains": c.law.tracking_gains(),
+        }),
     });
-    let gains = design.controller.as_ref().and_then(|c| match c.law {
-        LawDesign::FeedbackLinearization { gains } => Some(gains),
-        LawDesign::SlidingMode { .. } => None,
+    let law = law.or_else(|| {
+        design.hold.as_ref().map(|h| {
+            serde_json::json!({
+                "law": "model-sliding-mode",
+                "p": h.p,
+                "k": h.k,
+                "gains": h.gains(),
+                "position": h.position,
+                "holding_flux": h.holding_flux,
+                "holding_input": h.holding_input,
+                "phi_guard": h.phi_guard,
+            })
+        })
     });
+    let gains = (design.controller.as_ref())
+        .and_then(|c| c.law.tracking_gains())
+        .or_else(|| design.hold.as_ref().map(|h| h.gains()));
     let value = serde_json::json!({ "name": design.description.name, "controller": law, "gains": gains, "operations": operations });
     serde_json::to_string_pretty(&value).unwrap_or_default() + "\n"
 }

@@ -122,6 +122,15 @@ fn design_text(d: &Description) -> String {
             Law::FeedbackLinearization(Gains::Poles(p)) => {
                 format!("feedback linearization [PT 50], poles {p:?} s⁻¹")
             }
+            Law::ModelSlidingMode(m) => format!(
+                "model-based sliding mode [JA 89], p = {:e} s⁻¹, K = {:e} s⁻¹, {}",
+                m.p,
+                m.k,
+                match m.position {
+                    Some(z) => format!("holding z_ref = {z:e} m"),
+                    None => "tracking [trajectory]".into(),
+                }
+            ),
             Law::SlidingMode(m) => format!(
                 "model-free sliding mode [SM 34], λ₁ = {:e} s⁻¹, λ₂ = {:e} s⁻¹, η = {:e} m/s³{}",
                 m.lambda1,

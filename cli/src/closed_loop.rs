@@ -11,8 +11,10 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use designer::closed_loop::{
-    check_sample_period, resample_observer, run_loop, LoopRun, OperationOutcome,
+    check_sample_period, resample_observer, run_hold, run_loop, HoldOutcome, LoopRun,
+    OperationOutcome, HOLD_DURATION, SETTLED_FRACTION,
 };
+use designer::description::{Law, ModelSurface};
 use designer::design::Design;
 use designer::sim::Options;
 use miette::Report;
@@ -42,6 +44,10 @@ pub struct Args {
     /// Seed of the measurement noise, where an observer drives the controller
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// The plant's initial core field H_c [A/m] (a Jiles–Atherton plant; the observer
+    /// still starts from 0)
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
+    initial_field: f64,
 }
 
 pub fn run(args: &Args) -> Result<(), Report> {
@@ -55,7 +61,22 @@ pub fn run(args: &Args) -> Result<(), Report> {
     };
     let ts = positive("--sample-period", args.sample_period)?.unwrap_or(controller.sample_period);
     let duration = positive("--duration", args.duration)?;
-    check_sample_period(&description, ts).map_err(|e| fail(format!("{file}: {e}")))?;
+    if !args.initial_field.is_finite() {
+        return Err(fail(format!(
+            "--initial-field: expected a finite number [A/m], found {}",
+            args.initial_field
+        )));
+    }
+    let holds = matches!(
+        controller.law,
+        Law::ModelSlidingMode(ModelSurface {
+            position: Some(_),
+            ..
+        })
+    );
+    if !holds {
+        check_sample_period(&description, ts).map_err(|e| fail(format!("{file}: {e}")))?;
+    }
     let mut designed = description.clone();
     if let Some(c) = &mut designed.controller {
         c.sample_period = ts;
@@ -64,14 +85,26 @@ pub fn run(args: &Args) -> Result<(), Report> {
         resample_observer(o, ts);
     }
     let design = Design::new(&designed).map_err(|e| fail(format!("{file}: {e}")))?;
-    let run = run_loop(
-        &design,
-        plant.as_ref(),
-        ts,
-        duration,
-        args.seed,
-        &Options::default(),
-    )
+    let run = if holds {
+        run_hold(
+            &design,
+            plant.as_ref(),
+            ts,
+            duration,
+            args.seed,
+            args.initial_field,
+            &Options::default(),
+        )
+    } else {
+        run_loop(
+            &design,
+            plant.as_ref(),
+            ts,
+            duration,
+            args.seed,
+            &Options::default(),
+        )
+    }
     .map_err(|e| fail(format!("{file}: {e}")))?;
     let csv = to_csv(&run, design.model.dim() > 3);
     let svg = match &args.plot {
@@ -83,6 +116,12 @@ pub fn run(args: &Args) -> Result<(), Report> {
         files.push((path.as_path(), svg.as_bytes()));
     }
     atomic::write_all(&files).map_err(fail)?;
+    if holds {
+        let m = &description.mechanics;
+        let outcome = run.hold_outcome(m.z_max - m.z_min);
+        print!("{}", hold_summary(&outcome, run.z_ref.first().copied(), ts));
+        return Ok(());
+    }
     let t = description
         .trajectory
         .as_ref()
@@ -119,6 +158,41 @@ fn summary(outcomes: &[OperationOutcome], law: &str, ts: f64) -> String {
             o.rmse_z
                 .map_or("— (no sample)".into(), |r| format!("{r:.3e} m")),
             o.bounces
+        );
+    }
+    s
+}
+
+fn hold_summary(o: &HoldOutcome, z_ref: Option<f64>, ts: f64) -> String {
+    let mut s = format!(
+        "model-sliding-mode hold at z_ref = {:e} m, T_s = {ts:e} s\n",
+        z_ref.unwrap_or(f64::NAN)
+    );
+    let settled = o.settling_time.map_or(
+        format!("never settled within the run (default {HOLD_DURATION:e} s: --duration)"),
+        |t| {
+            format!(
+                "settled (within {} % of the stroke) at {:.3} ms",
+                SETTLED_FRACTION * 100.0,
+                t * 1e3
+            )
+        },
+    );
+    let _ = writeln!(s, "  {settled}");
+    let _ = writeln!(
+        s,
+        "  steady error {:+.3e} m (mean over the last fifth), band ±{:.3e} m",
+        o.steady_error, o.steady_band
+    );
+    if let Some(e) = &o.observer {
+        let hc = |x: Option<f64>| x.map_or(String::new(), |h| format!(", H_c {h:.3e} A/m"));
+        let _ = writeln!(
+            s,
+            "  observer error: transient max |Δz| {:.3e} m{}; steady RMS |Δz| {:.3e} m{}",
+            e.transient_z,
+            hc(e.transient_hc),
+            e.steady_z,
+            hc(e.steady_hc)
         );
     }
     s

@@ -193,7 +193,11 @@ fn limits_prints_json_and_a_plot_consistent_with_the_design() {
 
 #[test]
 fn limits_refuses_a_hysteretic_core_with_a_reason() {
-    rd!("limits", example_path("jiles-atherton-valve.toml")).rejected(&["Pontryagin", "sign(dφ/dt)", "polynomial"]);
+    rd!("limits", example_path("jiles-atherton-valve.toml")).rejected(&[
+        "Pontryagin",
+        "sign(dφ/dt)",
+        "polynomial",
+    ]);
 }
 
 #[test]

@@ -13,6 +13,7 @@ use crate::controller::{emit_controller, ControllerError, ControllerInput};
 use crate::emit::params_macro;
 use crate::error::EmitError;
 use crate::header::Header;
+use crate::hold::{emit_hold, HoldInput};
 use crate::observer::{
     emit_ekf, emit_kalman_macro, emit_ukf, wrap_module, ObserverError, ObserverInput,
 };
@@ -68,10 +69,28 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
             floats,
         };
         let emitted = match c.law {
-            LawDesign::FeedbackLinearization { .. } => emit_controller(&input),
+            LawDesign::FeedbackLinearization { .. } | LawDesign::ModelSlidingMode { .. } => {
+                emit_controller(&input)
+            }
             LawDesign::SlidingMode { .. } => emit_sliding_mode(&input),
         };
         modules.push(emitted.map_err(|source| BuildError::Emit {
+            file: file(),
+            source,
+        })?);
+    }
+    if let Some(h) = &design.hold {
+        let floats = d
+            .controller
+            .as_ref()
+            .map(|c| floats(&c.floats))
+            .unwrap_or_default();
+        let input = HoldInput {
+            model: &design.model,
+            design: h,
+            floats,
+        };
+        modules.push(emit_hold(&input).map_err(|source| BuildError::Emit {
             file: file(),
             source,
         })?);
@@ -143,12 +162,20 @@ fn invokes_params(module: &str) -> bool {
 fn header(design: &Design) -> String {
     let d = &design.description;
     let what = match design.controller.as_ref().map(|c| c.law) {
+        None if design.hold.is_some() => format!(
+            "position hold of `{}` (model-based sliding mode, [JA 89])",
+            d.name
+        ),
         Some(LawDesign::FeedbackLinearization { .. }) => format!(
             "perfect-tracking soft-landing controller of `{}` (feedback linearization, [PT 50])",
             d.name
         ),
         Some(LawDesign::SlidingMode { .. }) => format!(
             "soft-landing controller of `{}` (model-free sliding mode, [SM 34])",
+            d.name
+        ),
+        Some(LawDesign::ModelSlidingMode { .. }) => format!(
+            "soft-landing controller of `{}` (model-based sliding mode, [JA 89])",
             d.name
         ),
         None => format!("observers of `{}`", d.name),

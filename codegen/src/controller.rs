@@ -23,7 +23,7 @@
 //! rules. The emitted code has no `unwrap`, `expect`, indexing, `panic`,
 //! `as` or allocation, and depends only on `reldesign_runtime`.
 
-use designer::design::{ControllerDesign, LawDesign};
+use designer::design::{ControllerDesign, LawDesign, Linearization};
 use designer::model::Model;
 use designer::sym::{Graph, Id};
 use proc_macro2::TokenStream;
@@ -67,7 +67,7 @@ pub struct ControllerInput<'a> {
 }
 
 /// Names of the law's own constants (checked against the parameters' const names).
-const GAIN_CONSTS: &[&str] = &["GAIN_K1", "GAIN_K2", "GAIN_K3"];
+const GAIN_CONSTS: &[&str] = &["GAIN_K1", "GAIN_K2", "GAIN_K3", "SURFACE_P", "REACHING_K"];
 
 /// Symbols of the law's reference inputs and gains (must be new to the graph).
 const REF_SYMBOLS: [&str; 4] = ["z_ref", "v_ref", "a_ref", "j_ref"];
@@ -79,17 +79,46 @@ const GAIN_SYMBOLS: [&str; 3] = ["gain_k1", "gain_k2", "gain_k3"];
 /// them).
 pub fn emit_controller(input: &ControllerInput) -> Result<String, ControllerError> {
     let floats = checked_floats(input, GAIN_CONSTS)?;
-    let mut graph = input.model.graph.clone();
-    let law = LawSymbols::build(&mut graph, input.design, &input.model.named)?;
-    // MU0, Z_EPS as the file's params! declares them
-    let physical = in_scope(&mut graph, &of_model(input.model));
-    let f32 = floats.contains(&Float::F32);
-    let mut out = law_macro(&graph, input, &law, &physical, Scalar::Macro { f32 })?;
+    let source = LawSource {
+        model: input.model,
+        linearization: &input.design.linearization,
+        gains: fl_gains(input.design)?,
+        guarded: true,
+    };
+    let mut out = law_macro_text(&source, floats.contains(&Float::F32))?;
     for float in floats {
         out.push('\n');
         out.push_str(&float_module(input, float)?);
     }
     Ok(out)
+}
+
+/// What the law [PT 50] is emitted from: the model, its linearization and
+/// the gains K, and whether `guarded_law` (over the module's `control::Law`)
+/// is emitted too.
+pub struct LawSource<'a> {
+    pub model: &'a Model,
+    pub linearization: &'a Linearization,
+    pub gains: [f64; 3],
+    pub guarded: bool,
+}
+
+/// The `law!` macro of `source`, its literals typed for `f32` too if asked.
+pub fn law_macro_text(source: &LawSource, f32: bool) -> Result<String, ControllerError> {
+    let mut graph = source.model.graph.clone();
+    let law = LawSymbols::build(&mut graph, source.linearization, &source.model.named)?;
+    // MU0, Z_EPS as the file's params! declares them
+    let physical = in_scope(&mut graph, &of_model(source.model));
+    law_macro(&graph, source, &law, &physical, Scalar::Macro { f32 })
+}
+
+/// The law's state arguments: z, v, φ, and H_c on a Jiles–Atherton core.
+fn state_args(model: &Model) -> Vec<(&'static str, Id)> {
+    let names = ["z", "v", "phi", "hc"];
+    names
+        .into_iter()
+        .zip(model.states.iter().copied())
+        .collect()
 }
 
 /// The law's symbols and expressions in the (cloned) graph. The outputs
@@ -121,7 +150,7 @@ const STAGED_OUTPUTS: [&str; 4] = ["xi3", "lf3h", "beta", "w"];
 impl LawSymbols {
     fn build(
         g: &mut Graph,
-        design: &ControllerDesign,
+        lin: &Linearization,
         named: &[(&'static str, Id)],
     ) -> Result<LawSymbols, ControllerError> {
         let mut fresh = |name: &str| {
@@ -149,7 +178,6 @@ impl LawSymbols {
             fresh("law_w")?,
         ];
         let [xi3, lf3h, beta, w_sym] = staged;
-        let lin = &design.linearization;
         // [PT 41] T(x) = [z, v, ξ₃]
         let transform = [lin.transform[0], lin.transform[1], xi3];
         let mut terms = Vec::new();
@@ -199,23 +227,39 @@ type Comments = Vec<(&'static str, &'static str)>;
 /// every caller (one call, no stored outputs).
 fn law_terms(
     graph: &Graph,
-    input: &ControllerInput,
+    source: &LawSource,
     law: &LawSymbols,
     physical: &[Param],
     scalar: Scalar,
 ) -> Result<(TokenStream, Comments), ControllerError> {
-    let model = input.model;
+    let model = source.model;
     let mut params: Vec<Param> = model.params.iter().map(Param::from).collect();
     params.extend_from_slice(physical);
-    for ((&id, name), &k) in law
-        .gains
-        .iter()
-        .zip(GAIN_SYMBOLS)
-        .zip(&fl_gains(input.design)?)
-    {
+    for ((&id, name), &k) in law.gains.iter().zip(GAIN_SYMBOLS).zip(&source.gains) {
         params.push(Param::from((name, id, k)));
     }
-    let [z, v, phi] = [model.states[0], model.states[1], model.states[2]];
+    let mut inputs = state_args(model);
+    inputs.extend([
+        ("zr", law.refs[0]),
+        ("vr", law.refs[1]),
+        ("ar", law.refs[2]),
+        ("jr", law.refs[3]),
+    ]);
+    let field = if model.states.len() == 4 {
+        " with the core's\nfield H_c (which enters L_f³h through dφ/dt)"
+    } else {
+        ""
+    };
+    let see = if source.guarded {
+        ", see [`guarded_law`]"
+    } else {
+        ""
+    };
+    let doc = format!(
+        "The terms of the tracking law [PT 50] at the state x = [z, v, φ]{field} and the\n\
+         reference ξ_r = [z_r, v_r, a_r], z_r⁽³⁾ = j_r (not saturated, not guarded:\n\
+         φ = 0 makes β infinite{see})."
+    );
     let outputs = vec![
         ("xi3", law.xi3, "[PT 41] ξ₃ = a(x) = L_f²h"),
         ("lf3h", law.lf3h, "[PT 31] L_f³h"),
@@ -235,18 +279,8 @@ fn law_terms(
     let comments = outputs.iter().map(|&(n, _, d)| (n, d)).collect();
     let spec = FunctionSpec {
         name: "law_terms",
-        doc: "The terms of the tracking law [PT 50] at the state x = [z, v, φ] and the\n\
-              reference ξ_r = [z_r, v_r, a_r], z_r⁽³⁾ = j_r (not saturated, not guarded:\n\
-              φ = 0 makes β infinite, see [`guarded_law`]).",
-        inputs: vec![
-            ("z", z),
-            ("v", v),
-            ("phi", phi),
-            ("zr", law.refs[0]),
-            ("vr", law.refs[1]),
-            ("ar", law.refs[2]),
-            ("jr", law.refs[3]),
-        ],
+        doc: &doc,
+        inputs,
         outputs,
         named: law.named.clone(),
         output_symbols: STAGED_OUTPUTS.into_iter().zip(law.staged).collect(),
@@ -257,19 +291,30 @@ fn law_terms(
     Ok((tokens, comments))
 }
 
-/// K of [PT 48].
+/// K of [PT 48] (of the feedback-linearizing or the model-based
+/// sliding-mode law).
 fn fl_gains(d: &ControllerDesign) -> Result<[f64; 3], ControllerError> {
-    match d.law {
-        LawDesign::FeedbackLinearization { gains } => Ok(gains),
-        LawDesign::SlidingMode { .. } => {
-            Err(ControllerError::NotFeedbackLinearization("sliding-mode"))
-        }
-    }
+    d.law
+        .tracking_gains()
+        .ok_or(ControllerError::NotFeedbackLinearization("sliding-mode"))
 }
 
-/// The gains K [PT 48], documented.
+/// The gains K [PT 48], documented (with p and K of the model-based
+/// sliding mode [JA 88–93], whose law [JA 89] is [PT 50] with these gains).
 fn gain_consts(d: &ControllerDesign, float: Float) -> Result<TokenStream, ControllerError> {
     let [k1, k2, k3] = fl_gains(d)?;
+    if let LawDesign::ModelSlidingMode { p, k } = d.law {
+        return documented_consts(
+            float,
+            &[
+                ("SURFACE_P", p, "p [1/s] of the sliding surface s = (p + d/dt)²(z − z_r) [JA 88]."),
+                ("REACHING_K", k, "K [1/s] of the reaching law ṡ = −K·s [JA 93]."),
+                ("GAIN_K1", k1, "k1 = K·p² of K = [k1, k2, k3] [PT 48]: [JA 89] is [PT 50] with these gains (the error dynamics (d/dt + p)²(d/dt + K))."),
+                ("GAIN_K2", k2, "k2 = p² + 2p·K [PT 48]."),
+                ("GAIN_K3", k3, "k3 = 2p + K [PT 48]."),
+            ],
+        );
+    }
     documented_consts(
         float,
         &[
@@ -284,41 +329,77 @@ fn gain_consts(d: &ControllerDesign, float: Float) -> Result<TokenStream, Contro
 /// `guarded_law`, written once over the float type `$f`.
 fn law_macro(
     graph: &Graph,
-    input: &ControllerInput,
+    source: &LawSource,
     law: &LawSymbols,
     physical: &[Param],
     scalar: Scalar,
 ) -> Result<String, ControllerError> {
     let ty = scalar.ty();
-    let (law_fn, comments) = law_terms(graph, input, law, physical, scalar)?;
-    let law_args = quote!(z: #ty, v: #ty, phi: #ty, zr: #ty, vr: #ty, ar: #ty, jr: #ty);
+    let (law_fn, comments) = law_terms(graph, source, law, physical, scalar)?;
+    let state: Vec<_> = state_args(source.model)
+        .into_iter()
+        .map(|(name, _)| format_ident!("{name}"))
+        .collect();
+    let law_args = quote!(#(#state: #ty,)* zr: #ty, vr: #ty, ar: #ty, jr: #ty);
+    let call = quote!(#(#state,)* zr, vr, ar, jr);
+    // the runtime's state [z, v, φ, H_c]: H_c = 0 where the core has none
+    let runtime_state = if state.len() == 4 {
+        quote!([#(#state),*])
+    } else {
+        quote!([#(#state,)* 0.0])
+    };
+    let guarded = source.guarded.then(|| {
+        quote! {
+            /// The law [PT 50] as applied (`reldesign_runtime::control::guarded_law`): if
+            /// φ ≤ `PHI_GUARD` (φ → 0, where β = 1/L_g L_f²h blows up and D₀⁺ is left) it
+            /// is not evaluated and u = u_max drives the flux back into D₀⁺; otherwise u
+            /// of [PT 50]. Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
+            /// ±∞ to the bounds).
+            #[must_use]
+            pub fn guarded_law(#law_args) -> #ty {
+                control::guarded_law(&Design, #runtime_state, [zr, vr, ar, jr])
+            }
+        }
+    });
     let tokens = quote! {
         #law_fn
 
         /// u of the tracking law [PT 50], not saturated and not guarded.
         #[must_use]
         pub fn law(#law_args) -> #ty {
-            law_terms(z, v, phi, zr, vr, ar, jr).u
+            law_terms(#call).u
         }
 
-        /// The law [PT 50] as applied (`reldesign_runtime::control::guarded_law`): if
-        /// φ ≤ `PHI_GUARD` (φ → 0, where β = 1/L_g L_f²h blows up and D₀⁺ is left) it
-        /// is not evaluated and u = u_max drives the flux back into D₀⁺; otherwise u
-        /// of [PT 50]. Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
-        /// ±∞ to the bounds).
-        #[must_use]
-        pub fn guarded_law(#law_args) -> #ty {
-            control::guarded_law(&Design, [z, v, phi], [zr, vr, ar, jr])
-        }
+        #guarded
     };
     let text = comment_lets(&space_items(&format_items(tokens)?), "law_terms", &comments);
+    let functions = if source.guarded {
+        "`law_terms`, `law` and `guarded_law`"
+    } else {
+        "`law_terms` and `law`"
+    };
     let doc = format!(
         "The tracking law [PT 50] of `{}` over the float type `$f`, written once:\n\
-         `law_terms`, `law` and `guarded_law`, declared in each float module as `law!(f64)` /\n\
+         {functions}, declared in each float module as `law!(f64)` /\n\
          `law!(f32)` beside the module's `params!`, gains and `Design`.\n{MACRO_LITERALS}",
-        input.model.description.name
+        source.model.description.name
     );
     Ok(macro_rules("law", &doc, &text))
+}
+
+/// The pattern of the runtime's state [z, v, φ, H_c] in `Law::law`/`Hold::law`
+/// (H_c `_` where the core has none) and the `law_terms` call's state args.
+pub fn runtime_state_pattern(model: &Model) -> (TokenStream, TokenStream) {
+    let state: Vec<_> = state_args(model)
+        .into_iter()
+        .map(|(name, _)| format_ident!("{name}"))
+        .collect();
+    let pattern = if state.len() == 4 {
+        quote!([#(#state),*])
+    } else {
+        quote!([#(#state,)* _])
+    };
+    (pattern, quote!(#(#state),*))
 }
 
 /// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.
@@ -327,6 +408,7 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
     let module = format_ident!("{}", float.name());
     let design = input.design;
     let gains = gain_consts(design, float)?;
+    let (pattern, args) = runtime_state_pattern(input.model);
     let plan = plan_items(
         input.model,
         design,
@@ -347,8 +429,8 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
 
             impl control::Law<#ty> for Design {
                 #[inline(always)]
-                fn law(&self, [z, v, phi]: [#ty; 3], [zr, vr, ar, jr]: [#ty; 4]) -> #ty {
-                    law_terms(z, v, phi, zr, vr, ar, jr).u
+                fn law(&self, #pattern: [#ty; 4], [zr, vr, ar, jr]: [#ty; 4]) -> #ty {
+                    law_terms(#args, zr, vr, ar, jr).u
                 }
             }
 

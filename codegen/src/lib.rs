@@ -27,7 +27,8 @@
 //! | `error.rs` | [`EmitError`] |
 //! | `build.rs` | a description → the emitted file ([`build_file`], [`compile`], [`emit`]) |
 //! | `operations.rs` | what every controller module states: the plan's consts, tables, `Operation`, `Design` with `control::Plan` |
-//! | `controller.rs` | the feedback-linearizing controller: the `law!` macro and the float modules (over `reldesign_runtime::control`) |
+//! | `controller.rs` | the tracking-law controller (feedback linearization, and the model-based sliding mode [JA 89] which is it with other gains): the `law!` macro and the float modules (over `reldesign_runtime::control`) |
+//! | `hold.rs` | the position hold of the model-based sliding mode: the float modules (over `reldesign_runtime::hold`) |
 //! | `sliding.rs` | the model-free sliding-mode controller: λ₁, λ₂ and the float modules (over `reldesign_runtime::sliding`) |
 //! | `semera.rs` | the SEMERA and integral estimator modules |
 //! | `observer/` | the EKF and UKF: `model!` macros and float modules |
@@ -40,6 +41,7 @@ mod float;
 mod fold;
 mod format;
 mod header;
+mod hold;
 mod lower;
 mod names;
 mod observer;
@@ -59,6 +61,7 @@ pub use error::EmitError;
 pub use float::Float;
 pub use format::format_items;
 pub use header::{sha256_hex, Header};
+pub use hold::{emit_hold, HoldInput};
 pub use names::const_name;
 pub use observer::*;
 pub use param::Param;

@@ -15,7 +15,7 @@
 //! (seeded); otherwise the controller reads the plant's state.
 
 use crate::description::{Description, Operation};
-use crate::design::{operation_end, Design, RuntimeController, RuntimePlan};
+use crate::design::{operation_end, Design, RuntimeController, RuntimeHold, RuntimePlan};
 use crate::model::{Model, ModelPlant, Statics};
 use crate::observe::discrete::Estimate;
 use crate::observe::ekf::Ekf;
@@ -126,18 +126,14 @@ impl Sequencer<'_> {
             return 0.0;
         };
         let x = &m.x;
-        let [z, v, a, phi] = match &mut self.observer {
+        let (state, a) = match &mut self.observer {
             Some(o) => {
                 // the ADC samples i just before the new voltage is applied
                 let (i, _) = self.plant.current_and_voltage(m.t, x, o.held);
                 let (e, i) = o.step(i);
                 self.estimates.push((m.t, e));
-                [
-                    e.z,
-                    e.v,
-                    e.a,
-                    if self.nonnegative_current { i } else { e.phi },
-                ]
+                let phi = if self.nonnegative_current { i } else { e.phi };
+                ([e.z, e.v, phi, e.hc.unwrap_or(0.0)], e.a)
             }
             None => {
                 let mut dx: State = [0.0; crate::sim::MAX_DIM];
@@ -149,11 +145,12 @@ impl Sequencer<'_> {
                 } else {
                     x[2]
                 };
-                [x[0], x[1], a, phi]
+                // H_c: the plant's, where it has the state (x[3] is 0 otherwise)
+                ([x[0], x[1], phi, x[3]], a)
             }
         };
         self.z_ref.push((m.t, c.reference(m.t)[0]));
-        let u = c.step(m.t, z, v, a, phi);
+        let u = c.step(m.t, state, a);
         self.held = u;
         if let Some(o) = &mut self.observer {
             o.held = u;
@@ -244,6 +241,163 @@ pub fn run_loop(
         operation_length: length,
         estimates,
     })
+}
+
+/// Default length of a position-hold loop [s].
+pub const HOLD_DURATION: f64 = 20e-3;
+
+/// Runs `design`'s position hold ([JA §6.3]) at `sample_period` for
+/// `duration` (default [`HOLD_DURATION`]) on the model of `plant` (default:
+/// the design's own), from rest at z_max without flux and with the core's
+/// field at `initial_field` [A/m] (a Jiles–Atherton plant; the paper starts
+/// at 250 A/m); the observer of `[controller] estimator`, where named,
+/// drives it from the measured voltage and current (noise seeded by `seed`),
+/// starting from its own initial guess [z_max, z_max, 0, 0].
+pub fn run_hold(
+    design: &Design,
+    plant: Option<&Description>,
+    sample_period: f64,
+    duration: Option<f64>,
+    seed: u64,
+    initial_field: f64,
+    options: &Options,
+) -> Result<LoopRun, LoopError> {
+    let Some(h) = &design.hold else {
+        return Err(LoopError::NoController);
+    };
+    let plant_description = plant.unwrap_or(&design.description);
+    let mut plant_model = Model::build(plant_description);
+    if plant_model.dim() != design.model.dim() {
+        return Err(LoopError::PlantMismatch {
+            plant: plant_model.dim(),
+            design: design.model.dim(),
+        });
+    }
+    let model_plant = ModelPlant::new(&mut plant_model);
+    let mut design_model = design.model.clone();
+    let hold = RuntimeHold::new(&mut design_model, h).controller();
+    let mut observer = observer(design, sample_period, seed)?;
+    let (mut held, mut estimates, mut z_ref) = (0.0, Vec::new(), Vec::new());
+    let mut control = |_t: f64, m: &Measurement| {
+        let x = &m.x;
+        let state = match &mut observer {
+            Some(o) => {
+                // the ADC samples i just before the new voltage is applied
+                let (i, _) = model_plant.current_and_voltage(m.t, x, held);
+                let (e, _) = o.step(i);
+                estimates.push((m.t, e));
+                [e.z, e.v, e.phi, e.hc.unwrap_or(0.0)]
+            }
+            None => [x[0], x[1], x[2], x[3]],
+        };
+        z_ref.push((m.t, h.position));
+        let u = hold.step(state[0], state[1], state[2], state[3]);
+        held = u;
+        if let Some(o) = &mut observer {
+            o.held = u;
+        }
+        u
+    };
+    let (mut x0, mode0) = start_state(&mut plant_model, None);
+    if plant_model.dim() == 4 {
+        x0[3] = initial_field;
+    }
+    let t_end = duration.unwrap_or(HOLD_DURATION);
+    let trajectory = simulate_sampled(
+        &model_plant,
+        &mut control,
+        sample_period,
+        t_end,
+        x0,
+        mode0,
+        options,
+    )?;
+    let (current, _) =
+        model_plant.currents_and_voltages(&trajectory.t, &trajectory.x, &trajectory.u);
+    let z_ref = at_samples(&trajectory.t, &z_ref, h.position);
+    let estimates =
+        (observer.is_some()).then(|| at_samples(&trajectory.t, &estimates, NO_ESTIMATE));
+    Ok(LoopRun {
+        trajectory,
+        current,
+        z_ref,
+        operations: Vec::new(),
+        operation_length: t_end,
+        estimates,
+    })
+}
+
+/// What a position hold did ([JA §6.3], the paper's Fig. 10).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HoldOutcome {
+    /// The first time [s] after which |z − z_ref| stays within
+    /// [`SETTLED_FRACTION`] of the stroke; `None`: never within the run.
+    pub settling_time: Option<f64>,
+    /// Mean of z − z_ref over the run's last fifth [m].
+    pub steady_error: f64,
+    /// Where an observer drives the hold: the largest |ẑ − z| [m] and
+    /// |Ĥ_c − H_c| [A/m] before settling (the transient), and their RMS
+    /// over the last fifth (the steady state).
+    pub observer: Option<ObserverErrors>,
+    /// The largest |z − z_ref| over the last fifth [m].
+    pub steady_band: f64,
+}
+
+/// The observer's errors in a hold (see [`HoldOutcome::observer`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObserverErrors {
+    pub transient_z: f64,
+    pub transient_hc: Option<f64>,
+    pub steady_z: f64,
+    pub steady_hc: Option<f64>,
+}
+
+/// Settled: within this fraction of the stroke of z_ref.
+pub const SETTLED_FRACTION: f64 = 0.02;
+
+impl LoopRun {
+    /// The hold's figures; `stroke` is z_max − z_min.
+    pub fn hold_outcome(&self, stroke: f64) -> HoldOutcome {
+        let tr = &self.trajectory;
+        let n = tr.t.len();
+        let error = |k: usize| tr.x[k][0] - self.z_ref[k];
+        let settled_from = (0..n)
+            .rev()
+            .take_while(|&k| error(k).abs() <= SETTLED_FRACTION * stroke)
+            .last();
+        let settling_time = settled_from.map(|k| tr.t[k]);
+        let tail = n - n / 5;
+        let tail_len = (n - tail).max(1) as f64;
+        let steady_error = (tail..n).map(error).sum::<f64>() / tail_len;
+        let steady_band = (tail..n).map(|k| error(k).abs()).fold(0.0, f64::max);
+        let observer = self.estimates.as_ref().map(|e| {
+            let transient_end = settled_from.unwrap_or(n);
+            let z_err = |k: usize| e[k].z - tr.x[k][0];
+            let hc_err = |k: usize| e[k].hc.map(|h| h - tr.x[k][3]);
+            let finite_max = |it: &mut dyn Iterator<Item = f64>| {
+                it.filter(|x| x.is_finite())
+                    .fold(0.0, |a: f64, b| a.max(b.abs()))
+            };
+            let rms = |it: &mut dyn Iterator<Item = f64>| {
+                let v: Vec<f64> = it.filter(|x| x.is_finite()).collect();
+                (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt()
+            };
+            let has_field = e.iter().any(|x| x.hc.is_some());
+            ObserverErrors {
+                transient_z: finite_max(&mut (0..transient_end).map(z_err)),
+                transient_hc: has_field
+                    .then(|| finite_max(&mut (0..transient_end).filter_map(hc_err))),
+                steady_z: rms(&mut (tail..n).map(z_err)),
+                steady_hc: has_field.then(|| rms(&mut (tail..n).filter_map(hc_err))),
+            }
+        });
+        HoldOutcome {
+            settling_time,
+            steady_error,
+            observer,
+            steady_band,
+        }
+    }
 }
 
 /// The value recorded at or last before each output time (both in time

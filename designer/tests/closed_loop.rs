@@ -156,7 +156,7 @@ fn the_landed_band_is_the_descriptions() {
         let mut opening = RuntimePlan::new(&mut model, c).controller(Operation::Opening);
         (
             c.landed_band,
-            opening.step(6e-3, 1e-3 - 5e-7, 0.0, 0.0, 1e-5),
+            opening.step(6e-3, [1e-3 - 5e-7, 0.0, 1e-5, 0.0], 0.0),
         )
     };
     assert_eq!(step(&with_band), (1e-6, 0.0));

@@ -514,27 +514,48 @@ fn a_unipolar_supply_accepts_a_bound_above_u_min() {
     assert_eq!(d.trajectory.unwrap().u_bound, 20.0);
 }
 
+/// The Jiles–Atherton example's physics (its own design sections cut).
+fn ja_physics() -> String {
+    example_text("jiles-atherton-valve.toml")
+}
+
 #[test]
-fn jiles_atherton_core_takes_no_design_sections() {
-    let text = example_text("jiles-atherton-valve.toml") + TRAJECTORY;
-    let err = parse_str(&text, "ja.toml").expect_err("JA + trajectory");
-    assert_eq!(err.key(), "core.model");
+fn jiles_atherton_core_refuses_only_the_energy_optimal_trajectory() {
+    let text = ja_physics() + TRAJECTORY;
+    let err = parse_str(&text, "ja.toml").expect_err("JA + energy-optimal");
+    assert_eq!(err.key(), "trajectory.shape");
     assert!(
-        err.message().contains("T⁻¹") && err.message().contains("input-affine"),
+        err.message().contains("costate") && err.message().contains("polynomial"),
         "{err}"
     );
-    let text = example_text("jiles-atherton-valve.toml") + TRAJECTORY + CONTROLLER;
-    let err = parse_str(&text, "ja.toml").expect_err("JA + controller");
-    let line = text
-        .lines()
-        .position(|l| l.starts_with("model = \"jiles-atherton\""))
-        .unwrap()
-        + 1;
-    assert_eq!(
-        (err.key(), err.line(), err.column()),
-        ("core.model", line, 1)
-    );
-    assert!(err.message().contains("input-affine"), "{err}");
+    // a polynomial reference, tracked by each law
+    let polynomial = TRAJECTORY.replace("energy-optimal", "polynomial");
+    for controller in [
+        CONTROLLER.to_owned(),
+        CONTROLLER.replace(
+            "law = \"feedback-linearization\"\nsettling_time = 1e-3",
+            "law = \"model-sliding-mode\"\np = 1e3\nk = 1e4",
+        ),
+    ] {
+        let d = parse_str(&(ja_physics() + &polynomial + &controller), "ja.toml")
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(d.controller.is_some());
+    }
+}
+
+#[test]
+fn model_sliding_mode_holds_a_position_without_a_trajectory() {
+    let hold = "\n[controller]\nlaw = \"model-sliding-mode\"\np = 1e3\nk = 1e4\nposition = 4.5e-4\nsample_period = 5e-5\n";
+    let d = parse_str(&(ja_physics() + hold), "hold.toml").unwrap_or_else(|e| panic!("{e}"));
+    let Some(Law::ModelSlidingMode(s)) = d.controller.map(|c| c.law) else {
+        panic!("not the model-based sliding mode");
+    };
+    assert_eq!((s.p, s.k, s.position), (1e3, 1e4, Some(4.5e-4)));
+    // the stops are holdable positions too ([JA 94])
+    for z in ["0.0", "9e-4"] {
+        let text = ja_physics() + &hold.replace("4.5e-4", z);
+        assert!(parse_str(&text, "hold.toml").is_ok(), "{z}");
+    }
 }
 
 #[test]

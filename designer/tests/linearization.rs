@@ -149,7 +149,11 @@ fn jiles_atherton_chain_closes_on_z_v_phi_with_the_field_exogenous() {
     let tape = m.compile(&outs);
     let eval = |x: [f64; 4], u: f64| {
         let mut out = vec![0.0; tape.n_outputs()];
-        tape.eval(&[x[0], x[1], x[2], x[3], u, 0.0], &mut tape.scratch(), &mut out);
+        tape.eval(
+            &[x[0], x[1], x[2], x[3], u, 0.0],
+            &mut tape.scratch(),
+            &mut out,
+        );
         out
     };
     let mut checked = 0;
@@ -186,7 +190,11 @@ fn jiles_atherton_jerk_terms_are_odd_in_flux_and_field() {
     let tape = m.compile(&[lin.transform[2], lin.lf3h, lin.lglf2h]);
     let eval = |x: [f64; 4]| {
         let mut out = [0.0; 3];
-        tape.eval(&[x[0], x[1], x[2], x[3], 0.0, 0.0], &mut tape.scratch(), &mut out);
+        tape.eval(
+            &[x[0], x[1], x[2], x[3], 0.0, 0.0],
+            &mut tape.scratch(),
+            &mut out,
+        );
         out
     };
     for x in states(&m) {
@@ -195,8 +203,14 @@ fn jiles_atherton_jerk_terms_are_odd_in_flux_and_field() {
         // a is even in φ; dφ/dt is odd in (φ, H_c, u), ∂a/∂φ odd in φ:
         // the drift's jerk part ∂a/∂φ·φ̇ is even, the gain ∂a/∂φ·∂φ̇/∂u odd
         assert_eq!(plus[0], minus[0]);
-        assert!((plus[1] - minus[1]).abs() <= 1e-12 * plus[1].abs().max(1.0), "{plus:?} {minus:?}");
-        assert!((plus[2] + minus[2]).abs() <= 1e-12 * plus[2].abs(), "{plus:?} {minus:?}");
+        assert!(
+            (plus[1] - minus[1]).abs() <= 1e-12 * plus[1].abs().max(1.0),
+            "{plus:?} {minus:?}"
+        );
+        assert!(
+            (plus[2] + minus[2]).abs() <= 1e-12 * plus[2].abs(),
+            "{plus:?} {minus:?}"
+        );
     }
 }
 

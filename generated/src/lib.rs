@@ -22,3 +22,6 @@ pub mod sliding_mode_valve;
 /// Table I with the SEMERA and integral estimators of its Table II.
 #[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
 pub mod semera_valve;
+
+#[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
+pub mod jiles_atherton_valve;

@@ -219,7 +219,7 @@ macro_rules! law {
         /// ±∞ to the bounds).
         #[must_use]
         pub fn guarded_law(z: $f, v: $f, phi: $f, zr: $f, vr: $f, ar: $f, jr: $f) -> $f {
-            control::guarded_law(&Design, [z, v, phi], [zr, vr, ar, jr])
+            control::guarded_law(&Design, [z, v, phi, 0.0], [zr, vr, ar, jr])
         }
     };
 }
@@ -422,7 +422,7 @@ pub mod f32 {
 
     impl control::Law<f32> for Design {
         #[inline(always)]
-        fn law(&self, [z, v, phi]: [f32; 3], [zr, vr, ar, jr]: [f32; 4]) -> f32 {
+        fn law(&self, [z, v, phi, _]: [f32; 4], [zr, vr, ar, jr]: [f32; 4]) -> f32 {
             law_terms(z, v, phi, zr, vr, ar, jr).u
         }
     }
@@ -633,7 +633,7 @@ pub mod f64 {
 
     impl control::Law<f64> for Design {
         #[inline(always)]
-        fn law(&self, [z, v, phi]: [f64; 3], [zr, vr, ar, jr]: [f64; 4]) -> f64 {
+        fn law(&self, [z, v, phi, _]: [f64; 4], [zr, vr, ar, jr]: [f64; 4]) -> f64 {
             law_terms(z, v, phi, zr, vr, ar, jr).u
         }
     }

@@ -97,9 +97,11 @@ pub trait ConstPlan: Sized {
 
 /// A feedback-linearizing module: its plan and the tracking law [PT 50].
 pub trait Law<T>: Plan<T> {
-    /// u of the tracking law [PT 50] at the state x = [z, v, φ] and the reference
-    /// [z_r, v_r, a_r, j_r]: not guarded, not saturated.
-    fn law(&self, x: [T; 3], reference: [T; 4]) -> T;
+    /// u of the tracking law [PT 50] at the state x = [z, v, φ, H_c] and the
+    /// reference [z_r, v_r, a_r, j_r]: not guarded, not saturated. H_c, the
+    /// core's field, is read only by a design on a Jiles–Atherton core
+    /// (jiles-atherton-actuator-model [JA 89]: it enters L_f³z through dφ/dt).
+    fn law(&self, x: [T; 4], reference: [T; 4]) -> T;
 }
 
 /// [z_r, v_r, a_r, j_r] of one table row at τ = t − t_k (the integrals of
@@ -178,9 +180,9 @@ pub fn expert_rule<T: Scalar>(
 /// blows up and D₀⁺ is left) it is not evaluated and u = u_max drives the flux
 /// back into D₀⁺; otherwise [`Law::law`]. Saturated.
 #[inline]
-pub fn guarded_law<L: Law<T>, T: Scalar>(law: &L, x: [T; 3], reference: [T; 4]) -> T {
+pub fn guarded_law<L: Law<T>, T: Scalar>(law: &L, x: [T; 4], reference: [T; 4]) -> T {
     let settings = law.settings();
-    let [_, _, phi] = x;
+    let [_, _, phi, _] = x;
     if phi <= settings.phi_guard {
         return saturate(settings.u_max, &settings);
     }
@@ -326,12 +328,19 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
     /// The input u in [u_min, u_max] at time `t` [s] for the measured state
     /// x = [z, v, φ]: the hold rule at the end stop, else [`guarded_law`] at
     /// the reference of [`SoftLanding::reference`]. Finite for any input.
+    /// For a design on a Jiles–Atherton core use [`SoftLanding::step_with_field`].
     pub fn step(&mut self, t: T, z: T, v: T, phi: T) -> T {
+        self.step_with_field(t, z, v, phi, T::ZERO)
+    }
+
+    /// [`SoftLanding::step`] with the core's field H_c [A/m] (estimated by the
+    /// observer), which the law of a design on a Jiles–Atherton core reads.
+    pub fn step_with_field(&mut self, t: T, z: T, v: T, phi: T, hc: T) -> T {
         if let Some(u) = self.hold(self.tracker.elapsed(t), z, phi) {
             return u;
         }
         let reference = self.reference(t);
-        guarded_law(&self.law, [z, v, phi], reference)
+        guarded_law(&self.law, [z, v, phi, hc], reference)
     }
 }
 

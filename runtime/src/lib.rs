@@ -16,6 +16,7 @@
 )]
 
 pub mod control;
+pub mod hold;
 pub mod integral;
 pub mod linalg;
 // bit-level f64 logarithm: its index and exponent arithmetic is `as` by nature

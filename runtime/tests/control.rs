@@ -73,8 +73,8 @@ macro_rules! toy {
 
             impl Law<$f> for Toy {
                 /// u = 100·(z_r − z) + v_r − v + a_r + j_r + φ
-                fn law(&self, x: [$f; 3], r: [$f; 4]) -> $f {
-                    100.0 * (r[0] - x[0]) + r[1] - x[1] + r[2] + r[3] + x[2]
+                fn law(&self, x: [$f; 4], r: [$f; 4]) -> $f {
+                    100.0 * (r[0] - x[0]) + r[1] - x[1] + r[2] + r[3] + x[2] + x[3]
                 }
             }
 
@@ -148,13 +148,17 @@ macro_rules! toy {
                 let mut c = Ctl::new(Operation::Opening);
                 let (z, v, phi) = (0.1, 0.2, 0.5);
                 let r = c.clone().reference(1.5);
-                let want = Toy.law([z, v, phi], r);
+                let want = Toy.law([z, v, phi, 0.0], r);
                 assert!(want > -24.0 && want < 20.0, "{want}");
                 assert_eq!(c.step(1.5, z, v, phi), want);
+                // the field H_c reaches the law through step_with_field
+                let with_field = Toy.law([z, v, phi, 0.25], r);
+                assert_ne!(with_field, want);
+                assert_eq!(c.clone().step_with_field(1.5, z, v, phi, 0.25), with_field);
                 // the guard at φ ≤ phi_guard: u_max without evaluating the law
                 assert_eq!(c.step(1.5, z, v, 1e-3), 20.0);
                 assert_eq!(c.step(1.5, z, v, -0.5), 20.0);
-                assert_eq!(guarded_law(&Toy, [z, v, 0.0], r), 20.0);
+                assert_eq!(guarded_law(&Toy, [z, v, 0.0, 0.0], r), 20.0);
                 // saturation of a large law value, a NaN law value → 0
                 assert_eq!(c.step(1.5, -10.0, v, phi), 20.0);
                 assert_eq!(c.step(1.5, 10.0, v, phi), -24.0);

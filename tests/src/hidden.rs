@@ -682,15 +682,17 @@ pub fn hidden_case(
     hidden_case_of(&text, example_file, cause, excitation, with_z, seed)
 }
 
-/// `text` without its `[trajectory]` and `[controller]` sections (each from
-/// its header to the next header).
+/// `text` without its design sections `[trajectory]`, `[controller]` and
+/// `[observer…]` (each from its header to the next header).
 fn without_design_sections(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let mut skipping = false;
     for line in text.split_inclusive('\n') {
         let trimmed = line.trim_start();
         if trimmed.starts_with('[') {
-            skipping = trimmed.starts_with("[trajectory]") || trimmed.starts_with("[controller]");
+            skipping = ["[trajectory]", "[controller]", "[observer"]
+                .iter()
+                .any(|section| trimmed.starts_with(section));
         }
         if !skipping {
             out.push_str(line);

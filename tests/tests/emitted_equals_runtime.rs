@@ -58,7 +58,7 @@ fn sliding_mode_runtime_plan_equals_the_emitted_controller() {
             sm::f32::Controller::new(op32),
         );
         let [t, z, v, a, phi] = state(&mut rng, 1e-3, 6e-3);
-        let want = reference.step(t, z, v, a, phi);
+        let want = reference.step(t, [z, v, phi, 0.0], a);
         assert_eq!(
             e64.step(t, z, v, a, phi),
             want,
@@ -92,7 +92,7 @@ fn feedback_linearization_runtime_plan_equals_the_emitted_controller() {
             pt::f64::Operation::Opening
         });
         let [t, z, v, a, phi] = state(&mut rng, 1e-3, 7e-3);
-        let want = reference.step(t, z, v, a, phi);
+        let want = reference.step(t, [z, v, phi, 0.0], a);
         let got = emitted.step(t, z, v, phi);
         assert!(
             (got - want).abs() <= 1e-9 * want.abs().max(1.0),

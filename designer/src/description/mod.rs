@@ -230,6 +230,9 @@ pub enum Law {
     /// u = u_max·sgn(φ)·sgn*(s), model-free-sliding-mode-soft-landing [SM 34–35],
     /// with the expert rules [SM 43].
     SlidingMode(SlidingSurface),
+    /// u₂ of jiles-atherton-actuator-model [JA 89] on the surface [JA 88],
+    /// with the mode rules and saturation to [0, u_max] of [JA 94].
+    ModelSlidingMode(ModelSurface),
 }
 
 impl Law {
@@ -238,6 +241,7 @@ impl Law {
         match self {
             Law::FeedbackLinearization(_) => "feedback-linearization",
             Law::SlidingMode(_) => "sliding-mode",
+            Law::ModelSlidingMode(_) => "model-sliding-mode",
         }
     }
 }
@@ -256,6 +260,19 @@ pub struct SlidingSurface {
     /// current instead of φ's sign, takes sgn φ = +1 and never drives the
     /// current below 0.
     pub nonnegative_current: bool,
+}
+
+/// The model-based sliding-mode law's keys (jiles-atherton-actuator-model
+/// [JA §6.2]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModelSurface {
+    /// p [1/s] (> 0) of s = (p + d/dt)²(z − z_ref) [JA 88].
+    pub p: f64,
+    /// K [1/s] (> 0) of the reaching law ṡ = −K·s [JA 93].
+    pub k: f64,
+    /// z_ref [m]: a constant reference (a position hold); `None`: the
+    /// references of `[trajectory]`.
+    pub position: Option<f64>,
 }
 
 /// An estimator of `[observer].estimators`.

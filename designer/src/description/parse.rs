@@ -59,8 +59,8 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         .as_ref()
         .map(|s| design::parse_trajectory(s, &supply))
         .transpose()?;
-    if trajectory.is_some() {
-        checks::check_trajectory_core(&core_sect, &core)?;
+    if let (Some(s), Some(t)) = (&trajectory_sect, &trajectory) {
+        checks::check_trajectory_core(s, t, &core)?;
     }
     let controller_sect = root.opt_section("controller")?;
     let controller = controller_sect
@@ -68,7 +68,7 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         .map(design::parse_controller)
         .transpose()?;
     if let (Some(s), Some(c)) = (&controller_sect, &controller) {
-        checks::check_controller(&root, s, c, trajectory.as_ref(), &core_sect, &core)?;
+        checks::check_controller(&root, s, c, trajectory.as_ref(), &mechanics)?;
     }
     let observer = root
         .opt_section("observer")?

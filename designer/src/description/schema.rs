@@ -172,6 +172,7 @@ impl Key {
 /// The `[controller]` keys of each law.
 const FL: &[&str] = &["feedback-linearization"];
 const SM: &[&str] = &["sliding-mode"];
+const MSM: &[&str] = &["model-sliding-mode"];
 
 /// Every key, in the order of the reference (one key per line: a table).
 #[rustfmt::skip]
@@ -236,13 +237,16 @@ pub const KEYS: &[Key] = &[
     choice("trajectory.shape", &["energy-optimal", "polynomial"], "the motion: min ∫u² dt (Pontryagin), or the degree-5 polynomial"),
     number("trajectory.u_bound", Domain::Positive, "V", Presence::Required, "the design uses inputs in [max(u_min, −u_bound), u_bound]; max(0, u_min) < u_bound ≤ u_max; the rest is the feedback's (A with drive = \"current\")"),
     // [controller]
-    choice("controller.law", &["feedback-linearization", "sliding-mode"], "the control law: feedback linearization [PT 50], or the model-free sliding mode [SM 34–35] with the expert rules [SM 43]"),
+    choice("controller.law", &["feedback-linearization", "sliding-mode", "model-sliding-mode"], "the control law: feedback linearization [PT 50], the model-free sliding mode [SM 34–35] with the expert rules [SM 43], or the model-based sliding mode [JA 89] with the mode rules [JA 94]"),
     Key { variants: FL, ..number("controller.settling_time", Domain::Positive, "s", Presence::When("exactly one of settling_time and poles"), "5 % settling time of the error dynamics with a triple real pole") },
     numbers("controller.poles", FL, Domain::Negative, "1/s", Presence::When("exactly one of settling_time and poles"), "the three real closed-loop poles of the error dynamics"),
     Key { variants: SM, ..number("controller.lambda1", Domain::Positive, "1/s", Presence::Required, "λ₁ of the sliding surface s = (λ₁ + d/dt)(λ₂ + d/dt)(z − z_r) [SM 17]") },
     Key { variants: SM, ..number("controller.lambda2", Domain::Positive, "1/s", Presence::Required, "λ₂ of the sliding surface [SM 17]") },
     Key { variants: SM, ..number("controller.eta", Domain::Positive, "m/s³", Presence::Required, "η of the reaching condition s·ṡ ≤ −η·|s| [SM 20]: enters the robustness bound [SM 49], not the emitted law") },
     Key { variants: SM, kind: Kind::Bool, ..number("controller.nonnegative_current", Domain::Any, "", Presence::Optional("false: the step reads φ (measured or estimated) for its sign"), "the current is kept ≥ 0 [SM §5]: the step reads the coil current instead of φ, takes sgn φ = +1 and never drives the current below 0") },
+    Key { variants: MSM, ..number("controller.p", Domain::Positive, "1/s", Presence::Required, "p of the sliding surface s = (p + d/dt)²(z − z_ref) [JA 88]") },
+    Key { variants: MSM, ..number("controller.k", Domain::Positive, "1/s", Presence::Required, "K of the reaching law ṡ = −K·s [JA 93]: with p, the error dynamics (d/dt + p)²(d/dt + K)") },
+    Key { variants: MSM, ..number("controller.position", Domain::Any, "m", Presence::When("exactly one of position and a [trajectory] section"), "z_ref: hold the armature at this constant position in [z_min, z_max] [JA §6.3]") },
     number("controller.sample_period", Domain::Positive, "s", Presence::Required, "T_s: the emitted step runs once per sample; at most (landing − takeoff)/10"),
     names("controller.float", &["f32", "f64"], Presence::Optional("both"), "the float types to emit code for"),
     Key { kind: Kind::Choice(&["ekf", "ukf"]), ..number("controller.estimator", Domain::Any, "", Presence::Optional("the closed loops of `loop` and `sweep` feed the controller the plant's state"), "the observer of [observer] that drives the controller in `reldesign loop` and `sweep` from the measured voltage and current (it must be listed in observer.estimators)") },

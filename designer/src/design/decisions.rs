@@ -99,9 +99,31 @@ pub enum LawDesign {
         lambda2: f64,
         nonnegative_current: bool,
     },
+    /// p of the surface [JA 88] and K of the reaching law [JA 93]: the law
+    /// [JA 89] is the tracking law [PT 50] with the gains
+    /// [`model_sliding_gains`].
+    ModelSlidingMode { p: f64, k: f64 },
+}
+
+/// The gains K of [PT 48] that make [PT 50] the model-based sliding-mode law
+/// [JA 89]: with e = x − x_r, [JA 89] asks z⁽³⁾ = j_r − 2p·ė_a… precisely
+/// w = j_r − 2p·e_a − p²·e_v − K·s, s = e_a + 2p·e_v + p²·e_z [JA 88], so
+/// w = j_r − (2p + K)·e_a − (p² + 2pK)·e_v − K·p²·e_z: K = [K·p², p² + 2pK,
+/// 2p + K], the error dynamics (d/dt + p)²(d/dt + K).
+pub fn model_sliding_gains(p: f64, k: f64) -> [f64; 3] {
+    [k * p * p, p * p + 2.0 * p * k, 2.0 * p + k]
 }
 
 impl LawDesign {
+    /// K of the tracking law [PT 50], for the laws that are it.
+    pub fn tracking_gains(&self) -> Option<[f64; 3]> {
+        match *self {
+            LawDesign::FeedbackLinearization { gains } => Some(gains),
+            LawDesign::ModelSlidingMode { p, k } => Some(model_sliding_gains(p, k)),
+            LawDesign::SlidingMode { .. } => None,
+        }
+    }
+
     /// The values that must be positive and finite, by name.
     fn positive_values(&self) -> Vec<(String, f64)> {
         match *self {
@@ -113,6 +135,7 @@ impl LawDesign {
             LawDesign::SlidingMode {
                 lambda1, lambda2, ..
             } => vec![("lambda1".into(), lambda1), ("lambda2".into(), lambda2)],
+            LawDesign::ModelSlidingMode { p, k } => vec![("p".into(), p), ("k".into(), k)],
         }
     }
 }
@@ -261,7 +284,7 @@ fn check(spec: &ControllerSpec, operations: &[DesignedOperation]) -> Result<f64,
 
 /// `x > 0` rounded down to one significant digit (so that a small change of
 /// the design does not change the emitted threshold).
-fn round_down_1sig(x: f64) -> f64 {
+pub(super) fn round_down_1sig(x: f64) -> f64 {
     let e = x.log10().floor();
     let digit = (x / 10f64.powf(e)).floor().clamp(1.0, 9.0);
     format!("{digit}e{e}").parse().unwrap_or(x)

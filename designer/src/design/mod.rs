@@ -13,6 +13,8 @@
 //! - `segments.rs`: a reference as a compact table of polynomial segments;
 //! - `decisions.rs`: the controller's design decisions (gains, guard, landed
 //!   band, press, creep) as plain data, [`ControllerDesign`];
+//! - `hold.rs`: the position hold of the model-based sliding mode [JA §6.2]
+//!   as plain data, [`HoldDesign`];
 //! - `plan.rs`: description → [`Design`] (controller and Kalman model), the
 //!   pipeline up to code generation;
 //! - `report.rs`: the design report of `reldesign build`;
@@ -27,6 +29,7 @@ mod bvp;
 mod decisions;
 mod feasibility;
 mod fit_segments;
+mod hold;
 mod lie;
 mod limits;
 mod linearization;
@@ -46,14 +49,15 @@ pub use bvp::{
     BvpSolution,
 };
 pub use decisions::{
-    gains, triple_pole_settling_product, ControllerDesign, ControllerSpec, DesignedOperation,
-    LawDesign,
+    gains, model_sliding_gains, triple_pole_settling_product, ControllerDesign, ControllerSpec,
+    DesignedOperation, LawDesign,
 };
 pub use feasibility::{check as check_feasibility, Condition, Feasibility};
 pub use fit_segments::{
     fit_segments, knot_jumps, table_errors, FitError, SegmentFit, SegmentTolerance, Signal,
     Signals, TableErrors, ACCEPT,
 };
+pub use hold::{design_hold, HoldDesign};
 pub use lie::{lie, vanishing_factors, AffineSystem, OutputDerivatives};
 pub use limits::{motion_limits, CostPoint, MotionLimits};
 pub use linearization::{DesignError, Linearization};
@@ -67,5 +71,5 @@ pub use plan::{
 };
 pub use reference::{Flat, Polynomial, Reference};
 pub use robustness::{operation_end, ErrorBounds, Evaluator, Robustness, Sample};
-pub use runtime::{RuntimeController, RuntimePlan};
+pub use runtime::{RuntimeController, RuntimeHold, RuntimePlan};
 pub use segments::{Segment, Segments};

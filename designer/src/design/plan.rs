@@ -18,6 +18,7 @@ use crate::observe::discrete::{DiscreteModel, KalmanSettings, ResistanceSettings
 use super::decisions::{gains, ControllerDesign, ControllerSpec, DesignedOperation, LawDesign};
 use super::feasibility::check as check_feasibility;
 use super::fit_segments::{fit_segments, SegmentTolerance};
+use super::hold::{design_hold, HoldDesign};
 use super::linearization::{DesignError, Linearization};
 use super::optimal::{energy_optimal, OptimalError, OptimalSpec, OptimalTrajectory};
 use super::reference::{Polynomial, Reference};
@@ -93,6 +94,23 @@ pub enum PlanError {
         u_max: f64,
         hint: String,
     },
+    #[error(
+        "controller.position = {position:e} m cannot be held: at rest there the flux would \
+         need φ² = {flux_squared:e} Wb² (must be > 0: the magnet only attracts, so the spring \
+         must push away from z_min there); choose a position where the spring pushes the \
+         armature open"
+    )]
+    Unholdable { position: f64, flux_squared: f64 },
+    #[error(
+        "controller.position = {position:e} m needs a steady input of {input:.4} to hold \
+         (R·i of the flux that balances the spring there), but supply.u_max = {u_max}: \
+         choose a position nearer z_max or a larger supply.u_max"
+    )]
+    HoldingInput {
+        position: f64,
+        input: f64,
+        u_max: f64,
+    },
     #[error("internal error: the symbol `{0}` of the linearization is unbound")]
     UnboundSymbol(String),
 }
@@ -113,6 +131,8 @@ pub struct Design {
     pub model: Model,
     /// From `[trajectory]` + `[controller]`.
     pub controller: Option<ControllerDesign>,
+    /// From `[controller]` with law "model-sliding-mode" and `position`.
+    pub hold: Option<HoldDesign>,
     /// The EKF/UKF discretised model, from `[observer]` with "ekf" or "ukf".
     pub kalman: Option<DiscreteModel>,
 }
@@ -122,19 +142,28 @@ impl Design {
     /// and `[observer]` ask for.
     pub fn new(description: &Description) -> Result<Design, PlanError> {
         let mut model = Model::build(description);
-        let controller = match (&description.trajectory, &description.controller) {
-            (Some(_), Some(_)) => Some(design_controller(description, &mut model)?),
-            (None, None) => None,
+        let held = description.controller.as_ref().and_then(|c| match c.law {
+            Law::ModelSlidingMode(s) => s.position.map(|z| (s, z)),
+            _ => None,
+        });
+        let (controller, hold) = match (&description.trajectory, &description.controller, held) {
+            (None, Some(_), Some((surface, z))) => (
+                None,
+                Some(design_hold(description, &mut model, &surface, z)?),
+            ),
+            (Some(_), Some(_), _) => (Some(design_controller(description, &mut model)?), None),
+            (None, None, _) => (None, None),
             _ => return Err(PlanError::TrajectoryWithoutController),
         };
         let kalman = design_kalman(description, &model)?;
-        if controller.is_none() && description.observer.is_none() {
+        if controller.is_none() && hold.is_none() && description.observer.is_none() {
             return Err(PlanError::NothingToBuild);
         }
         Ok(Design {
             description: description.clone(),
             model,
             controller,
+            hold,
             kalman,
         })
     }
@@ -170,11 +199,12 @@ pub fn design_controller(
                 nonnegative_current: surface.nonnegative_current,
             }
         }
+        Law::ModelSlidingMode(s) => LawDesign::ModelSlidingMode { p: s.p, k: s.k },
     };
     let spec = ControllerSpec {
         law,
         sample_period: controller.sample_period,
-        u_min: description.supply.u_min,
+        u_min: lowest_input(description),
         u_max: description.supply.u_max,
         takeoff: trajectory.takeoff,
         landing: trajectory.landing,
@@ -182,6 +212,15 @@ pub fn design_controller(
         landed_band: controller.landed_band,
     };
     ControllerDesign::decide(model, linearization, &spec, operations)
+}
+
+/// The controller's lowest input: the supply's, or 0 for the model-based
+/// sliding mode, which saturates to [0, u_max] [JA 94].
+fn lowest_input(description: &Description) -> f64 {
+    match description.controller.as_ref().map(|c| c.law) {
+        Some(Law::ModelSlidingMode(_)) => description.supply.u_min.max(0.0),
+        _ => description.supply.u_min,
+    }
 }
 
 /// A reference of `[trajectory]`, shareable across threads.
@@ -233,7 +272,7 @@ fn design_bounds(
 ) -> ((f64, f64), Polynomial) {
     let mech = &description.mechanics;
     let bounds = (
-        description.supply.u_min.max(-trajectory.u_bound),
+        lowest_input(description).max(-trajectory.u_bound),
         trajectory.u_bound,
     );
     let (z0, zf) = match operation {

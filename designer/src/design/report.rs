@@ -14,6 +14,20 @@ impl Design {
     /// The report (one block per operation, then the observers).
     pub fn report(&self) -> String {
         let mut s = String::new();
+        if let Some(h) = &self.hold {
+            let [k1, k2, k3] = h.gains();
+            let _ = writeln!(
+                s,
+                "model-based sliding mode [JA 89]: p = {:e} s⁻¹, K = {:e} s⁻¹ (the tracking law [PT 50] with K = [{k1:e}, {k2:e}, {k3:e}])",
+                h.p, h.k
+            );
+            let _ = writeln!(s, "{}", h.linearization.singularity_text(&self.model.graph));
+            let _ = writeln!(
+                s,
+                "hold at z_ref = {:e} m: flux {:.4e} Wb, steady input {:.4} (supply ≤ {}), guard φ ≤ {:e} Wb",
+                h.position, h.holding_flux, h.holding_input, h.u_max, h.phi_guard
+            );
+        }
         if let Some(c) = &self.controller {
             let _ = writeln!(s, "{}", law_text(&c.law));
             let _ = writeln!(s, "{}", c.linearization.singularity_text(&self.model.graph));
@@ -111,5 +125,11 @@ fn law_text(law: &LawDesign) -> String {
                 ""
             }
         ),
+        LawDesign::ModelSlidingMode { p, k } => {
+            let [k1, k2, k3] = super::decisions::model_sliding_gains(p, k);
+            format!(
+                "model-based sliding mode [JA 89]: p = {p:e} s⁻¹, K = {k:e} s⁻¹ (the tracking law [PT 50] with K = [{k1:e}, {k2:e}, {k3:e}]), inputs in [0, u_max] [JA 94]"
+            )
+        }
     }
 }

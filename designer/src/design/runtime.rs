@@ -1,5 +1,6 @@
 //! A design as the runtime runs it: the runtime's `Plan`, `Law` and `Surface`
-//! traits implemented on a [`ControllerDesign`], so that the designer's closed
+//! traits implemented on a [`ControllerDesign`] (and `Hold` on a
+//! [`HoldDesign`]), so that the designer's closed
 //! loops (`reldesign loop`, `sweep`) run the very operation logic the emitted
 //! code runs (`reldesign_runtime::control`, `::sliding`), with the model's
 //! functions evaluated from tapes where the emitted file has code.
@@ -10,6 +11,7 @@
 use std::cell::RefCell;
 
 use reldesign_runtime::control::{Landing, Law, Motion, Plan, Settings, SoftLanding};
+use reldesign_runtime::hold::{Hold, HoldSettings, PositionHold};
 use reldesign_runtime::sliding::{SlidingMode, Surface, SurfaceSettings};
 
 use crate::description::Operation;
@@ -17,13 +19,49 @@ use crate::model::Model;
 use crate::sym::Tape;
 
 use super::decisions::{ControllerDesign, LawDesign};
+use super::hold::HoldDesign;
+use super::linearization::Linearization;
 
-/// The design's plan, with the feedback-linearizing law's tape where that is
-/// the law.
+/// The tracking law [PT 50] from a tape: (x, u, t) → [α, β, a(x)] [PT 32],
+/// [PT 41], x the model's states (H_c too on the Jiles–Atherton core).
+struct LawTape {
+    tape: Tape,
+    scratch: RefCell<Vec<f64>>,
+    /// The model's number of states (3, or 4 with H_c).
+    dim: usize,
+}
+
+impl LawTape {
+    fn new(model: &mut Model, lin: &Linearization) -> LawTape {
+        let tape = model.compile(&[lin.alpha, lin.beta, lin.transform[2]]);
+        let scratch = RefCell::new(tape.scratch());
+        LawTape {
+            tape,
+            scratch,
+            dim: model.dim(),
+        }
+    }
+
+    /// [PT 50] u = α + β·(K·(ξ_r − T(x)) + j_r), T(x) = [z, v, a(x)].
+    fn law(&self, gains: [f64; 3], x: [f64; 4], [zr, vr, ar, jr]: [f64; 4]) -> f64 {
+        let mut inputs = [0.0; 6];
+        inputs[..self.dim].copy_from_slice(&x[..self.dim]);
+        let mut out = [0.0; 3];
+        let n = self.dim + 2;
+        (self.tape).eval(&inputs[..n], &mut self.scratch.borrow_mut(), &mut out);
+        let [alpha, beta, a] = out;
+        let [k1, k2, k3] = gains;
+        let [z, v, ..] = x;
+        let w = k1 * (zr - z) + k2 * (vr - v) + k3 * (ar - a) + jr;
+        alpha + beta * w
+    }
+}
+
+/// The design's plan, with the tracking law's tape where the law is one
+/// (feedback linearization, the model-based sliding mode).
 pub struct RuntimePlan<'a> {
     design: &'a ControllerDesign,
-    /// (z, v, φ, u, t) → [α, β, a(x)] [PT 32], [PT 41], with its scratch.
-    law: Option<(Tape, RefCell<Vec<f64>>)>,
+    law: Option<LawTape>,
 }
 
 /// One of the two controllers, ready to step.
@@ -35,22 +73,14 @@ pub enum RuntimeController<'a> {
 impl<'a> RuntimePlan<'a> {
     /// The plan of `design` on `model` (the model the design was made on).
     pub fn new(model: &mut Model, design: &'a ControllerDesign) -> RuntimePlan<'a> {
-        let lin = &design.linearization;
-        let law = match design.law {
-            LawDesign::FeedbackLinearization { .. } => {
-                let tape = model.compile(&[lin.alpha, lin.beta, lin.transform[2]]);
-                let scratch = RefCell::new(tape.scratch());
-                Some((tape, scratch))
-            }
-            LawDesign::SlidingMode { .. } => None,
-        };
+        let law = (design.law.tracking_gains()).map(|_| LawTape::new(model, &design.linearization));
         RuntimePlan { design, law }
     }
 
     /// The controller of `operation`, started at t = 0.
     pub fn controller(self, operation: Operation) -> RuntimeController<'a> {
         match self.design.law {
-            LawDesign::FeedbackLinearization { .. } => {
+            LawDesign::FeedbackLinearization { .. } | LawDesign::ModelSlidingMode { .. } => {
                 RuntimeController::FeedbackLinearization(SoftLanding::with(self, operation))
             }
             LawDesign::SlidingMode { .. } => {
@@ -77,12 +107,13 @@ impl RuntimeController<'_> {
         }
     }
 
-    /// The input at `t` for the state [z, v, φ] and the acceleration a
-    /// (which only the sliding mode reads; `phi` is the current where the
-    /// sliding mode keeps it non-negative).
-    pub fn step(&mut self, t: f64, z: f64, v: f64, a: f64, phi: f64) -> f64 {
+    /// The input at `t` for the state [z, v, φ, H_c] and the acceleration a
+    /// (which only the model-free sliding mode reads; `phi` is the current
+    /// where it keeps the current non-negative; H_c only a law on a
+    /// Jiles–Atherton core reads).
+    pub fn step(&mut self, t: f64, [z, v, phi, hc]: [f64; 4], a: f64) -> f64 {
         match self {
-            RuntimeController::FeedbackLinearization(c) => c.step(t, z, v, phi),
+            RuntimeController::FeedbackLinearization(c) => c.step_with_field(t, z, v, phi, hc),
             RuntimeController::SlidingMode(c) => c.step(t, z, v, a, phi),
         }
     }
@@ -136,21 +167,11 @@ impl Plan<f64> for RuntimePlan<'_> {
 
 impl Law<f64> for RuntimePlan<'_> {
     /// [PT 50] u = α + β·(K·(ξ_r − T(x)) + j_r), T(x) = [z, v, a(x)].
-    fn law(&self, [z, v, phi]: [f64; 3], [zr, vr, ar, jr]: [f64; 4]) -> f64 {
-        let (
-            Some((tape, scratch)),
-            LawDesign::FeedbackLinearization {
-                gains: [k1, k2, k3],
-            },
-        ) = (&self.law, self.design.law)
-        else {
-            return f64::NAN;
-        };
-        let mut out = [0.0; 3];
-        tape.eval(&[z, v, phi, 0.0, 0.0], &mut scratch.borrow_mut(), &mut out);
-        let [alpha, beta, a] = out;
-        let w = k1 * (zr - z) + k2 * (vr - v) + k3 * (ar - a) + jr;
-        alpha + beta * w
+    fn law(&self, x: [f64; 4], reference: [f64; 4]) -> f64 {
+        match (&self.law, self.design.law.tracking_gains()) {
+            (Some(tape), Some(gains)) => tape.law(gains, x, reference),
+            _ => f64::NAN,
+        }
     }
 }
 
@@ -166,11 +187,52 @@ impl Surface<f64> for RuntimePlan<'_> {
                 lambda2,
                 nonnegative_current,
             },
-            LawDesign::FeedbackLinearization { .. } => SurfaceSettings {
-                lambda1: f64::NAN,
-                lambda2: f64::NAN,
-                nonnegative_current: false,
-            },
+            LawDesign::FeedbackLinearization { .. } | LawDesign::ModelSlidingMode { .. } => {
+                SurfaceSettings {
+                    lambda1: f64::NAN,
+                    lambda2: f64::NAN,
+                    nonnegative_current: false,
+                }
+            }
         }
+    }
+}
+
+/// A position hold as the runtime runs it: the runtime's `Hold` on a
+/// [`HoldDesign`], the law [JA 89] from a tape.
+pub struct RuntimeHold<'a> {
+    design: &'a HoldDesign,
+    law: LawTape,
+}
+
+impl<'a> RuntimeHold<'a> {
+    /// The hold of `design` on `model` (the model the design was made on).
+    pub fn new(model: &mut Model, design: &'a HoldDesign) -> RuntimeHold<'a> {
+        let law = LawTape::new(model, &design.linearization);
+        RuntimeHold { design, law }
+    }
+
+    /// The runtime's controller over this plan.
+    pub fn controller(self) -> PositionHold<RuntimeHold<'a>, f64> {
+        PositionHold::with(self)
+    }
+}
+
+impl Hold<f64> for RuntimeHold<'_> {
+    fn settings(&self) -> HoldSettings<f64> {
+        let d = self.design;
+        HoldSettings {
+            position: d.position,
+            z_min: d.z_min,
+            z_max: d.z_max,
+            u_max: d.u_max,
+            phi_guard: d.phi_guard,
+            landed_band: d.landed_band,
+        }
+    }
+
+    /// [JA 89] as [PT 50] with K = [K·p², p² + 2pK, 2p + K].
+    fn law(&self, x: [f64; 4], reference: [f64; 4]) -> f64 {
+        self.law.law(self.design.gains(), x, reference)
     }
 }

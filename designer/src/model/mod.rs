@@ -27,7 +27,7 @@ pub use self::core::LANGEVIN_SERIES_BELOW;
 pub use gap::{MU0, Z_EPS};
 pub use params::Params;
 pub use plant::{ModelPlant, PlantError};
-pub use statics::{Statics, SwitchingPoint};
+pub use statics::{anhysteretic_field, rest_point, Statics, SwitchingPoint};
 pub use table::{Spline, SplineKind};
 
 use crate::description::{Core, Description, Drive, Gap};

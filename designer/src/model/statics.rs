@@ -101,6 +101,19 @@ impl Statics {
     }
 }
 
+/// The steady point at rest at `z` with `flux` (φ̇ = 0: N·i = R_gap·φ +
+/// MMF_core(φ), the Jiles–Atherton core on its anhysteretic curve).
+pub fn rest_point(model: &mut Model, z: f64, flux: f64) -> SwitchingPoint {
+    let gap = GapCurve::new(model);
+    let d = &model.description;
+    let current = (gap.value(z) * flux + CoreCurve(&d.core).mmf(flux)) / d.coil.turns;
+    SwitchingPoint {
+        flux,
+        current,
+        voltage: d.coil.resistance * current,
+    }
+}
+
 /// R_gap and R_gap' as numeric functions (compiled from the model).
 struct GapCurve {
     tape: Tape,
@@ -157,7 +170,7 @@ impl CoreCurve<'_> {
 
 /// H on the anhysteretic curve for flux density B: solves
 /// M = M_sat·L((B − μ0(1 − α)M)/b) by bisection (the right side decreases in M).
-fn anhysteretic_field(ja: &crate::description::JilesAtherton, b_c: f64) -> f64 {
+pub fn anhysteretic_field(ja: &crate::description::JilesAtherton, b_c: f64) -> f64 {
     let langevin = |x: f64| {
         if x.abs() < 1e-4 {
             x / 3.0

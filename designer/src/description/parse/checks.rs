@@ -5,7 +5,7 @@
 
 use super::sect::{Res, Sect};
 use crate::description::{Coil, Controller, Core, Drive, Estimator, Gap, Mechanics, Observer};
-use crate::description::{Supply, Trajectory};
+use crate::description::{Law, ModelSurface, Shape, Supply, Trajectory};
 
 /// Grid size of the fringing-denominator check on (0, z_max].
 const DENOMINATOR_GRID: usize = 1000;
@@ -119,45 +119,56 @@ pub(super) fn check_u_bound(s: &Sect, u_bound: f64, supply: &Supply, unit: &str)
     Err(s.err("u_bound", msg, "outside the supply"))
 }
 
-/// A trajectory is designed in the feedback-linearizing coordinates, which
-/// need an input-affine core model.
-pub(super) fn check_trajectory_core(core_sect: &Sect, core: &Core) -> Res<()> {
-    if let Core::JilesAtherton(_) = core {
-        let msg = "a [trajectory] is designed through the feedback-linearizing coordinates \
-                   (x = T⁻¹(ξ), perfect-tracking-soft-landing eqs. 41–42), which need an \
-                   input-affine model, but the \"jiles-atherton\" core is not: its branch \
-                   δ = sign(dφ/dt) depends on the input u; design on a \"saturating\" or \
-                   \"linear\" core model of the same actuator";
-        return Err(core_sect.err("model", msg, "not input-affine"));
+/// A trajectory on the Jiles–Atherton core is a polynomial: the
+/// energy-optimal design (Pontryagin) needs a costate for H_c, whose branch
+/// sign(dφ/dt) depends on the input.
+pub(super) fn check_trajectory_core(
+    trajectory_sect: &Sect,
+    trajectory: &Trajectory,
+    core: &Core,
+) -> Res<()> {
+    if let (Core::JilesAtherton(_), Shape::EnergyOptimal) = (core, trajectory.shape) {
+        let msg = "the energy-optimal trajectory (Pontryagin) needs a costate for every \
+                   state, and the \"jiles-atherton\" core's field H_c switches branch with \
+                   sign(dφ/dt), which depends on the input, so the Hamiltonian is not \
+                   differentiable there; use shape = \"polynomial\" (tracked through H_c by \
+                   the controller), or design the energy-optimal reference on a \"saturating\" \
+                   core fitted to the same valve";
+        return Err(trajectory_sect.err("shape", msg, "not with a hysteretic core"));
     }
     Ok(())
 }
 
-/// A controller tracks a `[trajectory]`, on an input-affine core, sampled
-/// at least 10 times per motion.
+/// A controller tracks a `[trajectory]` sampled at least 10 times per
+/// motion, or (the model-based sliding mode) holds a constant `position`
+/// within the stroke.
 pub(super) fn check_controller(
     root: &Sect,
     s: &Sect,
     c: &Controller,
     trajectory: Option<&Trajectory>,
-    core_sect: &Sect,
-    core: &Core,
+    mechanics: &Mechanics,
 ) -> Res<()> {
+    if let Law::ModelSlidingMode(ModelSurface {
+        position: Some(z_ref),
+        ..
+    }) = c.law
+    {
+        return check_position(root, s, z_ref, trajectory.is_some(), mechanics);
+    }
     let Some(t) = trajectory else {
-        let msg = "section [controller] requires a [trajectory] section: the controller tracks \
-                   a reference trajectory, so give [trajectory] (operations, takeoff, landing, \
-                   shape, u_bound)";
+        let hold = if let Law::ModelSlidingMode(_) = c.law {
+            " (or, with this law, controller.position = z_ref to hold a constant position)"
+        } else {
+            ""
+        };
+        let msg = format!(
+            "section [controller] requires a [trajectory] section: the controller tracks \
+             a reference trajectory, so give [trajectory] (operations, takeoff, landing, \
+             shape, u_bound){hold}"
+        );
         return Err(root.err("controller", msg, "needs [trajectory]"));
     };
-    if let Core::JilesAtherton(_) = core {
-        let msg = format!(
-            "the controller law \"{}\" is designed on an input-affine model, but the \
-             \"jiles-atherton\" core is not: its branch δ = sign(dφ/dt) depends on the input \
-             u; design on a \"saturating\" or \"linear\" core model of the same actuator",
-            c.law.name()
-        );
-        return Err(core_sect.err("model", msg, "not input-affine"));
-    }
     let limit = t.longest_sample_period();
     if c.sample_period > limit {
         let found = s
@@ -169,6 +180,38 @@ pub(super) fn check_controller(
              controller to track it"
         );
         return Err(s.err("sample_period", msg, "too long for the motion"));
+    }
+    Ok(())
+}
+
+/// `controller.position`: within the stroke, and the one reference.
+fn check_position(
+    root: &Sect,
+    s: &Sect,
+    z_ref: f64,
+    with_trajectory: bool,
+    m: &Mechanics,
+) -> Res<()> {
+    if with_trajectory {
+        let msg = "controller.position holds a constant position, and [trajectory] gives \
+                   references to track: give one of them";
+        return Err(root.err("trajectory", msg, "conflicts with controller.position"));
+    }
+    if !(m.z_min..=m.z_max).contains(&z_ref) {
+        let found = s
+            .entry("position")
+            .map_or_else(|| z_ref.to_string(), |(_, v)| s.ctx.found(v));
+        let msg = format!(
+            "expected a number in [mechanics.z_min, mechanics.z_max] = [{}, {}] [m], found \
+             {found}: the armature can only be held within its stroke",
+            m.z_min, m.z_max
+        );
+        return Err(s.err("position", msg, "outside the stroke"));
+    }
+    if s.entry("creep_speed").is_some() {
+        let msg = "controller.creep_speed shapes the reference after a trajectory's landing; \
+                   a constant position has none: remove it";
+        return Err(s.err("creep_speed", msg, "not with controller.position"));
     }
     Ok(())
 }

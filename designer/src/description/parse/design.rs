@@ -7,8 +7,8 @@ use super::physics::input_unit;
 use super::sect::{Res, Sect};
 use crate::description::schema;
 use crate::description::{
-    Controller, Estimator, FloatType, Gains, Law, Operation, Shape, SlidingSurface, Supply,
-    Trajectory,
+    Controller, Estimator, FloatType, Gains, Law, ModelSurface, Operation, Shape, SlidingSurface,
+    Supply, Trajectory,
 };
 
 pub(super) fn parse_trajectory(s: &Sect, supply: &Supply) -> Res<Trajectory> {
@@ -54,7 +54,12 @@ pub(super) fn parse_controller(s: &Sect) -> Res<Controller> {
     s.check_keys(Some(name), &format!("in [controller] with law \"{name}\""))?;
     let law = match name {
         "feedback-linearization" => Law::FeedbackLinearization(parse_gains(s)?),
-        _ => Law::SlidingMode(parse_surface(s)?),
+        "sliding-mode" => Law::SlidingMode(parse_surface(s)?),
+        _ => Law::ModelSlidingMode(ModelSurface {
+            p: s.req("p")?,
+            k: s.req("k")?,
+            position: s.opt("position")?,
+        }),
     };
     let sample_period = s.req("sample_period")?;
     let floats = parse_floats(s)?;

@@ -1,0 +1,147 @@
+//! A position hold by the model-based sliding mode of
+//! jiles-atherton-actuator-model [JA §6.2] (`[controller] law =
+//! "model-sliding-mode"` with `position`), as plain data: the law's p and K,
+//! the position, the limits and the guard. Code generation renders a
+//! [`HoldDesign`]; the runtime's `hold` module applies it.
+//!
+//! The position must be holdable: at rest there the flux must balance the
+//! spring with an attracting force (φ² > 0 on T⁻¹ [PT 42]), and the steady
+//! input R·i of that flux (the Jiles–Atherton core on its anhysteretic curve)
+//! must lie within the supply [JA 94].
+
+use crate::description::{Description, ModelSurface};
+use crate::model::{rest_point, Model};
+use crate::sym::Tape;
+
+use super::decisions::{model_sliding_gains, round_down_1sig};
+use super::linearization::Linearization;
+use super::plan::PlanError;
+
+/// Fraction of the holding flux below which the law is not evaluated.
+const GUARD_FRACTION: f64 = 1e-3;
+/// Fraction of the stroke within which the armature is at a stop [JA 86].
+const LANDED_FRACTION: f64 = 1e-9;
+
+/// The designed position hold: everything the emitted module states.
+#[derive(Debug, Clone)]
+pub struct HoldDesign {
+    pub linearization: Linearization,
+    /// p [1/s] of [JA 88], K [1/s] of [JA 93].
+    pub p: f64,
+    pub k: f64,
+    /// z_ref [m].
+    pub position: f64,
+    /// T_s [s].
+    pub sample_period: f64,
+    /// u ∈ [0, u_max] [JA 94].
+    pub u_max: f64,
+    pub z_min: f64,
+    pub z_max: f64,
+    /// [Wb]: where φ̂ ≤ `phi_guard` the law is not evaluated and u = u_max.
+    pub phi_guard: f64,
+    /// [m]: within this distance of a stop the armature is at it [JA 86].
+    pub landed_band: f64,
+    /// The flux and the steady input that hold the armature at rest at the
+    /// position (0 at a stop the spring holds).
+    pub holding_flux: f64,
+    pub holding_input: f64,
+}
+
+impl HoldDesign {
+    /// K of the tracking law [PT 50] that is [JA 89].
+    pub fn gains(&self) -> [f64; 3] {
+        model_sliding_gains(self.p, self.k)
+    }
+}
+
+/// Designs the hold of `[controller]` (law "model-sliding-mode" with
+/// `position`).
+pub fn design_hold(
+    description: &Description,
+    model: &mut Model,
+    surface: &ModelSurface,
+    position: f64,
+) -> Result<HoldDesign, PlanError> {
+    let Some(controller) = &description.controller else {
+        return Err(PlanError::NothingToBuild);
+    };
+    let linearization = Linearization::derive(model)?;
+    let mech = &description.mechanics;
+    let stroke = mech.z_max - mech.z_min;
+    let band = controller
+        .landed_band
+        .unwrap_or_else(|| round_down_1sig(LANDED_FRACTION * stroke));
+    let at_stop = position <= mech.z_min + band || position >= mech.z_max - band;
+    let flux_squared = rest_flux_squared(model, &linearization, position)?;
+    let holding_flux = if flux_squared > 0.0 && flux_squared.is_finite() {
+        flux_squared.sqrt()
+    } else if at_stop {
+        0.0
+    } else {
+        return Err(PlanError::Unholdable {
+            position,
+            flux_squared,
+        });
+    };
+    let holding_input = rest_point(model, position, holding_flux).voltage;
+    let u_max = description.supply.u_max;
+    if !at_stop && !(holding_input < u_max) {
+        return Err(PlanError::HoldingInput {
+            position,
+            input: holding_input,
+            u_max,
+        });
+    }
+    // the guard: 10⁻³ of the holding flux (of mid-stroke's at a stop)
+    let guard_base = if holding_flux > 0.0 {
+        holding_flux
+    } else {
+        rest_flux_squared(model, &linearization, mech.z_min + 0.5 * stroke)?
+            .max(0.0)
+            .sqrt()
+    };
+    if !(guard_base > 0.0 && guard_base.is_finite()) {
+        return Err(PlanError::NoFluxFloor);
+    }
+    let design = HoldDesign {
+        linearization,
+        p: surface.p,
+        k: surface.k,
+        position,
+        sample_period: controller.sample_period,
+        u_max,
+        z_min: mech.z_min,
+        z_max: mech.z_max,
+        phi_guard: round_down_1sig(GUARD_FRACTION * guard_base),
+        landed_band: band,
+        holding_flux,
+        holding_input,
+    };
+    for (name, value) in [
+        ("p", design.p),
+        ("k", design.k),
+        ("sample_period", design.sample_period),
+        ("u_max", design.u_max),
+    ] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(PlanError::BadValue {
+                name: name.into(),
+                value,
+            });
+        }
+    }
+    Ok(design)
+}
+
+/// φ² at rest at `z` on T⁻¹ [PT 42]: (ξ₃ − a₀(z, 0))/c₂(z) with ξ₃ = 0.
+fn rest_flux_squared(model: &Model, lin: &Linearization, z: f64) -> Result<f64, PlanError> {
+    let mut inputs = lin.xi.to_vec();
+    inputs.extend(model.params.iter().map(|(_, id, _)| id));
+    let tape = Tape::compile(&model.graph, &inputs, &[lin.flux_squared])
+        .map_err(|e| PlanError::UnboundSymbol(e.0))?;
+    let mut point = vec![z, 0.0, 0.0];
+    point.extend(model.params.iter().map(|(_, _, v)| v));
+    let mut out = [0.0];
+    tape.eval(&point, &mut tape.scratch(), &mut out);
+    Ok(out[0])
+}
