@@ -9,10 +9,16 @@
 //!   φ_sat² for a saturating core (its [SM 14]);
 //! - [PT 54] the input u_r = α(x_r) + β(x_r)·z_r⁽³⁾ stays within the bounds.
 //!
+//! On a Jiles–Atherton core α and β read the field H_c, which T⁻¹ does not
+//! give: it follows the reference's flux path (`model::FieldPath`), from a
+//! demagnetised core for an operation that starts at z_max and from the
+//! anhysteretic field of the holding flux under u_max for one that starts at
+//! z_min (what the closing left).
+//!
 //! The report says which condition fails, where, by how much, and what to try.
 
 use crate::description::Core;
-use crate::model::Model;
+use crate::model::{FieldPath, Model, Statics};
 use crate::sym::Tape;
 
 use super::linearization::Linearization;
@@ -70,6 +76,20 @@ impl Feasibility {
         ));
         s
     }
+}
+
+/// H_c along a reference starting at rest at `z0` (see the module docs):
+/// `None` for a core without the field state.
+pub fn reference_field(model: &mut Model, z0: f64) -> Option<FieldPath> {
+    model.has_field_state().then_some(())?;
+    let mech = &model.description.mechanics;
+    let from_closed = (z0 - mech.z_min).abs() < (z0 - mech.z_max).abs();
+    let flux = if from_closed {
+        Statics::of(model).hold_flux
+    } else {
+        0.0
+    };
+    FieldPath::anhysteretic(model, flux)
 }
 
 fn hint(name: &str) -> &'static str {
@@ -164,6 +184,8 @@ pub fn check(
         (f64::INFINITY, f64::NEG_INFINITY),
     );
     let (mut fs, mut ls) = (flux_tape.scratch(), law.scratch());
+    let mut field = reference_field(model, reference.at(t0).z);
+    let mut law_in = vec![0.0; model.dim() + 2];
     for k in 0..=samples {
         let t = t0 + (tf - t0) * k as f64 / samples as f64;
         let r = reference.at(t);
@@ -177,7 +199,14 @@ pub fn check(
             let phi = phi2[0].sqrt();
             flux_range = (flux_range.0.min(phi), flux_range.1.max(phi));
             let mut ab = [0.0; 2];
-            law.eval(&[r.z, r.v, phi, 0.0, t], &mut ls, &mut ab);
+            law_in[..3].copy_from_slice(&[r.z, r.v, phi]);
+            if let Some(path) = &mut field {
+                law_in[3] = path.advance(phi);
+            }
+            if let Some(time) = law_in.last_mut() {
+                *time = t;
+            }
+            law.eval(&law_in, &mut ls, &mut ab);
             let u = ab[0] + ab[1] * r.jerk;
             input_range = (input_range.0.min(u), input_range.1.max(u));
             u_high.observe(t, u);

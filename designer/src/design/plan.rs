@@ -440,9 +440,14 @@ fn polynomial_remedy(
             lo = mid;
         }
     }
+    let alternative = if model.has_field_state() {
+        "a wider input range (trajectory.u_bound, supply) allows a shorter one"
+    } else {
+        "shape = \"energy-optimal\" may need less (`reldesign limits` gives its shortest motion)"
+    };
     format!(
         "  the polynomial needs trajectory.landing − trajectory.takeoff ≥ {:.4} ms (it is {:.4} ms); \
-         shape = \"energy-optimal\" may need less (`reldesign limits` gives its shortest motion)\n",
+         {alternative}\n",
         hi * 1e3,
         duration * 1e3
     )

@@ -14,12 +14,15 @@
 //!   (by default 20 % of max|v_r| and of max|a_r|).
 //!
 //! The whole operation is sampled, the rests before t₀ and after t_f
-//! included: holding the takeoff flux needs an input too.
+//! included: holding the takeoff flux needs an input too. On a
+//! Jiles–Atherton core f_j and B_j read H_c, taken along the reference's flux
+//! path (`model::FieldPath`, the nominal core's even in a Monte-Carlo draw).
 
 use crate::description::{schema, SlidingSurface};
-use crate::model::Model;
+use crate::model::{FieldPath, Model};
 use crate::sym::Tape;
 
+use super::feasibility::reference_field;
 use super::linearization::Linearization;
 use super::reference::Reference;
 
@@ -113,10 +116,21 @@ pub struct Evaluator {
     /// Where m and φ_sat are among the parameters.
     mass: Option<usize>,
     phi_sat: Option<usize>,
+    /// H_c along the reference on a Jiles–Atherton core, from rest at z_max
+    /// and at z_min (`feasibility::reference_field`; the nominal core).
+    field_from: Option<[FieldPath; 2]>,
+    /// z_min, z_max: which start a reference has.
+    stroke: [f64; 2],
 }
 
 impl Evaluator {
     pub fn new(model: &Model, lin: &Linearization) -> Evaluator {
+        let mech = &model.description.mechanics;
+        let stroke = [mech.z_min, mech.z_max];
+        let mut nominal = model.clone();
+        let field_from = reference_field(&mut nominal, stroke[1])
+            .zip(reference_field(&mut nominal, stroke[0]))
+            .map(|(open, closed)| [open, closed]);
         let params: Vec<_> = model.params.iter().map(|(_, id, _)| id).collect();
         let names: Vec<String> = model.params.iter().map(|(n, _, _)| n.to_owned()).collect();
         let with_params = |mut inputs: Vec<_>| {
@@ -142,6 +156,8 @@ impl Evaluator {
             mass: index_of("mechanics.mass"),
             phi_sat: index_of("core.phi_sat"),
             names,
+            field_from,
+            stroke,
         }
     }
 
@@ -169,8 +185,26 @@ impl Evaluator {
         self.flux
             .eval(&work.flux_in, &mut work.flux_scratch, &mut phi2);
         work.law_in.clear();
-        work.law_in.extend([f.z, f.v, 0.0, 0.0, t]);
+        work.law_in.extend([f.z, f.v, 0.0]);
+        if work.field.is_some() {
+            work.law_in.push(0.0);
+        }
+        work.law_in.extend([0.0, t]);
         work.law_in.extend(p);
+        // H_c on the flux path (a = L_f²z reads none: only α, β change)
+        let field = match (&mut work.field, phi2[0] > 0.0) {
+            (Some(path), true) => path.advance(phi2[0].sqrt()),
+            (Some(path), false) => path.field(),
+            (None, _) => 0.0,
+        };
+        if let Some(hc) = work
+            .field
+            .is_some()
+            .then(|| work.law_in.get_mut(3))
+            .flatten()
+        {
+            *hc = field;
+        }
         let mut at_flux = |phi: f64| {
             work.law_in[2] = phi;
             let mut out = [0.0; 3];
@@ -227,11 +261,23 @@ impl Evaluator {
         params: &[f64],
     ) -> Robustness {
         let times = sample_times(r, t_end, samples);
+        let [z_min, z_max] = self.stroke;
+        let from_closed = {
+            let z0 = r.at(0.0).z;
+            (z0 - z_min).abs() < (z0 - z_max).abs()
+        };
         let mut work = Work {
             law_in: Vec::new(),
             flux_in: Vec::new(),
             law_scratch: self.law.scratch(),
             flux_scratch: self.flux.scratch(),
+            field: (self.field_from.as_ref()).map(|[open, closed]| {
+                if from_closed {
+                    closed.clone()
+                } else {
+                    open.clone()
+                }
+            }),
         };
         let samples: Vec<Sample> = times
             .iter()
@@ -247,6 +293,8 @@ struct Work {
     flux_in: Vec<f64>,
     law_scratch: Vec<f64>,
     flux_scratch: Vec<f64>,
+    /// H_c along the reference (Jiles–Atherton core).
+    field: Option<FieldPath>,
 }
 
 /// `samples` + 1 instants evenly over [0, t_end], plus the motion's ends (the

@@ -17,6 +17,7 @@
 //! | coil voltage (current drive) | v = R·u + N·φ̇ ([PT 1]) |
 
 mod core;
+mod field_path;
 mod gap;
 mod params;
 mod plant;
@@ -24,6 +25,7 @@ mod statics;
 mod table;
 
 pub use self::core::LANGEVIN_SERIES_BELOW;
+pub use field_path::FieldPath;
 pub use gap::{MU0, Z_EPS};
 pub use params::Params;
 pub use plant::{ModelPlant, PlantError};
