@@ -29,7 +29,7 @@ fn main() {
     let code = reldesign_build::emit(&design).unwrap_or_else(|e| panic!("{e}"));
     std::fs::write(out.join("sliding_mode_valve.rs"), code).unwrap();
 
-    let run = run_loop(&design, None, 1e-5, None, 0, &Options::default())
+    let run = run_loop(&design, None, 1e-5, None, designer::closed_loop::Noise::seeded(0), &Options::default())
         .unwrap_or_else(|e| panic!("{e}"));
     let starts = &run.operations;
     assert!(

@@ -11,8 +11,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use designer::closed_loop::{
-    check_sample_period, resample_observer, run_hold, run_loop, HoldOutcome, LoopRun,
-    OperationOutcome, HOLD_DURATION, SETTLED_FRACTION,
+    check_sample_period, resample_observer, run_hold, run_loop, HoldOutcome, LoopRun, Noise,
+    OperationOutcome, HOLD_DURATION, SETTLED_FRACTION, SETTLING_WINDOW,
 };
 use designer::description::{Law, ModelSurface};
 use designer::design::Design;
@@ -91,7 +91,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
             plant.as_ref(),
             ts,
             duration,
-            args.seed,
+            Noise::seeded(args.seed),
             args.initial_field,
             &Options::default(),
         )
@@ -101,7 +101,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
             plant.as_ref(),
             ts,
             duration,
-            args.seed,
+            Noise::seeded(args.seed),
             &Options::default(),
         )
     }
@@ -117,8 +117,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
     }
     atomic::write_all(&files).map_err(fail)?;
     if holds {
-        let m = &description.mechanics;
-        let outcome = run.hold_outcome(m.z_max - m.z_min);
+        let outcome = run.hold_outcome();
         print!("{}", hold_summary(&outcome, run.z_ref.first().copied(), ts));
         return Ok(());
     }
@@ -172,16 +171,17 @@ fn hold_summary(o: &HoldOutcome, z_ref: Option<f64>, ts: f64) -> String {
         format!("never settled within the run (default {HOLD_DURATION:e} s: --duration)"),
         |t| {
             format!(
-                "settled (within {} % of the stroke) at {:.3} ms",
-                SETTLED_FRACTION * 100.0,
-                t * 1e3
+                "settled at {:.3} ms (the error's {} ms average within {} % of the initial error)",
+                t * 1e3,
+                SETTLING_WINDOW * 1e3,
+                SETTLED_FRACTION * 100.0
             )
         },
     );
     let _ = writeln!(s, "  {settled}");
     let _ = writeln!(
         s,
-        "  steady error {:+.3e} m (mean over the last fifth), band ±{:.3e} m",
+        "  steady error {:+.3e} m (mean over the last fifth), ripple ±{:.3e} m",
         o.steady_error, o.steady_band
     );
     if let Some(e) = &o.observer {
@@ -239,7 +239,7 @@ fn plot(run: &LoopRun, name: &str, ts: f64) -> Result<String, String> {
     let mut out = String::new();
     {
         let e = |e: plotters::drawing::DrawingAreaErrorKind<std::io::Error>| e.to_string();
-        let root = SVGBackend::with_string(&mut out, (900, 800)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut out, (900, 1000)).into_drawing_area();
         root.fill(&WHITE).map_err(e)?;
         let root = root
             .titled(
@@ -247,16 +247,28 @@ fn plot(run: &LoopRun, name: &str, ts: f64) -> Result<String, String> {
                 ("sans-serif", 22),
             )
             .map_err(e)?;
-        let panels = root.split_evenly((3, 1));
         let tr = &run.trajectory;
         let t: Vec<f64> = tr.t.iter().map(|t| t * 1e3).collect();
         let z: Vec<f64> = tr.x.iter().map(|x| x[0] * 1e3).collect();
         let zr: Vec<f64> = run.z_ref.iter().map(|z| z * 1e3).collect();
-        let series: [(&str, Vec<(&[f64], RGBColor, &str)>); 3] = [
-            ("position [mm]", vec![(&zr, RED, "z_ref"), (&z, BLACK, "z")]),
+        let phi: Vec<f64> = tr.x.iter().map(|x| x[2] * 1e6).collect();
+        // the observer's estimates, where one drives the controller
+        let (z_hat, phi_hat): (Vec<f64>, Vec<f64>) = (run.estimates.iter().flatten())
+            .map(|e| (e.z * 1e3, e.phi * 1e6))
+            .unzip();
+        let mut position = vec![(zr.as_slice(), RED, "z_ref"), (z.as_slice(), BLACK, "z")];
+        let mut flux = vec![(phi.as_slice(), MAGENTA, "φ")];
+        if run.estimates.is_some() {
+            position.push((z_hat.as_slice(), CYAN, "ẑ"));
+            flux.push((phi_hat.as_slice(), CYAN, "φ̂"));
+        }
+        let series: [(&str, Vec<(&[f64], RGBColor, &str)>); 4] = [
+            ("position [mm]", position),
+            ("flux [µWb]", flux),
             ("input u", vec![(&tr.u, BLUE, "u")]),
             ("current i [A]", vec![(&run.current, GREEN, "i")]),
         ];
+        let panels = root.split_evenly((4, 1));
         for (area, (label, lines)) in panels.iter().zip(series) {
             crate::plot::panel(area, &t, &lines, label)?;
         }

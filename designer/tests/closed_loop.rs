@@ -14,7 +14,15 @@ use support::example_path;
 fn first_impacts(example: &str, ts: f64) -> Vec<Option<f64>> {
     let d = parse_file(&example_path(example)).unwrap();
     let design = Design::new(&d).unwrap_or_else(|e| panic!("{e}"));
-    let run = run_loop(&design, None, ts, None, 0, &Options::default()).unwrap();
+    let run = run_loop(
+        &design,
+        None,
+        ts,
+        None,
+        designer::closed_loop::Noise::seeded(0),
+        &Options::default(),
+    )
+    .unwrap();
     let t = d.trajectory.as_ref().unwrap();
     run.operations
         .iter()
@@ -131,7 +139,15 @@ fn sliding_mode_tracks_an_energy_optimal_reference() {
     let margin = text.replace("u_bound = 40.0", "u_bound = 30.0");
     let d = designer::description::parse_str(&margin, "eo.toml").unwrap();
     let design = Design::new(&d).unwrap_or_else(|e| panic!("{e}"));
-    let run = run_loop(&design, None, 1e-5, None, 0, &Options::default()).unwrap();
+    let run = run_loop(
+        &design,
+        None,
+        1e-5,
+        None,
+        designer::closed_loop::Noise::seeded(0),
+        &Options::default(),
+    )
+    .unwrap();
     let t = d.trajectory.as_ref().unwrap();
     for o in run.outcomes(t.takeoff, t.landing) {
         let v = o.impact_velocity.expect("lands").abs();
@@ -201,7 +217,15 @@ fn every_law_lands_softly_on_the_hysteretic_core() {
         let d =
             designer::description::parse_str(&text, "ja.toml").unwrap_or_else(|e| panic!("{e}"));
         let design = Design::new(&d).unwrap_or_else(|e| panic!("{law}: {e}"));
-        let run = run_loop(&design, None, 1e-5, None, 0, &Options::default()).unwrap();
+        let run = run_loop(
+            &design,
+            None,
+            1e-5,
+            None,
+            designer::closed_loop::Noise::seeded(0),
+            &Options::default(),
+        )
+        .unwrap();
         let t = d.trajectory.as_ref().unwrap();
         let outcomes: Vec<OperationOutcome> = run.outcomes(t.takeoff, t.landing);
         eprintln!("{law}: {outcomes:?}");

@@ -3,6 +3,7 @@
 
 pub mod devices;
 pub mod hidden;
+pub mod sensorless;
 
 use designer::description::{parse_file, parse_str, Description};
 use designer::model::Model;

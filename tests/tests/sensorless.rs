@@ -11,7 +11,6 @@
 //! of estimated positions [JA 84–85], drives u into the ±24 V limits and the
 //! loop oscillates (measured); the slower loop is the sensorless design.
 
-use designer::description::parse_str;
 use designer::description::Description;
 use designer::model::{Model, ModelPlant};
 use designer::observe::discrete::{DiscreteModel, ResistanceSettings};
@@ -24,54 +23,9 @@ mod sensorless_valve {
     include!(concat!(env!("OUT_DIR"), "/sensorless_valve.rs"));
 }
 use reldesign_generated::perfect_tracking_valve::f64 as example64;
-use reldesign_tests::{example_path, impacts, root, Rng};
+use reldesign_tests::sensorless::mismatched_plant;
+use reldesign_tests::{impacts, root, Rng};
 use sensorless_valve::f64 as c64;
-
-const VALVE: &str = "perfect-tracking-valve.toml";
-
-/// Inverse Jiles–Atherton core whose anhysteretic curve follows the design's
-/// Fröhlich–Kennelly core (r0 = 3e6 H⁻¹, φ_sat = 25 µWb) within ±8 % of the
-/// MMF for φ ≤ 21 µWb (least squares of m_sat, b, α at l_c = 40 mm, A_c =
-/// 20 mm²), with hysteresis added (c = 0.5, κ = 60 A/m: a coercive MMF of
-/// ~2.4 A·turn, 5 % of the holding MMF).
-const JA_CORE: &str = "model = \"jiles-atherton\"
-length = 0.04
-area = 20e-6
-m_sat = 1.0715e6
-b = 4.6685e-3
-c = 0.5
-kappa = 60.0
-alpha = 8.3174e-3";
-
-const SATURATING_CORE: &str = "model = \"saturating\"
-r0 = 3e6                    # R_core0 = 3·10⁶ H⁻¹, Table 1
-phi_sat = 25e-6             # φ_sat = 25 µWb, Table 1";
-
-/// The perfect-tracking valve with the JA core and k_s, R scaled: physics
-/// only (the design sections need the design model, not the plant).
-fn mismatched_plant(ks_factor: f64, r_factor: f64) -> Description {
-    let text = std::fs::read_to_string(example_path(VALVE)).expect("example");
-    let physics = text
-        .split("[trajectory]")
-        .next()
-        .expect("text before [trajectory]");
-    let mut plant = physics.replacen(SATURATING_CORE, JA_CORE, 1);
-    for (from, to) in [
-        (
-            "stiffness = 50.0",
-            format!("stiffness = {}", 50.0 * ks_factor),
-        ),
-        (
-            "resistance = 75.0",
-            format!("resistance = {}", 75.0 * r_factor),
-        ),
-    ] {
-        assert!(plant.contains(from), "{from}");
-        plant = plant.replacen(from, &to, 1);
-    }
-    assert!(plant.contains("jiles-atherton"));
-    parse_str(&plant, "mismatched-plant.toml").unwrap_or_else(|e| panic!("{e}"))
-}
 
 /// The first impact speed at `destination` within (after, before), NaN if
 /// none, and the number of bounces there.

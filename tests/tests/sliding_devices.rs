@@ -105,7 +105,15 @@ fn sliding_mode_lands_generated_devices() {
         let supply = d.supply.u_max;
         let design = Design::new(&d).unwrap_or_else(|e| panic!("{}: {e}", device.name));
         let options = Options::default();
-        let run = run_loop(&design, None, tau / 4000.0, None, 0, &options).unwrap();
+        let run = run_loop(
+            &design,
+            None,
+            tau / 4000.0,
+            None,
+            designer::closed_loop::Noise::seeded(0),
+            &options,
+        )
+        .unwrap();
         let baseline = switching_baseline(&d, None, &options).unwrap();
         let t = d.trajectory.as_ref().unwrap();
         for (o, (_, switching)) in run.outcomes(t.takeoff, t.landing).iter().zip(&baseline) {
