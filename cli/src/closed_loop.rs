@@ -44,6 +44,10 @@ pub struct Args {
     /// Seed of the measurement noise, where an observer drives the controller
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// The measurement noise σ_v,σ_i [V,A] the observer reads (default: the observer's own
+    /// voltage_noise, current_noise)
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    noise: Option<Vec<f64>>,
     /// The plant's initial core field H_c [A/m] (a Jiles–Atherton plant; the observer
     /// still starts from 0)
     #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
@@ -67,6 +71,18 @@ pub fn run(args: &Args) -> Result<(), Report> {
             args.initial_field
         )));
     }
+    let noise = Noise {
+        seed: args.seed,
+        sigma: match args.noise.as_deref() {
+            None => None,
+            Some(&[v, i]) if v >= 0.0 && i >= 0.0 && v.is_finite() && i.is_finite() => Some([v, i]),
+            Some(other) => {
+                return Err(fail(format!(
+                    "--noise: expected two numbers σ_v,σ_i ≥ 0 [V,A], found {other:?}"
+                )))
+            }
+        },
+    };
     let holds = matches!(
         controller.law,
         Law::ModelSlidingMode(ModelSurface {
@@ -91,7 +107,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
             plant.as_ref(),
             ts,
             duration,
-            Noise::seeded(args.seed),
+            noise,
             args.initial_field,
             &Options::default(),
         )
@@ -101,7 +117,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
             plant.as_ref(),
             ts,
             duration,
-            Noise::seeded(args.seed),
+            noise,
             &Options::default(),
         )
     }

@@ -100,7 +100,11 @@ fn main() -> ExitCode {
 
 /// Reads and validates a description; errors render with source and caret.
 pub fn load(path: &Path) -> Result<Description, Report> {
-    parse_file(path).map_err(Report::new)
+    let description = parse_file(path).map_err(Report::new)?;
+    for warning in &description.warnings {
+        eprintln!("warning: {warning}");
+    }
+    Ok(description)
 }
 
 /// A number for JSON, which has no ∞ or NaN: those become null.

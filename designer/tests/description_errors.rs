@@ -598,3 +598,27 @@ fn misspelt_design_keys_get_a_suggestion() {
     let help = err.help().map(|h| h.to_string());
     assert_eq!(help.as_deref(), Some("did you mean `settling_time`?"));
 }
+
+/// `controller.estimator = "ekf"` on a soft-landing law parses, with a
+/// warning that names the key and the evidence; the UKF, none.
+#[test]
+fn an_ekf_driven_soft_landing_is_warned_against() {
+    let text = std::fs::read_to_string(root().join("tests/data/sensorless-valve.toml")).unwrap();
+    let with = |estimator: &str| {
+        let text = text.replacen(
+            "[controller]\n",
+            &format!("[controller]\nestimator = \"{estimator}\"\n"),
+            1,
+        );
+        parse_str(&text, "sensorless.toml").unwrap_or_else(|e| panic!("{e}"))
+    };
+    let ekf = with("ekf");
+    assert_eq!(ekf.warnings.len(), 1, "{:?}", ekf.warnings);
+    let w = &ekf.warnings[0];
+    assert!(
+        w.starts_with("sensorless.toml:") && w.contains("controller.estimator"),
+        "{w}"
+    );
+    assert!(w.contains("hovers") && w.contains("ukf"), "{w}");
+    assert!(with("ukf").warnings.is_empty());
+}

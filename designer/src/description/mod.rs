@@ -31,6 +31,9 @@ pub struct Description {
     pub observer: Option<Observer>,
     /// Where the description came from (file name as given, full text).
     pub source: Source,
+    /// What the parser accepts but advises against, each as
+    /// `file:line:column: key: message` (the CLI prints them).
+    pub warnings: Vec<String>,
 }
 
 #[derive(Debug, Clone, PartialEq)]

@@ -74,8 +74,10 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         .opt_section("observer")?
         .map(|s| observer::parse_observer(&s, &supply, &core_sect, &core))
         .transpose()?;
+    let mut warnings = Vec::new();
     if let (Some(s), Some(c)) = (&controller_sect, &controller) {
         checks::check_estimator(s, c, observer.as_ref())?;
+        warnings.extend(checks::estimator_warning(s, c).map(|w| w.to_string()));
     }
     let source = Source {
         file_name: file_name.to_string(),
@@ -92,6 +94,7 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         controller,
         observer,
         source,
+        warnings,
     })
 }
 
