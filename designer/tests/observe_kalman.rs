@@ -18,7 +18,7 @@
 
 use designer::description::{parse_file, parse_str, Core, Description, Drive};
 use designer::model::Model;
-use designer::observe::discrete::{DiscreteModel, Estimate, KalmanSettings};
+use designer::observe::discrete::{DiscreteModel, Estimate, KalmanSettings, StateKind, MAX_DIM};
 use designer::observe::ekf::Ekf;
 use designer::observe::ukf::Ukf;
 use designer::replay::replay;
@@ -123,20 +123,31 @@ fn symbolic_jacobians_match_finite_differences() {
             Core::Saturating { phi_sat, .. } => 0.9 * phi_sat,
             _ => 2.5e-5,
         };
-        // typical magnitudes of z, z_prev, φ, H_c
-        let scale = [stroke, stroke, phi_max, 1000.0];
+        // typical magnitudes of each state
+        let r0 = d.coil.resistance;
+        let scale: [f64; MAX_DIM] = std::array::from_fn(|k| match dm.kinds.get(k) {
+            Some(StateKind::Flux) => phi_max,
+            Some(StateKind::CoreField) => 1000.0,
+            Some(StateKind::Resistance) => r0,
+            _ => stroke,
+        });
         let mut rng = Rng::new(0x5EED_0B5E ^ file.len() as u64);
         let (mut checked, mut skipped) = (0usize, 0usize);
         for _ in 0..100 {
             let z = rng.range(m.z_min + 0.1 * stroke, m.z_max - 0.1 * stroke);
             let v = rng.range(-1.0, 1.0);
             let sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
-            let x = [
-                z,
-                z - v * 50e-6,
-                sign * rng.range(0.05, 1.0) * phi_max,
-                rng.range(-2000.0, 2000.0),
-            ];
+            let flux = sign * rng.range(0.05, 1.0) * phi_max;
+            let mut x = [0.0; MAX_DIM];
+            for (k, kind) in dm.kinds.iter().enumerate() {
+                x[k] = match kind {
+                    StateKind::Position => z,
+                    StateKind::PreviousPosition => z - v * 50e-6,
+                    StateKind::Flux => flux,
+                    StateKind::CoreField => rng.range(-2000.0, 2000.0),
+                    StateKind::Resistance => r0 * rng.range(0.9, 1.1),
+                };
+            }
             let u = rng.range(d.supply.u_min, d.supply.u_max);
             let (jac, gain) = tapes.jacobian(&x, u, 0.0);
             let meas = tapes.measure(&x, u, 0.0);
@@ -286,8 +297,8 @@ fn valve_record(d: &Description, ts: f64, t_end: f64, seed: u64) -> Record {
 }
 
 /// Lower Cholesky factor exists (the covariance is positive definite).
-fn positive_definite(n: usize, p: &[[f64; 4]; 4]) -> bool {
-    let mut l = [[0.0; 4]; 4];
+fn positive_definite(n: usize, p: &[[f64; MAX_DIM]; MAX_DIM]) -> bool {
+    let mut l = [[0.0; MAX_DIM]; MAX_DIM];
     for i in 0..n {
         for j in 0..=i {
             let mut s = p[i][j];
@@ -307,7 +318,7 @@ fn positive_definite(n: usize, p: &[[f64; 4]; 4]) -> bool {
     true
 }
 
-fn symmetric(n: usize, p: &[[f64; 4]; 4]) -> bool {
+fn symmetric(n: usize, p: &[[f64; MAX_DIM]; MAX_DIM]) -> bool {
     (0..n).all(|i| (0..n).all(|j| p[i][j] == p[j][i]))
 }
 
@@ -335,7 +346,7 @@ struct Scores {
 
 trait Filter {
     fn step(&mut self, u: f64, y: f64) -> Estimate;
-    fn covariance(&self) -> [[f64; 4]; 4];
+    fn covariance(&self) -> [[f64; MAX_DIM]; MAX_DIM];
     fn dim(&self) -> usize;
     fn repairs(&self) -> usize;
     fn skipped(&self) -> usize;
@@ -347,7 +358,7 @@ macro_rules! filter_impl {
             fn step(&mut self, u: f64, y: f64) -> Estimate {
                 <$t>::step(self, u, y)
             }
-            fn covariance(&self) -> [[f64; 4]; 4] {
+            fn covariance(&self) -> [[f64; MAX_DIM]; MAX_DIM] {
                 <$t>::covariance(self)
             }
             fn dim(&self) -> usize {

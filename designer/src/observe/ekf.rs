@@ -12,4 +12,8 @@ use super::discrete::TapeModel;
 use super::filter::Reference;
 
 /// The f64 reference EKF.
-pub type Ekf = Reference<rt::Ekf<TapeModel<3>, f64, 3>, rt::Ekf<TapeModel<4>, f64, 4>>;
+pub type Ekf = Reference<
+    rt::Ekf<TapeModel<3>, f64, 3>,
+    rt::Ekf<TapeModel<4>, f64, 4>,
+    rt::Ekf<TapeModel<5>, f64, 5>,
+>;

@@ -1,7 +1,7 @@
 //! The reference filters' shape: a runtime filter (`reldesign_runtime::observe`)
 //! on the tape-backed model ([`TapeModel`]) at the model's number of states
-//! (3, or 4 with H_c or R, known only when the description is read), with
-//! the designer's [`Estimate`] and 4-arrays.
+//! (3, 4 with H_c or R, 5 with both, known only when the description is
+//! read), with the designer's [`Estimate`] and [`MAX_DIM`]-arrays.
 
 use reldesign_runtime::linalg::Matrix;
 use reldesign_runtime::observe as rt;
@@ -49,29 +49,51 @@ macro_rules! runtime_impl {
 runtime_impl!(rt::Ekf<TapeModel<N>, f64, N>,);
 runtime_impl!(rt::Ukf<TapeModel<N>, f64, N, P>, P);
 
-/// A reference filter: `A` on 3 states or `B` on 4.
+/// A reference filter: `A` on 3 states, `B` on 4, `C` on 5.
 #[derive(Clone, Debug)]
-pub struct Reference<A, B>(ByDim<A, B>);
+pub struct Reference<A, B, C>(ByDim<A, B, C>);
 
 #[derive(Clone, Debug)]
-enum ByDim<A, B> {
+enum ByDim<A, B, C> {
     Three(A),
     Four(B),
+    Five(C),
 }
 
-/// `a` in the leading entries of a 4-array.
+/// `a` in the leading entries of a [`MAX_DIM`]-array.
 fn padded<const N: usize>(a: [f64; N]) -> [f64; MAX_DIM] {
     let mut p = [0.0; MAX_DIM];
     p[..N].copy_from_slice(&a);
     p
 }
 
-impl<A: Runtime<3>, B: Runtime<4>> Reference<A, B> {
+/// A covariance in the leading block of a [`MAX_DIM`]-square.
+fn padded_square<const N: usize>(p: Matrix<f64, N>) -> [[f64; MAX_DIM]; MAX_DIM] {
+    let mut out = [[0.0; MAX_DIM]; MAX_DIM];
+    for (o, row) in out.iter_mut().zip(p) {
+        *o = padded(row);
+    }
+    out
+}
+
+/// Calls `$body` with the filter of whichever size.
+macro_rules! each {
+    ($self:expr, $f:ident => $body:expr) => {
+        match $self {
+            ByDim::Three($f) => $body,
+            ByDim::Four($f) => $body,
+            ByDim::Five($f) => $body,
+        }
+    };
+}
+
+impl<A: Runtime<3>, B: Runtime<4>, C: Runtime<5>> Reference<A, B, C> {
     /// A filter at its initial state (at rest at z_max, φ = 0, H_c = 0).
     pub fn new(discrete: &DiscreteModel) -> Self {
         Reference(match discrete.dim() {
             3 => ByDim::Three(A::build(TapeModel::new(discrete))),
-            _ => ByDim::Four(B::build(TapeModel::new(discrete))),
+            4 => ByDim::Four(B::build(TapeModel::new(discrete))),
+            _ => ByDim::Five(C::build(TapeModel::new(discrete))),
         })
     }
 
@@ -83,58 +105,35 @@ impl<A: Runtime<3>, B: Runtime<4>> Reference<A, B> {
     /// One sample: predict with u (held over the last sample), update with
     /// y (measured now), report the posterior.
     pub fn step(&mut self, u: f64, y: f64) -> Estimate {
-        match &mut self.0 {
-            ByDim::Three(f) => f.step(u, y).into(),
-            ByDim::Four(f) => f.step(u, y).into(),
-        }
+        each!(&mut self.0, f => f.step(u, y).into())
     }
 
     /// The posterior mean x_{k|k} (first `dim` entries).
     pub fn state(&self) -> [f64; MAX_DIM] {
-        match &self.0 {
-            ByDim::Three(f) => padded(f.state()),
-            ByDim::Four(f) => f.state(),
-        }
+        each!(&self.0, f => padded(f.state()))
     }
 
     /// The posterior covariance (leading `dim`×`dim` block).
     pub fn covariance(&self) -> [[f64; MAX_DIM]; MAX_DIM] {
-        match &self.0 {
-            ByDim::Three(f) => {
-                let p = f.covariance();
-                let mut out = [[0.0; MAX_DIM]; MAX_DIM];
-                for (o, row) in out.iter_mut().zip(p) {
-                    *o = padded(row);
-                }
-                out
-            }
-            ByDim::Four(f) => f.covariance(),
-        }
+        each!(&self.0, f => padded_square(f.covariance()))
     }
 
     pub fn dim(&self) -> usize {
         match &self.0 {
             ByDim::Three(_) => 3,
             ByDim::Four(_) => 4,
+            ByDim::Five(_) => 5,
         }
     }
 
     /// Samples whose measurement update was skipped (non-finite data).
     pub fn skipped(&self) -> usize {
-        let n = match &self.0 {
-            ByDim::Three(f) => f.skipped(),
-            ByDim::Four(f) => f.skipped(),
-        };
-        n as usize
+        each!(&self.0, f => f.skipped() as usize)
     }
 
     /// Restarts after a non-finite prediction (the UKF: and repaired
     /// factorisations).
     pub fn repairs(&self) -> usize {
-        let n = match &self.0 {
-            ByDim::Three(f) => f.repairs(),
-            ByDim::Four(f) => f.repairs(),
-        };
-        n as usize
+        each!(&self.0, f => f.repairs() as usize)
     }
 }

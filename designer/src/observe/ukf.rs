@@ -11,4 +11,8 @@ use super::discrete::TapeModel;
 use super::filter::Reference;
 
 /// The f64 reference UKF (2N + 1 sigma points).
-pub type Ukf = Reference<rt::Ukf<TapeModel<3>, f64, 3, 7>, rt::Ukf<TapeModel<4>, f64, 4, 9>>;
+pub type Ukf = Reference<
+    rt::Ukf<TapeModel<3>, f64, 3, 7>,
+    rt::Ukf<TapeModel<4>, f64, 4, 9>,
+    rt::Ukf<TapeModel<5>, f64, 5, 11>,
+>;

@@ -141,7 +141,7 @@ fn parse_kalman(s: &Sect, core_sect: &Sect, core: &Core) -> Res<KalmanSection> {
     let initial_z_std = s.req("initial_z_std")?;
     let initial_phi_std = s.req("initial_phi_std")?;
     let initial_hc_std = parse_hc(s, "initial_hc_std", ja, core_sect)?;
-    let resistance = parse_resistance_estimate(s, ja)?;
+    let resistance = parse_resistance_estimate(s)?;
     Ok(KalmanSection {
         process_z,
         process_phi,
@@ -179,9 +179,9 @@ fn parse_hc(s: &Sect, key: &str, ja: bool, core_sect: &Sect) -> Res<Option<f64>>
 
 /// `estimate_resistance` (a boolean, default false) of `[observer.kalman]`
 /// with `resistance_rate_std` [Ω/s] and `initial_resistance_std` [Ω], both
-/// required with it and refused without it. With a Jiles–Atherton core the
-/// state [z, z_prev, φ, H_c, R] would exceed the filters' four states.
-fn parse_resistance_estimate(s: &Sect, ja: bool) -> Res<Option<ResistanceEstimate>> {
+/// required with it and refused without it (with a Jiles–Atherton core the
+/// state is [z, z_prev, φ, H_c, R]).
+fn parse_resistance_estimate(s: &Sect) -> Res<Option<ResistanceEstimate>> {
     const KEY: &str = "estimate_resistance";
     let on = s.opt_bool(KEY)?.unwrap_or(false);
     let keys = ["resistance_rate_std", "initial_resistance_std"];
@@ -192,11 +192,6 @@ fn parse_resistance_estimate(s: &Sect, ja: bool) -> Res<Option<ResistanceEstimat
             return Err(s.err(key, msg, "R is not estimated"));
         }
         return Ok(None);
-    }
-    if ja {
-        let msg = "not supported with core.model = \"jiles-atherton\": the state \
-                   [z, z_prev, φ, H_c, R] would have 5 entries and the filters hold at most 4";
-        return Err(s.err(KEY, msg, "too many states"));
     }
     Ok(Some(ResistanceEstimate {
         rate_std: s.req(keys[0])?,

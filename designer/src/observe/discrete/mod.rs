@@ -113,8 +113,8 @@ pub const MODE_BAND_SIGMAS: f64 = 3.0;
 /// The saturating core is evaluated at |φ| ≤ (1 − this)·φ_sat.
 pub const FLUX_DOMAIN_MARGIN: f64 = 1e-3;
 
-/// The largest state the filters hold: [z, z_prev, φ, H_c] or [z, z_prev, φ, R].
-pub const MAX_DIM: usize = 4;
+/// The largest state the filters hold: [z, z_prev, φ, H_c, R].
+pub const MAX_DIM: usize = 5;
 
 /// What each state of the discretised model is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -464,13 +464,14 @@ impl DiscreteModel {
         }
         match self.dim() {
             3 => rows(self.filter_settings::<3>().initial_factor),
-            _ => rows(self.filter_settings::<4>().initial_factor),
+            4 => rows(self.filter_settings::<4>().initial_factor),
+            _ => rows(self.filter_settings::<5>().initial_factor),
         }
     }
 }
 
-/// The model's symbol R checked for use as a state: valid settings, room in
-/// [`MAX_DIM`], and a parameter called R.
+/// The model's symbol R checked for use as a state: valid settings and a
+/// parameter called R.
 fn resistance_symbol(
     model: &Model,
     settings: &KalmanSettings,
@@ -484,11 +485,9 @@ fn resistance_symbol(
             return Err(KalmanError::BadResistanceSetting { name, value });
         }
     }
-    if model.has_field_state() {
-        return Err(KalmanError::TooManyStates);
-    }
-    // n = 4 with R: the unscented transform needs n + κ > 0
-    if 4.0 + settings.ukf_kappa <= 0.0 {
+    // n = 4 (5 with H_c) with R: the unscented transform needs n + κ > 0
+    let n = if model.has_field_state() { 5.0 } else { 4.0 };
+    if n + settings.ukf_kappa <= 0.0 {
         return Err(KalmanError::BadSetting {
             name: "ukf_kappa",
             value: settings.ukf_kappa,

@@ -5,8 +5,6 @@ use reldesign_runtime::observe::Weights;
 
 use crate::description::Observer;
 
-use super::MAX_DIM;
-
 /// Coil-resistance estimation (`estimate_resistance = true` in
 /// `[observer.kalman]`): R as a random-walk state.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -73,8 +71,6 @@ pub enum KalmanError {
     UnusedFieldSetting(&'static str),
     #[error("the symbol `{0}` the discretised model needs is already taken by the model")]
     NameTaken(String),
-    #[error("observer.kalman: estimate_resistance with the Jiles–Atherton core needs 5 states [z, z_prev, φ, H_c, R]; the filters hold at most {MAX_DIM}")]
-    TooManyStates,
     #[error("observer.kalman: {name} = {value:e}: expected a finite number > 0")]
     BadResistanceSetting { name: &'static str, value: f64 },
     #[error("estimate_resistance: the model has no coil resistance parameter `R`")]

@@ -6,7 +6,7 @@ use reldesign_runtime::observe::{self as rt, Configured, Linearisation, Reading,
 
 use crate::sym::Tape;
 
-use super::DiscreteModel;
+use super::{DiscreteModel, MAX_DIM};
 
 /// The discretised model compiled for f64 evaluation (parameters bound),
 /// with scratch buffers: evaluations do not allocate.
@@ -24,14 +24,14 @@ pub struct DiscreteTapes {
     /// f_v [JA 87].
     acceleration: Tape,
     scratch: [Vec<f64>; 5],
-    inputs: [f64; 6],
+    inputs: [f64; MAX_DIM + 2],
 }
 
 /// F(x, u) and the acceleration f_v at x.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Prediction {
     /// x_{k+1} (first n entries used).
-    pub next: [f64; 4],
+    pub next: [f64; MAX_DIM],
     /// f_v(z, v, φ) at x_k.
     pub acceleration: f64,
 }
@@ -43,7 +43,7 @@ pub struct MeasurementEval {
     /// ∂h/∂u
     pub dy_du: f64,
     /// ∂h/∂x (first n used)
-    pub dy_dx: [f64; 4],
+    pub dy_dx: [f64; MAX_DIM],
 }
 
 impl DiscreteTapes {
@@ -77,7 +77,7 @@ impl DiscreteTapes {
             measurement,
             input_gain,
             acceleration,
-            inputs: [0.0; 6],
+            inputs: [0.0; MAX_DIM + 2],
         }
     }
 
@@ -85,7 +85,7 @@ impl DiscreteTapes {
         self.n
     }
 
-    fn set_inputs(&mut self, x: &[f64; 4], u: f64, t: f64) -> usize {
+    fn set_inputs(&mut self, x: &[f64; MAX_DIM], u: f64, t: f64) -> usize {
         let n = self.n;
         self.inputs[..n].copy_from_slice(&x[..n]);
         self.inputs[n] = u;
@@ -94,13 +94,13 @@ impl DiscreteTapes {
     }
 
     /// [JA 84], and f_v at x.
-    pub fn predict(&mut self, x: &[f64; 4], u: f64, t: f64) -> Prediction {
+    pub fn predict(&mut self, x: &[f64; MAX_DIM], u: f64, t: f64) -> Prediction {
         let m = self.set_inputs(x, u, t);
-        let mut out = [0.0; 5];
+        let mut out = [0.0; MAX_DIM + 1];
         let n = self.n;
         self.prediction
             .eval(&self.inputs[..m], &mut self.scratch[0], &mut out[..n + 1]);
-        let mut next = [0.0; 4];
+        let mut next = [0.0; MAX_DIM];
         next[..n].copy_from_slice(&out[..n]);
         Prediction {
             next,
@@ -109,36 +109,41 @@ impl DiscreteTapes {
     }
 
     /// ∂F/∂x and g = ∂F/∂u at (x, u).
-    pub fn jacobian(&mut self, x: &[f64; 4], u: f64, t: f64) -> ([[f64; 4]; 4], [f64; 4]) {
+    pub fn jacobian(
+        &mut self,
+        x: &[f64; MAX_DIM],
+        u: f64,
+        t: f64,
+    ) -> ([[f64; MAX_DIM]; MAX_DIM], [f64; MAX_DIM]) {
         let m = self.set_inputs(x, u, t);
         let n = self.n;
-        let mut out = [0.0; 20];
+        let mut out = [0.0; MAX_DIM * MAX_DIM + MAX_DIM];
         self.jacobian.eval(
             &self.inputs[..m],
             &mut self.scratch[1],
             &mut out[..n * n + n],
         );
-        let mut f = [[0.0; 4]; 4];
+        let mut f = [[0.0; MAX_DIM]; MAX_DIM];
         for (i, row) in f.iter_mut().enumerate().take(n) {
             row[..n].copy_from_slice(&out[i * n..(i + 1) * n]);
         }
-        let mut gain = [0.0; 4];
+        let mut gain = [0.0; MAX_DIM];
         gain[..n].copy_from_slice(&out[n * n..n * n + n]);
         (f, gain)
     }
 
     /// g = ∂F/∂u at (x, u).
-    pub fn input_gain(&mut self, x: &[f64; 4], u: f64, t: f64) -> [f64; 4] {
+    pub fn input_gain(&mut self, x: &[f64; MAX_DIM], u: f64, t: f64) -> [f64; MAX_DIM] {
         let m = self.set_inputs(x, u, t);
         let n = self.n;
-        let mut gain = [0.0; 4];
+        let mut gain = [0.0; MAX_DIM];
         self.input_gain
             .eval(&self.inputs[..m], &mut self.scratch[3], &mut gain[..n]);
         gain
     }
 
     /// f_v(z, v, φ) of [JA 87] at x (v of [JA 85]).
-    pub fn acceleration(&mut self, x: &[f64; 4], u: f64, t: f64) -> f64 {
+    pub fn acceleration(&mut self, x: &[f64; MAX_DIM], u: f64, t: f64) -> f64 {
         let m = self.set_inputs(x, u, t);
         let mut out = [0.0; 1];
         self.acceleration
@@ -147,13 +152,13 @@ impl DiscreteTapes {
     }
 
     /// h, ∂h/∂u, ∂h/∂x at (x, u).
-    pub fn measure(&mut self, x: &[f64; 4], u: f64, t: f64) -> MeasurementEval {
+    pub fn measure(&mut self, x: &[f64; MAX_DIM], u: f64, t: f64) -> MeasurementEval {
         let m = self.set_inputs(x, u, t);
         let n = self.n;
-        let mut out = [0.0; 6];
+        let mut out = [0.0; MAX_DIM + 2];
         self.measurement
             .eval(&self.inputs[..m], &mut self.scratch[2], &mut out[..n + 2]);
-        let mut dy_dx = [0.0; 4];
+        let mut dy_dx = [0.0; MAX_DIM];
         dy_dx[..n].copy_from_slice(&out[2..n + 2]);
         MeasurementEval {
             y: out[0],
@@ -183,15 +188,15 @@ impl<const N: usize> TapeModel<N> {
     }
 }
 
-/// x in the tapes' 4-array (entries past N are 0).
-fn padded<const N: usize>(x: &[f64; N]) -> [f64; 4] {
-    let mut p = [0.0; 4];
+/// x in the tapes' MAX_DIM-array (entries past N are 0).
+fn padded<const N: usize>(x: &[f64; N]) -> [f64; MAX_DIM] {
+    let mut p = [0.0; MAX_DIM];
     p[..N].copy_from_slice(x);
     p
 }
 
 /// The leading N entries.
-fn leading<const N: usize>(x: &[f64; 4]) -> [f64; N] {
+fn leading<const N: usize>(x: &[f64; MAX_DIM]) -> [f64; N] {
     std::array::from_fn(|i| x[i])
 }
 
