@@ -22,8 +22,8 @@
 //! factor (positive definite), the estimate is finite, and at rest (from
 //! 100 ms into each cycle) |ẑ − z| ≤ 1 µm; the filter never repairs a
 //! factorisation, restarts or skips a sample; no variance peaks above
-//! twice its peak in the first cycle (no drift: the peaks are stationary
-//! within ±20 %).
+//! twice its peak in the first cycle (no drift: the cycles' peaks stay
+//! within −25 %/+15 % of the first's).
 //!
 //! f32 fails the same checks (a known failure, ignored; run it with
 //! `cargo test -p reldesign-tests --test ja_ukf_long_run -- --ignored
