@@ -20,9 +20,10 @@ def sh(cmd, **kw):
     return subprocess.run(cmd, check=True, text=True, capture_output=True, **kw)
 
 
-def collected(cmd, out, what):
-    """Total instructions of `cmd` under callgrind, its output written to `out`."""
-    r = subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}"] + cmd,
+def collected(cmd, out, what, flags=()):
+    """Total instructions of `cmd` under callgrind (with the extra callgrind `flags`),
+    its output written to `out`."""
+    r = subprocess.run(["valgrind", "--tool=callgrind", *flags, f"--callgrind-out-file={out}"] + cmd,
                        text=True, capture_output=True)
     m = re.search(r"Collected\s*:\s*(\d+)", r.stderr)
     if r.returncode or not m:
@@ -30,13 +31,13 @@ def collected(cmd, out, what):
     return int(m.group(1))
 
 
-def difference(cmd_for, n, work, tag):
+def difference(cmd_for, n, work, tag, flags=()):
     """(Ir per call, [output of the N run, output of the 2N run]); `cmd_for(calls)`
     is the command making `calls` calls."""
     ir, files = [], []
     for calls in (n, 2 * n):
         out = os.path.join(work, f"cg.{tag}.{calls}")
-        ir.append(collected(cmd_for(calls), out, tag))
+        ir.append(collected(cmd_for(calls), out, tag, flags))
         files.append(out)
     return (ir[1] - ir[0]) / n, files
 

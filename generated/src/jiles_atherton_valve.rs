@@ -239,6 +239,7 @@ macro_rules! law {
 
         /// u of the tracking law [PT 50], not saturated and not guarded.
         #[must_use]
+        #[allow(clippy::too_many_arguments)]
         pub fn law(z: $f, v: $f, phi: $f, hc: $f, zr: $f, vr: $f, ar: $f, jr: $f) -> $f {
             law_terms(z, v, phi, hc, zr, vr, ar, jr).u
         }
