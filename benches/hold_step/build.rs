@@ -39,7 +39,7 @@ fn main() {
         None,
         TS,
         Some(DURATION),
-        0,
+        designer::closed_loop::Noise::seeded(0),
         250.0,
         &Options::default(),
     )
