@@ -687,3 +687,22 @@ fn sweep_process_noise_and_sample_period() {
         }
     }
 }
+
+/// A sample period beyond twice the coil's electrical time constant makes
+/// the flux's Euler step [JA 84c] diverge: refused with τ and the remedy.
+#[test]
+fn a_sample_period_too_long_for_the_coil_is_refused() {
+    let ja = example("jiles-atherton-valve.toml");
+    let model = Model::build(&ja);
+    // τ = 1.47 ms at z_max (φ = 0): 2.9 ms is stable, 3.0 ms is not
+    assert!(DiscreteModel::new(&model, &settings(&ja, 2.9e-3)).is_ok());
+    let e = DiscreteModel::new(&model, &settings(&ja, 3.0e-3))
+        .err()
+        .expect("refused");
+    let text = e.to_string();
+    assert!(
+        text.contains("observer.sample_period = 3e-3") && text.contains("τ = 1.474e-3 s"),
+        "{text}"
+    );
+    assert!(text.contains("2τ") && text.contains("τ/5"), "{text}");
+}

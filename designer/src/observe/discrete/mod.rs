@@ -232,6 +232,7 @@ impl DiscreteModel {
                 Ok(g.symbol(name))
             }
         };
+        check_electrical_step(model, settings.sample_period)?;
         let mech = &model.description.mechanics;
         let z_prev = fresh(&mut g, Z_PREV)?;
         for name in [T_S, Z_MIN, Z_MAX, PHI_LIM] {
@@ -468,6 +469,32 @@ impl DiscreteModel {
             _ => rows(self.filter_settings::<5>().initial_factor),
         }
     }
+}
+
+/// [JA 84c] is forward Euler on the flux: stable while T_s·|∂f_φ/∂φ| ≤ 2.
+/// The rate −∂f_φ/∂φ = 1/τ is largest where the magnetic circuit's
+/// reluctance is: checked at rest at both stops with φ = 0 (H_c = 0).
+fn check_electrical_step(model: &Model, sample_period: f64) -> Result<(), KalmanError> {
+    let mut m = model.clone();
+    let phi = m.states[2];
+    let rate = m.graph.diff(m.f[2], phi);
+    let tape = m.compile(&[rate]);
+    let mech = &m.description.mechanics;
+    let mut out = [0.0];
+    for z in [mech.z_min, mech.z_max] {
+        let mut inputs = vec![0.0; m.dim() + 2];
+        inputs[0] = z;
+        tape.eval(&inputs, &mut tape.scratch(), &mut out);
+        let tau = -1.0 / out[0];
+        if tau > 0.0 && sample_period > 2.0 * tau {
+            return Err(KalmanError::SampleTooLong {
+                sample_period,
+                tau,
+                z,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The model's symbol R checked for use as a state: valid settings and a

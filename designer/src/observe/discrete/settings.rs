@@ -75,6 +75,18 @@ pub enum KalmanError {
     BadResistanceSetting { name: &'static str, value: f64 },
     #[error("estimate_resistance: the model has no coil resistance parameter `R`")]
     NoResistance,
+    #[error(
+        "observer.sample_period = {sample_period:e} s is too long for the coil: the flux's \
+         electrical time constant is τ = {tau:.3e} s at z = {z:e} m (φ = 0), and the \
+         forward-Euler flux step [JA 84c] diverges once T_s > 2τ; sample at least every \
+         τ/5 = {:.3e} s for an accurate step",
+        tau / 5.0
+    )]
+    SampleTooLong {
+        sample_period: f64,
+        tau: f64,
+        z: f64,
+    },
 }
 
 impl KalmanSettings {
