@@ -223,3 +223,53 @@ fn emitted_module_compiles_passes_clippy_and_is_total() {
         "{at_stops} {guarded} {law}"
     );
 }
+
+/// The feedback-linearizing controller on the Jiles–Atherton core (a
+/// polynomial `[trajectory]`): the emitted law takes H_c, `guarded_law`
+/// passes it to the runtime, and the module compiles `no_std`, passes
+/// clippy's panic-free gate, and `step_with_field` is total.
+#[test]
+fn the_tracking_law_on_the_hysteretic_core_takes_the_field() {
+    let physics = example_text();
+    let physics = &physics[..physics.find("\n[controller]").unwrap()];
+    let text = format!(
+        "{physics}\n[trajectory]\noperations = [\"closing\", \"opening\"]\ntakeoff = 2e-3\nlanding = 8e-3\nshape = \"polynomial\"\nu_bound = 24.0\n\n[controller]\nlaw = \"feedback-linearization\"\nsettling_time = 1e-3\nsample_period = 1e-5\n"
+    );
+    let code = emitted(&text);
+    assert!(code.contains("hc: $f,") && code.contains("law_terms(z, v, phi, hc, zr, vr, ar, jr)"));
+    assert!(code.contains("control::guarded_law(&Design, [z, v, phi, hc], [zr, vr, ar, jr])"));
+    let krate = ScratchCrate::new("codegen-check-ja-tracking");
+    krate.write(
+        "src/lib.rs",
+        "//! Emitted by codegen/tests/hold.rs.\n#![no_std]\n#![forbid(unsafe_code)]\n\npub mod valve;\n",
+    );
+    krate.write("src/valve.rs", &code);
+    let odd = ODD.join(", ");
+    let main = format!(
+        "use codegen_check_ja_tracking::valve::f64::*;\n\ntype F = f64;\n\nfn main() {{
+    let mut n = 0;
+    for t in [0.0, 3e-3, 9e-3, {odd}] {{
+        for z in [Z_MIN, Z_MAX, 4e-4, {odd}] {{
+            for phi in [0.0, 1e-5, {odd}] {{
+                for hc in [300.0, {odd}] {{
+                    let mut c = Controller::new(Operation::Closing);
+                    let u = c.step_with_field(t, z, 0.1, phi, hc);
+                    assert!(u.is_finite() && (U_MIN..=U_MAX).contains(&u), \"{{t}} {{z}} {{phi}} {{hc}} {{u}}\");
+                    n += 1;
+                }}
+            }}
+        }}
+    }}
+    println!(\"{{n}}\");
+}}\n"
+    );
+    krate.write("src/main.rs", &main);
+    krate.clippy_panic_free();
+    let out = krate.cargo(&["run", "--offline", "--quiet"]);
+    let n: usize = String::from_utf8(out.stdout)
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    assert_eq!(n, (3 + 9) * (3 + 9) * (2 + 9) * (1 + 9));
+}
