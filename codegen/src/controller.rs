@@ -414,6 +414,18 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
     let design = input.design;
     let gains = gain_consts(design, float)?;
     let (pattern, args) = runtime_state_pattern(input.model);
+    let step = if input.model.states.len() == 4 {
+        "`step_with_field(t, z, v, phi, hc)` with the observer's H_c (the law reads it;\n`step` would pass H_c = 0)"
+    } else {
+        "`step(t, z, v, phi)`"
+    };
+    let controller_doc = crate::emit::doc_attrs(&format!(
+        "One operation of the actuator (`reldesign_runtime::control::SoftLanding`):\n\
+         pre-movement stage before t₀ (ξ_r = [z₀, 0, 0], which brings ξ₃ to 0 so the\n\
+         forces balance at takeoff), tracking of the table on [t₀, t_f], hold at z_f\n\
+         after t_f with the expert rules of model-free-sliding-mode [SM 43] at the end\n\
+         stop; `new`, `start`, `reference`, {step}. Allocation- and panic-free."
+    ));
     let plan = plan_items(
         input.model,
         design,
@@ -439,11 +451,7 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
                 }
             }
 
-            /// One operation of the actuator (`reldesign_runtime::control::SoftLanding`):
-            /// pre-movement stage before t₀ (ξ_r = [z₀, 0, 0], which brings ξ₃ to 0 so the
-            /// forces balance at takeoff), tracking of the table on [t₀, t_f], hold at z_f
-            /// after t_f with the expert rules of model-free-sliding-mode [SM 43] at the end
-            /// stop; `new`, `start`, `reference`, `step`. Allocation- and panic-free.
+            #controller_doc
             pub type Controller = control::SoftLanding<Design, #ty>;
         }
     };

@@ -454,7 +454,7 @@ fn local_consts(
 }
 
 /// `#[doc = " line"]` per line (an empty text gives none).
-fn doc_attrs(text: &str) -> TokenStream {
+pub(crate) fn doc_attrs(text: &str) -> TokenStream {
     let mut out = TokenStream::new();
     if text.is_empty() {
         return out;

@@ -100,10 +100,11 @@ fn float_module(input: &HoldInput, float: Float) -> Result<String, ControllerErr
     )?;
     let (pattern, args) = runtime_state_pattern(input.model);
     let step_doc = if input.model.states.len() == 4 {
-        " The armature held at `POSITION` (`reldesign_runtime::hold::PositionHold`): the mode\n rules [JA 94] at the stops, else u₂ of [JA 89], saturated to [0, U_MAX]; `new`,\n `step(z, v, phi, hc)` with the observer's ẑ, v̂, φ̂, Ĥ_c. Allocation- and panic-free."
+        "The armature held at `POSITION` (`reldesign_runtime::hold::PositionHold`): the mode\nrules [JA 94] at the stops, else u₂ of [JA 89], saturated to [0, U_MAX]; `new`,\n`step(z, v, phi, hc)` with the observer's ẑ, v̂, φ̂, Ĥ_c. Allocation- and panic-free."
     } else {
-        " The armature held at `POSITION` (`reldesign_runtime::hold::PositionHold`): the mode\n rules [JA 94] at the stops, else u₂ of [JA 89], saturated to [0, U_MAX]; `new`,\n `step(z, v, phi, 0.0)` (the core has no field state). Allocation- and panic-free."
+        "The armature held at `POSITION` (`reldesign_runtime::hold::PositionHold`): the mode\nrules [JA 94] at the stops, else u₂ of [JA 89], saturated to [0, U_MAX]; `new`,\n`step(z, v, phi, 0.0)` (the core has no field state). Allocation- and panic-free."
     };
+    let step_doc = crate::emit::doc_attrs(step_doc);
     let tokens = quote! {
         #[doc = " The hold in this float type."]
         pub mod #module {
@@ -142,7 +143,7 @@ fn float_module(input: &HoldInput, float: Float) -> Result<String, ControllerErr
                 }
             }
 
-            #[doc = #step_doc]
+            #step_doc
             pub type Controller = hold::PositionHold<Design, #ty>;
         }
     };

@@ -7,6 +7,7 @@
 //! `control::Plan`. The law's own items (`controller.rs`, `sliding.rs`) come
 //! beside them.
 
+use crate::emit::doc_attrs;
 use designer::description::Operation;
 use designer::design::ControllerDesign;
 use designer::model::Model;
@@ -179,16 +180,6 @@ fn lit(float: Float, name: &str, value: f64) -> Result<TokenStream, ControllerEr
             name: format!("{name} ({})", float.name()),
             value,
         })
-}
-
-/// `#[doc = " line"]` per line.
-fn doc_attrs(text: &str) -> TokenStream {
-    let mut out = TokenStream::new();
-    for line in text.lines() {
-        let line = format!(" {line}");
-        out.extend(quote!(#[doc = #line]));
-    }
-    out
 }
 
 /// The rust names of an operation: (variant, table const, landing, doc).

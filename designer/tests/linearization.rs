@@ -142,8 +142,8 @@ fn jiles_atherton_chain_closes_on_z_v_phi_with_the_field_exogenous() {
     assert!(!m.graph.depends_on(lin.transform[2], hc));
     assert!(m.graph.depends_on(lin.lf3h, hc));
     assert!(m.graph.depends_on(lin.alpha, hc));
-    // the jerk along the full hysteretic f (Ḣ_c included, either branch)
-    // by central differences of a, against L_f³z + L_g L_f²z·u
+    // the jerk along the model's full f by central differences of a (the
+    // H_c row moves too, which a does not read), against L_f³z + L_g L_f²z·u
     let mut outs = m.f.clone();
     outs.extend([lin.transform[2], lin.lf3h, lin.lglf2h, lin.alpha, lin.beta]);
     let tape = m.compile(&outs);

@@ -431,7 +431,7 @@ pub mod f32 {
     /// pre-movement stage before t₀ (ξ_r = [z₀, 0, 0], which brings ξ₃ to 0 so the
     /// forces balance at takeoff), tracking of the table on [t₀, t_f], hold at z_f
     /// after t_f with the expert rules of model-free-sliding-mode [SM 43] at the end
-    /// stop; `new`, `start`, `reference`, `step`. Allocation- and panic-free.
+    /// stop; `new`, `start`, `reference`, `step(t, z, v, phi)`. Allocation- and panic-free.
     pub type Controller = control::SoftLanding<Design, f32>;
 }
 
@@ -642,7 +642,7 @@ pub mod f64 {
     /// pre-movement stage before t₀ (ξ_r = [z₀, 0, 0], which brings ξ₃ to 0 so the
     /// forces balance at takeoff), tracking of the table on [t₀, t_f], hold at z_f
     /// after t_f with the expert rules of model-free-sliding-mode [SM 43] at the end
-    /// stop; `new`, `start`, `reference`, `step`. Allocation- and panic-free.
+    /// stop; `new`, `start`, `reference`, `step(t, z, v, phi)`. Allocation- and panic-free.
     pub type Controller = control::SoftLanding<Design, f64>;
 }
 

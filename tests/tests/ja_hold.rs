@@ -119,6 +119,24 @@ fn the_papers_hold_settles_at_z_ref_on_every_plant() {
         ("k_s ×1.1, R ×0.9", Some(plant(1.1, 0.9, 1.0)), false),
         ("k_s ×0.9, R ×1.1", Some(plant(0.9, 1.1, 1.0)), false),
     ];
+    // the paper's four states [z, z_prev, φ, H_c]: without R the hold is lost
+    // at 2 % of R (the flux drifts with (u − R·i)/N at rest)
+    let four = {
+        let text = std::fs::read_to_string(example_path("jiles-atherton-valve.toml")).unwrap();
+        let mut d = parse_str(&text, "jiles-atherton-valve.toml").unwrap();
+        if let Some(k) = d.observer.as_mut().and_then(|o| o.kalman.as_mut()) {
+            k.resistance = None;
+        }
+        Design::new(&d).unwrap_or_else(|e| panic!("{e}"))
+    };
+    for (name, r) in [
+        ("four states, R ×1.02", 1.02),
+        ("four states, R ×0.98", 0.98),
+    ] {
+        let o = hold(&four, Some(&plant(1.0, r, 1.0)), 0);
+        row(name, &o);
+        assert!(o.steady_error.abs() > 100e-6, "{name}: {o:?}");
+    }
     for (name, p, claimed) in &plants {
         for seed in 0..2 {
             let o = hold(&design, p.as_ref(), seed);

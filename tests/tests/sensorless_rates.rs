@@ -96,16 +96,18 @@ fn row(estimator: &str, ts: f64, seeds: u64) -> Row {
     row
 }
 
-/// CI: at 10 µs, the UKF lands every plant ≥ 10× softer than switching.
+/// CI, on the first noise seed: at 10 µs the UKF lands every plant's
+/// closing ≥ 10× and opening ≥ 9× softer than switching (measured 12.3×
+/// and 10.3×; other seeds hover once in 25 openings, see the docs).
 #[test]
-fn ukf_at_10_us_lands_every_plant_ten_times_softer() {
+fn ukf_at_10_us_lands_every_plant_on_the_first_seed() {
     let r = row("ukf", 10e-6, 1);
     eprintln!("{r:?}");
     assert!(r.worst[0] >= 10.0 && r.worst[1] >= 9.0, "{r:?}");
 }
 
 #[test]
-#[ignore = "about 2 min in release: the table of docs/validation/sensorless.md"]
+#[ignore = "the table of docs/validation/sensorless.md: a few seconds in release, minutes in debug"]
 fn table_against_the_sample_period() {
     println!("| T_s | filter | closing × (worst–best) | opening × (worst–best) | most bounces | runs < 10× or > 1 bounce |");
     println!("| --- | --- | --- | --- | --- | --- |");

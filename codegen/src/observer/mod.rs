@@ -31,6 +31,7 @@
 mod layout;
 mod settings;
 
+use crate::emit::doc_attrs;
 use designer::description::Drive;
 use designer::observe::discrete::DiscreteModel;
 use proc_macro2::{Ident, Literal, TokenStream};
@@ -150,20 +151,6 @@ fn lit(float: Float, name: &str, value: f64) -> Result<TokenStream, ObserverErro
             value,
             float: float.name(),
         })
-}
-
-/// `#[doc = " line"]` per line.
-fn doc_attrs(text: &str) -> TokenStream {
-    let mut out = TokenStream::new();
-    for line in text.lines() {
-        let line = if line.is_empty() {
-            String::new()
-        } else {
-            format!(" {line}")
-        };
-        out.extend(quote!(#[doc = #line]));
-    }
-    out
 }
 
 /// The model functions `layout` holds, in the order they are emitted.

@@ -9,7 +9,7 @@
 //! input R·i of that flux (the Jiles–Atherton core on its anhysteretic curve)
 //! must lie within the supply [JA 94].
 
-use crate::description::{Description, ModelSurface};
+use crate::description::{Description, Drive, ModelSurface};
 use crate::model::{rest_point, Model};
 use crate::sym::Tape;
 
@@ -83,7 +83,12 @@ pub fn design_hold(
             flux_squared,
         });
     };
-    let holding_input = rest_point(model, position, holding_flux).voltage;
+    let rest = rest_point(model, position, holding_flux);
+    // the steady input in the supply's unit: R·i [V], or i [A] with current drive
+    let holding_input = match description.supply.drive {
+        Drive::Voltage => rest.voltage,
+        Drive::Current => rest.current,
+    };
     let u_max = description.supply.u_max;
     if !at_stop && !(holding_input < u_max) {
         return Err(PlanError::HoldingInput {

@@ -103,7 +103,8 @@ pub enum PlanError {
     Unholdable { position: f64, flux_squared: f64 },
     #[error(
         "controller.position = {position:e} m needs a steady input of {input:.4} to hold \
-         (R·i of the flux that balances the spring there), but supply.u_max = {u_max}: \
+         (R·i, or i with current drive, of the flux that balances the spring there), but \
+         supply.u_max = {u_max}: \
          choose a position nearer z_max or a larger supply.u_max"
     )]
     HoldingInput {

@@ -471,19 +471,38 @@ impl DiscreteModel {
     }
 }
 
-/// [JA 84c] is forward Euler on the flux: stable while T_s·|∂f_φ/∂φ| ≤ 2.
-/// The rate −∂f_φ/∂φ = 1/τ is largest where the magnetic circuit's
-/// reluctance is: checked at rest at both stops with φ = 0 (H_c = 0).
+/// [JA 84c] is forward Euler on the flux: stable while T_s/τ ≤ 2, with
+/// 1/τ = −dφ̇/dφ the rate of the magnetic circuit. On a Jiles–Atherton core
+/// the core's MMF l_c·H_c moves with φ through the field's own step
+/// [JA 84d], so 1/τ = −(∂f_φ/∂φ + ∂f_φ/∂H_c·dH_c/dφ), dH_c/dφ = (∂f_Hc/∂u)/
+/// (∂f_φ/∂u) on the rising branch. Checked at rest at both stops at φ = 0
+/// (demagnetised): the operating point every loop starts from. (In
+/// saturation τ is far shorter; the filters' measurement update keeps the
+/// step there in practice, see `tests/tests/ja_ukf_long_run.rs`.)
 fn check_electrical_step(model: &Model, sample_period: f64) -> Result<(), KalmanError> {
     let mut m = model.clone();
-    let phi = m.states[2];
-    let rate = m.graph.diff(m.f[2], phi);
+    let (phi, u) = (m.states[2], m.input);
+    let g = &mut m.graph;
+    let mut rate = g.diff(m.f[2], phi);
+    if let Some(&hc) = m.states.get(3) {
+        // dH_c/dφ along the step: (∂f_Hc/∂u)/(∂f_φ/∂u)
+        let dh_du = g.diff(m.f[3], u);
+        let dphi_du = g.diff(m.f[2], u);
+        let dh_dphi = g.div(dh_du, dphi_du);
+        let via_field = g.diff(m.f[2], hc);
+        let through = g.mul(via_field, dh_dphi);
+        rate = g.add(rate, through);
+    }
     let tape = m.compile(&[rate]);
     let mech = &m.description.mechanics;
     let mut out = [0.0];
     for z in [mech.z_min, mech.z_max] {
         let mut inputs = vec![0.0; m.dim() + 2];
         inputs[0] = z;
+        // a small positive input: φ̇ > 0, the rising branch of sign(φ̇)
+        if let Some(input) = inputs.get_mut(m.dim()) {
+            *input = 1e-6;
+        }
         tape.eval(&inputs, &mut tape.scratch(), &mut out);
         let tau = -1.0 / out[0];
         if tau > 0.0 && sample_period > 2.0 * tau {
