@@ -85,8 +85,6 @@ struct Observer {
     noise: SplitMix64,
     sigma_v: f64,
     sigma_i: f64,
-    /// The voltage applied over the last sample period.
-    held: f64,
 }
 
 enum Filter {
@@ -95,10 +93,10 @@ enum Filter {
 }
 
 impl Observer {
-    /// The estimate after measuring the current `i` now (the voltage held
-    /// over the last sample), and the measured current.
-    fn step(&mut self, i: f64) -> (Estimate, f64) {
-        let u = self.held + self.sigma_v * self.noise.normal();
+    /// The estimate after measuring the current `i` now and the voltage
+    /// `held` over the last sample, and the measured current.
+    fn step(&mut self, held: f64, i: f64) -> (Estimate, f64) {
+        let u = held + self.sigma_v * self.noise.normal();
         let i = i + self.sigma_i * self.noise.normal();
         let e = match &mut self.filter {
             Filter::Ekf(f) => f.step(u, i),
@@ -108,19 +106,75 @@ impl Observer {
     }
 }
 
+/// What a loop's controller reads at each sample: the plant's state, or the
+/// observer's estimate from the measured voltage and current; and the input
+/// held since the last sample.
+struct Sensing<'a> {
+    plant: &'a ModelPlant,
+    observer: Option<Observer>,
+    /// φ is read as the coil current ([SM §5]'s non-negative current).
+    nonnegative_current: bool,
+    /// The input held over the last sample period (the current depends on it
+    /// through the eddy-current term).
+    held: f64,
+    estimates: Vec<(f64, Estimate)>,
+}
+
+impl Sensing<'_> {
+    /// [z, v, φ, H_c] and the acceleration a at the sample `m` (H_c is 0
+    /// where neither the plant nor the observer has it).
+    fn read(&mut self, m: &Measurement) -> ([f64; 4], f64) {
+        let x = &m.x;
+        match &mut self.observer {
+            Some(o) => {
+                // the ADC samples i just before the new voltage is applied
+                let (i, _) = self.plant.current_and_voltage(m.t, x, self.held);
+                let (e, i) = o.step(self.held, i);
+                self.estimates.push((m.t, e));
+                let phi = if self.nonnegative_current { i } else { e.phi };
+                ([e.z, e.v, phi, e.hc.unwrap_or(0.0)], e.a)
+            }
+            None => {
+                let mut dx: State = [0.0; crate::sim::MAX_DIM];
+                self.plant.deriv(m.t, x, 0.0, &mut dx);
+                // a: the free-motion acceleration, 0 against a stop
+                let a = if m.mode == Mode::Free { dx[1] } else { 0.0 };
+                let phi = if self.nonnegative_current {
+                    self.plant.current_and_voltage(m.t, x, self.held).0
+                } else {
+                    x[2]
+                };
+                // H_c: the plant's, where it has the state (x[3] is 0 otherwise)
+                ([x[0], x[1], phi, x[3]], a)
+            }
+        }
+    }
+
+    /// The run's current at every sample, its records at the samples (the
+    /// reference `z_ref` starting from `z_ref_before`), and the estimates.
+    fn record(
+        &self,
+        trajectory: &Trajectory,
+        z_ref: &[(f64, f64)],
+        z_ref_before: f64,
+    ) -> (Vec<f64>, Vec<f64>, Option<Vec<Estimate>>) {
+        let t = &trajectory.t;
+        let (current, _) = self
+            .plant
+            .currents_and_voltages(t, &trajectory.x, &trajectory.u);
+        let estimates =
+            (self.observer.is_some()).then(|| at_samples(t, &self.estimates, NO_ESTIMATE));
+        (current, at_samples(t, z_ref, z_ref_before), estimates)
+    }
+}
+
 /// The controller and where the loop stands.
 struct Sequencer<'a> {
     plan: Vec<RuntimeController<'a>>,
     operations: Vec<(Operation, f64)>,
     current: usize,
-    plant: &'a ModelPlant,
-    nonnegative_current: bool,
-    observer: Option<Observer>,
-    /// The input held over the last sample period (the current depends on it
-    /// through the eddy-current term).
-    held: f64,
+    sensing: Sensing<'a>,
     z_ref: Vec<(f64, f64)>,
-    estimates: Vec<(f64, Estimate)>,
 }
 
 impl Sequencer<'_> {
@@ -142,36 +196,10 @@ impl Sequencer<'_> {
         let Some(c) = self.plan.get_mut(self.current) else {
             return 0.0;
         };
-        let x = &m.x;
-        let (state, a) = match &mut self.observer {
-            Some(o) => {
-                // the ADC samples i just before the new voltage is applied
-                let (i, _) = self.plant.current_and_voltage(m.t, x, o.held);
-                let (e, i) = o.step(i);
-                self.estimates.push((m.t, e));
-                let phi = if self.nonnegative_current { i } else { e.phi };
-                ([e.z, e.v, phi, e.hc.unwrap_or(0.0)], e.a)
-            }
-            None => {
-                let mut dx: State = [0.0; crate::sim::MAX_DIM];
-                self.plant.deriv(m.t, x, 0.0, &mut dx);
-                // a: the free-motion acceleration, 0 against a stop
-                let a = if m.mode == Mode::Free { dx[1] } else { 0.0 };
-                let phi = if self.nonnegative_current {
-                    self.plant.current_and_voltage(m.t, x, self.held).0
-                } else {
-                    x[2]
-                };
-                // H_c: the plant's, where it has the state (x[3] is 0 otherwise)
-                ([x[0], x[1], phi, x[3]], a)
-            }
-        };
+        let (state, a) = self.sensing.read(m);
         self.z_ref.push((m.t, c.reference(m.t)[0]));
         let u = c.step(m.t, state, a);
-        self.held = u;
-        if let Some(o) = &mut self.observer {
-            o.held = u;
-        }
+        self.sensing.held = u;
         u
     }
 }
@@ -219,12 +247,14 @@ pub fn run_loop(
         plan: controllers,
         operations: operations.clone(),
         current: 0,
-        plant: &model_plant,
-        nonnegative_current,
-        observer: observer(design, sample_period, noise)?,
-        held: 0.0,
+        sensing: Sensing {
+            plant: &model_plant,
+            observer: observer(design, sample_period, noise)?,
+            nonnegative_current,
+            held: 0.0,
+            estimates: Vec::new(),
+        },
         z_ref: Vec::new(),
-        estimates: Vec::new(),
     };
     let (x0, mode0) = start_state(&mut plant_model, operations.first().map(|o| o.0));
     let t_end = duration.unwrap_or(length * operations.len() as f64);
@@ -238,13 +268,8 @@ pub fn run_loop(
         mode0,
         options,
     )?;
-    let (current, _) =
-        model_plant.currents_and_voltages(&trajectory.t, &trajectory.x, &trajectory.u);
-    let z_ref = at_samples(&trajectory.t, &sequencer.z_ref, f64::NAN);
-    let estimates = sequencer
-        .observer
-        .is_some()
-        .then(|| at_samples(&trajectory.t, &sequencer.estimates, NO_ESTIMATE));
+    let (current, z_ref, estimates) =
+        (sequencer.sensing).record(&trajectory, &sequencer.z_ref, f64::NAN);
     Ok(LoopRun {
         trajectory,
         current,
@@ -283,26 +308,19 @@ pub fn run_hold(
     let model_plant = ModelPlant::new(&mut plant_model);
     let mut design_model = design.model.clone();
     let hold = RuntimeHold::new(&mut design_model, h).controller();
-    let mut observer = observer(design, sample_period, noise)?;
-    let (mut held, mut estimates, mut z_ref) = (0.0, Vec::new(), Vec::new());
+    let mut sensing = Sensing {
+        plant: &model_plant,
+        observer: observer(design, sample_period, noise)?,
+        nonnegative_current: false,
+        held: 0.0,
+        estimates: Vec::new(),
+    };
+    let mut z_ref = Vec::new();
     let mut control = |_t: f64, m: &Measurement| {
-        let x = &m.x;
-        let state = match &mut observer {
-            Some(o) => {
-                // the ADC samples i just before the new voltage is applied
-                let (i, _) = model_plant.current_and_voltage(m.t, x, held);
-                let (e, _) = o.step(i);
-                estimates.push((m.t, e));
-                [e.z, e.v, e.phi, e.hc.unwrap_or(0.0)]
-            }
-            None => [x[0], x[1], x[2], x[3]],
-        };
+        let ([z, v, phi, hc], _) = sensing.read(m);
         z_ref.push((m.t, h.position));
-        let u = hold.step(state[0], state[1], state[2], state[3]);
-        held = u;
-        if let Some(o) = &mut observer {
-            o.held = u;
-        }
+        let u = hold.step(z, v, phi, hc);
+        sensing.held = u;
         u
     };
     let (mut x0, mode0) = start_state(&mut plant_model, None);
@@ -319,11 +337,7 @@ pub fn run_hold(
         mode0,
         options,
     )?;
-    let (current, _) =
-        model_plant.currents_and_voltages(&trajectory.t, &trajectory.x, &trajectory.u);
-    let z_ref = at_samples(&trajectory.t, &z_ref, h.position);
-    let estimates =
-        (observer.is_some()).then(|| at_samples(&trajectory.t, &estimates, NO_ESTIMATE));
+    let (current, z_ref, estimates) = sensing.record(&trajectory, &z_ref, h.position);
     Ok(LoopRun {
         trajectory,
         current,
@@ -507,7 +521,6 @@ fn observer(
         noise: SplitMix64::new(noise.seed),
         sigma_v: noise.sigma.map_or(o.voltage_noise, |s| s[0]),
         sigma_i: noise.sigma.map_or(o.current_noise, |s| s[1]),
-        held: 0.0,
     }))
 }
 
