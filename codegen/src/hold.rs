@@ -19,8 +19,7 @@ use quote::{format_ident, quote};
 use crate::controller::{law_macro_text, runtime_state_pattern, ControllerError, LawSource};
 use crate::float::Float;
 use crate::format::{format_items, space_items};
-use crate::names::const_name;
-use crate::operations::documented_consts;
+use crate::operations::{documented_consts, unique_floats};
 
 /// Everything [`emit_hold`] needs.
 #[derive(Clone)]
@@ -48,21 +47,7 @@ const HOLD_CONSTS: &[&str] = &[
 /// The `law!` macro and the hold's float modules, formatted and
 /// deterministic; each module invokes the file's `params!` macro too.
 pub fn emit_hold(input: &HoldInput) -> Result<String, ControllerError> {
-    let mut floats: Vec<Float> = Vec::new();
-    for &f in &input.floats {
-        if !floats.contains(&f) {
-            floats.push(f);
-        }
-    }
-    if floats.is_empty() {
-        return Err(ControllerError::NoFloat);
-    }
-    for (name, _, _) in input.model.params.iter() {
-        let cname = const_name(name).map_err(ControllerError::from)?;
-        if HOLD_CONSTS.contains(&cname.as_str()) {
-            return Err(ControllerError::NameTaken(cname));
-        }
-    }
+    let floats = unique_floats(input.model, &input.floats, &[HOLD_CONSTS])?;
     let source = LawSource {
         model: input.model,
         linearization: &input.design.linearization,

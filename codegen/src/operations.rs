@@ -7,7 +7,6 @@
 //! `control::Plan`. The law's own items (`controller.rs`, `sliding.rs`) come
 //! beside them.
 
-use crate::emit::doc_attrs;
 use designer::description::Operation;
 use designer::design::ControllerDesign;
 use designer::model::Model;
@@ -15,6 +14,7 @@ use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use crate::controller::{ControllerError, ControllerInput};
+use crate::emit::doc_attrs;
 use crate::error::EmitError;
 use crate::float::Float;
 use crate::names::const_name;
@@ -42,22 +42,33 @@ pub fn checked_floats(
     input: &ControllerInput,
     law_consts: &[&str],
 ) -> Result<Vec<Float>, ControllerError> {
-    let mut floats: Vec<Float> = Vec::new();
-    for &f in &input.floats {
-        if !floats.contains(&f) {
-            floats.push(f);
+    unique_floats(input.model, &input.floats, &[PLAN_CONSTS, law_consts])
+}
+
+/// `floats` each once in the order given (at least one), after checking
+/// that no parameter const of `model` takes a name of the `taken` lists
+/// (the module's own consts).
+pub fn unique_floats(
+    model: &Model,
+    floats: &[Float],
+    taken: &[&[&str]],
+) -> Result<Vec<Float>, ControllerError> {
+    let mut unique: Vec<Float> = Vec::new();
+    for &f in floats {
+        if !unique.contains(&f) {
+            unique.push(f);
         }
     }
-    if floats.is_empty() {
+    if unique.is_empty() {
         return Err(ControllerError::NoFloat);
     }
-    for (name, _, _) in input.model.params.iter() {
+    for (name, _, _) in model.params.iter() {
         let cname = const_name(name)?;
-        if law_consts.contains(&cname.as_str()) || PLAN_CONSTS.contains(&cname.as_str()) {
+        if taken.iter().any(|names| names.contains(&cname.as_str())) {
             return Err(ControllerError::NameTaken(cname));
         }
     }
-    Ok(floats)
+    Ok(unique)
 }
 
 /// `pub const NAME: f = value;` per entry, each with its doc.

@@ -31,12 +31,12 @@
 mod layout;
 mod settings;
 
-use crate::emit::doc_attrs;
 use designer::description::Drive;
 use designer::observe::discrete::DiscreteModel;
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
+use crate::emit::doc_attrs;
 use crate::error::EmitError;
 use crate::float::{Float, Scalar, MACRO_LITERALS};
 use crate::format::{comment_lets, format_items, macro_rules, space_items};
