@@ -436,7 +436,7 @@ fn settled_from(t: &[f64], error: &[f64], band: f64) -> Option<usize> {
         }
         averaged[k] = sum / (k + 1 - start) as f64;
     }
-    let outside = averaged.iter().rposition(|a| !(a.abs() <= band));
+    let outside = averaged.iter().rposition(|a| a.is_nan() || a.abs() > band);
     match outside {
         None => Some(0),
         Some(k) if k + 1 < n => Some(k + 1),

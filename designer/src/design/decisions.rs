@@ -6,10 +6,9 @@
 
 use crate::description::{Gains, Operation};
 use crate::model::Model;
-use crate::sym::Tape;
 
 use super::feasibility::Feasibility;
-use super::linearization::Linearization;
+use super::linearization::{FluxSquared, Linearization};
 use super::optimal::OptimalTrajectory;
 use super::plan::PlanError;
 use super::segments::Segments;
@@ -298,19 +297,10 @@ fn smallest_reference_flux(
     lin: &Linearization,
     operations: &[DesignedOperation],
 ) -> Result<f64, PlanError> {
-    let mut inputs = lin.xi.to_vec();
-    inputs.extend(model.params.iter().map(|(_, id, _)| id));
-    let tape = Tape::compile(&model.graph, &inputs, &[lin.flux_squared])
-        .map_err(|e| PlanError::UnboundSymbol(e.0))?;
-    let mut scratch = tape.scratch();
-    let mut point: Vec<f64> = vec![0.0; 3];
-    point.extend(model.params.iter().map(|(_, _, v)| v));
-    let mut out = [0.0];
+    let mut flux_squared = FluxSquared::new(model, lin).map_err(PlanError::UnboundSymbol)?;
     let mut smallest = f64::INFINITY;
     let mut visit = |xi: [f64; 3]| {
-        point[..3].copy_from_slice(&xi);
-        tape.eval(&point, &mut scratch, &mut out);
-        let phi2 = out[0];
+        let phi2 = flux_squared.at(xi);
         if phi2.is_finite() && phi2 > 0.0 {
             smallest = smallest.min(phi2.sqrt());
         }

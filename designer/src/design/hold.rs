@@ -11,10 +11,9 @@
 
 use crate::description::{Description, Drive, ModelSurface};
 use crate::model::{rest_point, Model};
-use crate::sym::Tape;
 
 use super::decisions::{model_sliding_gains, round_down_1sig};
-use super::linearization::Linearization;
+use super::linearization::{FluxSquared, Linearization};
 use super::plan::PlanError;
 
 /// Fraction of the holding flux below which the law is not evaluated.
@@ -72,7 +71,10 @@ pub fn design_hold(
         .landed_band
         .unwrap_or_else(|| round_down_1sig(LANDED_FRACTION * stroke));
     let at_stop = position <= mech.z_min + band || position >= mech.z_max - band;
-    let flux_squared = rest_flux_squared(model, &linearization, position)?;
+    let mut rest_flux_squared =
+        FluxSquared::new(model, &linearization).map_err(PlanError::UnboundSymbol)?;
+    // [PT 42] φ² at rest: ξ = [z, 0, 0]
+    let flux_squared = rest_flux_squared.at([position, 0.0, 0.0]);
     let holding_flux = if flux_squared > 0.0 && flux_squared.is_finite() {
         flux_squared.sqrt()
     } else if at_stop {
@@ -101,7 +103,7 @@ pub fn design_hold(
     let guard_base = if holding_flux > 0.0 {
         holding_flux
     } else {
-        rest_flux_squared(model, &linearization, mech.z_min + 0.5 * stroke)?
+        (rest_flux_squared.at([mech.z_min + 0.5 * stroke, 0.0, 0.0]))
             .max(0.0)
             .sqrt()
     };
@@ -136,17 +138,4 @@ pub fn design_hold(
         }
     }
     Ok(design)
-}
-
-/// φ² at rest at `z` on T⁻¹ [PT 42]: (ξ₃ − a₀(z, 0))/c₂(z) with ξ₃ = 0.
-fn rest_flux_squared(model: &Model, lin: &Linearization, z: f64) -> Result<f64, PlanError> {
-    let mut inputs = lin.xi.to_vec();
-    inputs.extend(model.params.iter().map(|(_, id, _)| id));
-    let tape = Tape::compile(&model.graph, &inputs, &[lin.flux_squared])
-        .map_err(|e| PlanError::UnboundSymbol(e.0))?;
-    let mut point = vec![z, 0.0, 0.0];
-    point.extend(model.params.iter().map(|(_, _, v)| v));
-    let mut out = [0.0];
-    tape.eval(&point, &mut tape.scratch(), &mut out);
-    Ok(out[0])
 }

@@ -23,7 +23,7 @@
 //! is the internal dynamics the linearization leaves alone.
 
 use crate::model::Model;
-use crate::sym::{Graph, Id};
+use crate::sym::{Graph, Id, Tape};
 
 use super::lie::{vanishing_factors, AffineSystem};
 
@@ -165,4 +165,37 @@ fn inverse_transform(
     let num = g.sub(xi[2], a0);
     let ratio = g.div(num, c2);
     Ok(([xi[0], xi[1], g.sqrt(ratio)], ratio))
+}
+
+/// φ² = (ξ₃ − a₀(ξ₁, ξ₂))/c₂(ξ₁) of T⁻¹ [PT 42] compiled at the model's
+/// parameter values, to evaluate at many ξ.
+pub struct FluxSquared {
+    tape: Tape,
+    scratch: Vec<f64>,
+    /// ξ, then the parameters' values.
+    point: Vec<f64>,
+}
+
+impl FluxSquared {
+    /// The radicand of `lin` on `model`; `Err` names a symbol left unbound.
+    pub fn new(model: &Model, lin: &Linearization) -> Result<FluxSquared, String> {
+        let mut inputs = lin.xi.to_vec();
+        inputs.extend(model.params.iter().map(|(_, id, _)| id));
+        let tape = Tape::compile(&model.graph, &inputs, &[lin.flux_squared]).map_err(|e| e.0)?;
+        let mut point = vec![0.0; 3];
+        point.extend(model.params.iter().map(|(_, _, v)| v));
+        Ok(FluxSquared {
+            scratch: tape.scratch(),
+            tape,
+            point,
+        })
+    }
+
+    /// φ² at ξ = [z, v, a].
+    pub fn at(&mut self, xi: [f64; 3]) -> f64 {
+        self.point[..3].copy_from_slice(&xi);
+        let mut out = [0.0];
+        self.tape.eval(&self.point, &mut self.scratch, &mut out);
+        out[0]
+    }
 }
