@@ -8,7 +8,7 @@
 //! ½·R_gap'(z_min)·φ² < −F(z_min, 0) (jiles-atherton-actuator-model [JA 49–50]).
 //! The Jiles–Atherton core is evaluated on its anhysteretic curve.
 
-use crate::description::{Core, Drive};
+use crate::description::{Core, Description, Drive};
 use crate::sim::State;
 use crate::sym::Tape;
 
@@ -45,14 +45,7 @@ impl Statics {
         let passive = |z: f64| d.mechanics.stiffness * z + d.mechanics.preload;
         let (passive_at_max, passive_at_min) = (passive(z_max), passive(z_min));
         let core = CoreCurve(&d.core);
-        let point = |z: f64, flux: f64| {
-            let current = (gap.value(z) * flux + core.mmf(flux)) / d.coil.turns;
-            SwitchingPoint {
-                flux,
-                current,
-                voltage: d.coil.resistance * current,
-            }
-        };
+        let point = |z: f64, flux: f64| steady_point(&gap, d, z, flux);
         let pull_in = if passive_at_max > 0.0 {
             Err(format!("at zero flux the passive force ({passive_at_max:.4} N) already pushes the armature away from z_max"))
         } else if passive_at_max == 0.0 {
@@ -105,7 +98,11 @@ impl Statics {
 /// MMF_core(φ), the Jiles–Atherton core on its anhysteretic curve).
 pub fn rest_point(model: &mut Model, z: f64, flux: f64) -> SwitchingPoint {
     let gap = GapCurve::new(model);
-    let d = &model.description;
+    steady_point(&gap, &model.description, z, flux)
+}
+
+/// [PT 4] N·i = R_gap(z)·φ + MMF_core(φ) at rest, and its voltage R·i.
+fn steady_point(gap: &GapCurve, d: &Description, z: f64, flux: f64) -> SwitchingPoint {
     let current = (gap.value(z) * flux + CoreCurve(&d.core).mmf(flux)) / d.coil.turns;
     SwitchingPoint {
         flux,
