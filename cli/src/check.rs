@@ -3,7 +3,9 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use designer::description::{Core, Description, Drive, FloatType, Gains, Gap, Law, Shape};
+use designer::description::{
+    Core, Description, Drive, FloatType, Gains, Gap, Law, SetPoint, Shape, Switching,
+};
 use designer::model::{Model, ModelPlant, Statics, SwitchingPoint};
 use miette::Report;
 
@@ -129,6 +131,21 @@ fn design_text(d: &Description) -> String {
                 match m.position {
                     Some(z) => format!("holding z_ref = {z:e} m"),
                     None => "tracking [trajectory]".into(),
+                }
+            ),
+            Law::Backstepping(b) => format!(
+                "backstepping through the force [SFB 19], α = {:?} s⁻¹, switching {}, {}",
+                b.gains,
+                match b.switching {
+                    Switching::None => "none",
+                    Switching::Intuitive => "intuitive [SFB 28]",
+                    Switching::Hybrid => "hybrid [SFB 31–33]",
+                },
+                match b.reference {
+                    SetPoint::Position(z) => format!("holding y_r = {z:e} m"),
+                    SetPoint::Square { low, high, period } => {
+                        format!("square reference {low:e} / {high:e} m, period {period:e} s")
+                    }
                 }
             ),
             Law::SlidingMode(m) => format!(

@@ -236,6 +236,10 @@ pub enum Law {
     /// u₂ of jiles-atherton-actuator-model [JA 89] on the surface [JA 88],
     /// with the mode rules and saturation to [0, u_max] of [JA 94].
     ModelSlidingMode(ModelSurface),
+    /// Backstepping through the magnetic force, switched-force-backstepping
+    /// [SFB 19], with a certified region [SFB Theorem 3] and the switching
+    /// strategies [SFB 28], [SFB 31–33].
+    Backstepping(BacksteppingKeys),
 }
 
 impl Law {
@@ -245,6 +249,7 @@ impl Law {
             Law::FeedbackLinearization(_) => "feedback-linearization",
             Law::SlidingMode(_) => "sliding-mode",
             Law::ModelSlidingMode(_) => "model-sliding-mode",
+            Law::Backstepping(_) => "backstepping",
         }
     }
 }
@@ -276,6 +281,50 @@ pub struct ModelSurface {
     /// z_ref [m]: a constant reference (a position hold); `None`: the
     /// references of `[trajectory]`.
     pub position: Option<f64>,
+}
+
+/// The backstepping law's keys (switched-force-backstepping [SFB §III–IV]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BacksteppingKeys {
+    /// α₁, α₂, α₃ [1/s] (> 0): z₂ = v + α₁·z₁ [SFB 9], ż₂ = −z₁ − α₂·z₂
+    /// [SFB 14], Ḟ − Ḟ_d = −α₃·(F − F_d) [SFB 18].
+    pub gains: [f64; 3],
+    pub switching: Switching,
+    /// α [1/s] of AᵀP + PA ⪯ −α·P [SFB Theorem 3]; `None`: the default
+    /// (`design::backstepping_design`).
+    pub decay: Option<f64>,
+    pub reference: SetPoint,
+}
+
+/// What the backstepping law does where F_d < 0 (the magnet cannot push).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Switching {
+    /// The local law everywhere [SFB 19] (its output saturated).
+    None,
+    /// u = 0 until the state enters the region D, then the law [SFB 28].
+    Intuitive,
+    /// The law while F_d ≥ 0, u = 0 from F_d ≤ 0 until D, then the law
+    /// [SFB 31–33].
+    Hybrid,
+}
+
+/// The backstepping law's reference y_r.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SetPoint {
+    /// A constant position [m].
+    Position(f64),
+    /// `low` for the first half of each `period` [s], then `high` [m].
+    Square { low: f64, high: f64, period: f64 },
+}
+
+impl SetPoint {
+    /// The constant references, in the order they are first held.
+    pub fn positions(&self) -> Vec<f64> {
+        match *self {
+            SetPoint::Position(z) => vec![z],
+            SetPoint::Square { low, high, .. } => vec![low, high],
+        }
+    }
 }
 
 /// An estimator of `[observer].estimators`.

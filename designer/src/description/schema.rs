@@ -173,6 +173,9 @@ impl Key {
 const FL: &[&str] = &["feedback-linearization"];
 const SM: &[&str] = &["sliding-mode"];
 const MSM: &[&str] = &["model-sliding-mode"];
+const BS: &[&str] = &["backstepping"];
+/// Laws that hold a constant `position`.
+const HOLDS: &[&str] = &["model-sliding-mode", "backstepping"];
 
 /// Every key, in the order of the reference (one key per line: a table).
 #[rustfmt::skip]
@@ -237,7 +240,7 @@ pub const KEYS: &[Key] = &[
     choice("trajectory.shape", &["energy-optimal", "polynomial"], "the motion: min ∫u² dt (Pontryagin), or the degree-5 polynomial"),
     number("trajectory.u_bound", Domain::Positive, "V", Presence::Required, "the design uses inputs in [max(u_min, −u_bound), u_bound]; max(0, u_min) < u_bound ≤ u_max; the rest is the feedback's (A with drive = \"current\")"),
     // [controller]
-    choice("controller.law", &["feedback-linearization", "sliding-mode", "model-sliding-mode"], "the control law: feedback linearization [PT 50], the model-free sliding mode [SM 34–35] with the expert rules [SM 43], or the model-based sliding mode [JA 89] with the mode rules [JA 94]"),
+    choice("controller.law", &["feedback-linearization", "sliding-mode", "model-sliding-mode", "backstepping"], "the control law: feedback linearization [PT 50], the model-free sliding mode [SM 34–35] with the expert rules [SM 43], the model-based sliding mode [JA 89] with the mode rules [JA 94], or backstepping through the force [SFB 19] with a certified region [SFB Theorem 3]"),
     Key { variants: FL, ..number("controller.settling_time", Domain::Positive, "s", Presence::When("exactly one of settling_time and poles"), "5 % settling time of the error dynamics with a triple real pole") },
     numbers("controller.poles", FL, Domain::Negative, "1/s", Presence::When("exactly one of settling_time and poles"), "the three real closed-loop poles of the error dynamics"),
     Key { variants: SM, ..number("controller.lambda1", Domain::Positive, "1/s", Presence::Required, "λ₁ of the sliding surface s = (λ₁ + d/dt)(λ₂ + d/dt)(z − z_r) [SM 17]") },
@@ -246,7 +249,11 @@ pub const KEYS: &[Key] = &[
     Key { variants: SM, kind: Kind::Bool, ..number("controller.nonnegative_current", Domain::Any, "", Presence::Optional("false: the step reads φ (measured or estimated) for its sign"), "the current is kept ≥ 0 [SM §5]: the step reads the coil current instead of φ, takes sgn φ = +1 and never drives the current below 0") },
     Key { variants: MSM, ..number("controller.p", Domain::Positive, "1/s", Presence::Required, "p of the sliding surface s = (p + d/dt)²(z − z_ref) [JA 88]") },
     Key { variants: MSM, ..number("controller.k", Domain::Positive, "1/s", Presence::Required, "K of the reaching law ṡ = −K·s [JA 93]: with p, the error dynamics (d/dt + p)²(d/dt + K)") },
-    Key { variants: MSM, ..number("controller.position", Domain::Any, "m", Presence::When("exactly one of position and a [trajectory] section"), "z_ref: hold the armature at this constant position in [z_min, z_max] [JA §6.3]") },
+    Key { variants: HOLDS, ..number("controller.position", Domain::Any, "m", Presence::When("model-sliding-mode: exactly one of position and a [trajectory] section; backstepping: exactly one of position and square"), "z_ref: hold the armature at this constant position in [z_min, z_max] [JA §6.3], [SFB §III]") },
+    numbers("controller.gains", BS, Domain::Positive, "1/s", Presence::Required, "α₁, α₂, α₃ of the backstepping law: z₂ = v + α₁·(z − y_r) [SFB 9], ż₂ = −z₁ − α₂·z₂ [SFB 14], (F − F_d) decays at α₃ [SFB 18]"),
+    Key { variants: BS, kind: Kind::Choice(&["none", "intuitive", "hybrid"]), ..number("controller.switching", Domain::Any, "", Presence::Optional("hybrid"), "where F_d < 0: none (the local law [SFB 19] everywhere), intuitive (u = 0 until the region D is reached [SFB 28]), hybrid (the law while F_d ≥ 0, u = 0 from F_d ≤ 0 until D [SFB 31–33]); intuitive and hybrid need the spring's rest inside D") },
+    Key { variants: BS, ..number("controller.decay", Domain::Positive, "1/s", Presence::Optional("a fifth of the largest a quadratic V allows"), "α of the region's LMI AᵀP + PA ⪯ −α·P [SFB Theorem 3]") },
+    numbers("controller.square", BS, Domain::Positive, "m, m, s", Presence::When("exactly one of position and square"), "[z_low, z_high, period]: a square reference, z_low for the first half of each period, then z_high [SFB §V]"),
     number("controller.sample_period", Domain::Positive, "s", Presence::Required, "T_s: the emitted step runs once per sample; at most (landing − takeoff)/10"),
     names("controller.float", &["f32", "f64"], Presence::Optional("both"), "the float types to emit code for"),
     Key { kind: Kind::Choice(&["ekf", "ukf"]), ..number("controller.estimator", Domain::Any, "", Presence::Optional("the closed loops of `loop` and `sweep` feed the controller the plant's state"), "the observer of [observer] that drives the controller in `reldesign loop` and `sweep` from the measured voltage and current (it must be listed in observer.estimators)") },

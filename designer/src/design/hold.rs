@@ -53,6 +53,45 @@ impl HoldDesign {
     }
 }
 
+/// The flux and the steady input (R·i [V], or i [A] with current drive)
+/// that hold the armature at rest at `position`; 0 at a stop the spring
+/// holds. Errors: no attracting flux balances the spring there, or the input
+/// exceeds the supply.
+pub(super) fn holding(
+    description: &Description,
+    model: &mut Model,
+    rest_flux_squared: &mut FluxSquared,
+    position: f64,
+    at_stop: bool,
+) -> Result<(f64, f64), PlanError> {
+    // [PT 42] φ² at rest: ξ = [z, 0, 0]
+    let flux_squared = rest_flux_squared.at([position, 0.0, 0.0]);
+    let holding_flux = if flux_squared > 0.0 && flux_squared.is_finite() {
+        flux_squared.sqrt()
+    } else if at_stop {
+        0.0
+    } else {
+        return Err(PlanError::Unholdable {
+            position,
+            flux_squared,
+        });
+    };
+    let rest = rest_point(model, position, holding_flux);
+    let holding_input = match description.supply.drive {
+        Drive::Voltage => rest.voltage,
+        Drive::Current => rest.current,
+    };
+    let u_max = description.supply.u_max;
+    if !at_stop && !(holding_input < u_max) {
+        return Err(PlanError::HoldingInput {
+            position,
+            input: holding_input,
+            u_max,
+        });
+    }
+    Ok((holding_flux, holding_input))
+}
+
 /// Designs the hold of `[controller]` (law "model-sliding-mode" with
 /// `position`).
 pub fn design_hold(
@@ -73,32 +112,9 @@ pub fn design_hold(
     let at_stop = position <= mech.z_min + band || position >= mech.z_max - band;
     let mut rest_flux_squared =
         FluxSquared::new(model, &linearization).map_err(PlanError::UnboundSymbol)?;
-    // [PT 42] φ² at rest: ξ = [z, 0, 0]
-    let flux_squared = rest_flux_squared.at([position, 0.0, 0.0]);
-    let holding_flux = if flux_squared > 0.0 && flux_squared.is_finite() {
-        flux_squared.sqrt()
-    } else if at_stop {
-        0.0
-    } else {
-        return Err(PlanError::Unholdable {
-            position,
-            flux_squared,
-        });
-    };
-    let rest = rest_point(model, position, holding_flux);
-    // the steady input in the supply's unit: R·i [V], or i [A] with current drive
-    let holding_input = match description.supply.drive {
-        Drive::Voltage => rest.voltage,
-        Drive::Current => rest.current,
-    };
+    let (holding_flux, holding_input) =
+        holding(description, model, &mut rest_flux_squared, position, at_stop)?;
     let u_max = description.supply.u_max;
-    if !at_stop && !(holding_input < u_max) {
-        return Err(PlanError::HoldingInput {
-            position,
-            input: holding_input,
-            u_max,
-        });
-    }
     // the guard: 10⁻³ of the holding flux (of mid-stroke's at a stop)
     let guard_base = if holding_flux > 0.0 {
         holding_flux

@@ -4,6 +4,13 @@
 //! - `linearization.rs`: exact feedback linearization for y = z: α, β, T, T⁻¹,
 //!   the jerk terms;
 //! - `reference.rs`: soft-landing position references (polynomial);
+//! - `backstepping.rs`: backstepping through the force for y = z
+//!   [SFB §III]: F_d, Ḟ = f_F + g_F·u, the law u [SFB 19];
+//! - `lmi.rs`: small SDPs of 2×2 LMIs, as second-order cone programs (generic);
+//! - `region.rs`: the backstepping law's certified region [SFB lemma 1],
+//!   [SFB Theorem 3], extended to the spring's rest;
+//! - `backstepping_design.rs`: the backstepping controller as plain data,
+//!   [`BacksteppingDesign`];
 //! - `feasibility.rs`: conditions [PT 54], [PT 56], [PT 57] along a reference;
 //! - `bvp.rs` (and `bvp/`): a collocation two-point BVP solver (generic);
 //! - `optimal.rs`: the energy-optimal reference (Pontryagin, [PT 58–66]);
@@ -25,6 +32,8 @@
 //! - `runtime.rs`: a design as the runtime runs it (its `Plan`, `Law`,
 //!   `Surface` traits), for the designer's closed loops.
 
+mod backstepping;
+mod backstepping_design;
 mod bvp;
 mod decisions;
 mod feasibility;
@@ -33,17 +42,21 @@ mod hold;
 mod lie;
 mod limits;
 mod linearization;
+mod lmi;
 mod monte_carlo;
 mod optimal;
 mod optimal_guess;
 mod optimal_search;
 mod plan;
 mod reference;
+mod region;
 mod report;
 mod robustness;
 mod runtime;
 mod segments;
 
+pub use backstepping::{Backstepping, BacksteppingError, SYMBOLS as BACKSTEPPING_SYMBOLS};
+pub use backstepping_design::{design_backstepping, BacksteppingDesign};
 pub use bvp::{
     jacobian_discrepancy, solve_bvp, solve_collocation, BvpError, BvpOptions, BvpProblem,
     BvpSolution,
@@ -60,7 +73,8 @@ pub use fit_segments::{
 pub use hold::{design_hold, HoldDesign};
 pub use lie::{lie, vanishing_factors, AffineSystem, OutputDerivatives};
 pub use limits::{motion_limits, CostPoint, MotionLimits};
-pub use linearization::{DesignError, Linearization};
+pub use linearization::{DesignError, FluxSquared, Linearization};
+pub use lmi::{eigenvalues, Lmi2, Sdp2, SdpOutcome, Sym2};
 pub use monte_carlo::{Analysis, Draw, MonteCarlo, Nominal, RobustnessError, Variation};
 pub use optimal::{
     energy_optimal, CostateGuess, HamiltonianSystem, OptimalError, OptimalSpec, OptimalTrajectory,
@@ -70,6 +84,9 @@ pub use plan::{
     design_controller, design_kalman, design_reference, Design, PlanError, SharedReference,
 };
 pub use reference::{Flat, Polynomial, Reference};
+pub use region::{
+    decay_limit, design_region, level, quadratic, Level, Region, RegionError, Target, REST_MARGIN,
+};
 pub use robustness::{operation_end, ErrorBounds, Evaluator, Robustness, Sample};
 pub use runtime::{RuntimeController, RuntimeHold, RuntimePlan};
 pub use segments::{Segment, Segments};

@@ -18,6 +18,7 @@ use crate::observe::discrete::{DiscreteModel, KalmanSettings, ResistanceSettings
 use super::decisions::{gains, ControllerDesign, ControllerSpec, DesignedOperation, LawDesign};
 use super::feasibility::check as check_feasibility;
 use super::fit_segments::{fit_segments, SegmentTolerance};
+use super::backstepping_design::{design_backstepping, BacksteppingDesign};
 use super::hold::{design_hold, HoldDesign};
 use super::linearization::{DesignError, Linearization};
 use super::optimal::{energy_optimal, OptimalError, OptimalSpec, OptimalTrajectory};
@@ -114,6 +115,10 @@ pub enum PlanError {
     },
     #[error("internal error: the symbol `{0}` of the linearization is unbound")]
     UnboundSymbol(String),
+    #[error("the backstepping law's region: {0}")]
+    Region(super::region::RegionError),
+    #[error("the backstepping law: {0}")]
+    Backstepping(super::backstepping::BacksteppingError),
 }
 
 impl Operation {
@@ -134,6 +139,8 @@ pub struct Design {
     pub controller: Option<ControllerDesign>,
     /// From `[controller]` with law "model-sliding-mode" and `position`.
     pub hold: Option<HoldDesign>,
+    /// From `[controller]` with law "backstepping".
+    pub backstepping: Option<BacksteppingDesign>,
     /// The EKF/UKF discretised model, from `[observer]` with "ekf" or "ukf".
     pub kalman: Option<DiscreteModel>,
 }
@@ -147,7 +154,14 @@ impl Design {
             Law::ModelSlidingMode(s) => s.position.map(|z| (s, z)),
             _ => None,
         });
+        let mut backstepping = None;
         let (controller, hold) = match (&description.trajectory, &description.controller, held) {
+            (None, Some(c), _) if matches!(c.law, Law::Backstepping(_)) => {
+                if let Law::Backstepping(keys) = c.law {
+                    backstepping = Some(design_backstepping(description, &mut model, &keys)?);
+                }
+                (None, None)
+            }
             (None, Some(_), Some((surface, z))) => (
                 None,
                 Some(design_hold(description, &mut model, &surface, z)?),
@@ -157,7 +171,8 @@ impl Design {
             _ => return Err(PlanError::TrajectoryWithoutController),
         };
         let kalman = design_kalman(description, &model)?;
-        if controller.is_none() && hold.is_none() && description.observer.is_none() {
+        let designed = controller.is_some() || hold.is_some() || backstepping.is_some();
+        if !designed && description.observer.is_none() {
             return Err(PlanError::NothingToBuild);
         }
         Ok(Design {
@@ -165,6 +180,7 @@ impl Design {
             model,
             controller,
             hold,
+            backstepping,
             kalman,
         })
     }
@@ -201,6 +217,8 @@ pub fn design_controller(
             }
         }
         Law::ModelSlidingMode(s) => LawDesign::ModelSlidingMode { p: s.p, k: s.k },
+        // holds positions, not a [trajectory] (the description refuses both)
+        Law::Backstepping(_) => return Err(PlanError::NothingToBuild),
     };
     let spec = ControllerSpec {
         law,

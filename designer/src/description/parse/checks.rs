@@ -5,7 +5,7 @@
 
 use super::sect::{Res, Sect};
 use crate::description::{Coil, Controller, Core, Drive, Estimator, Gap, Mechanics, Observer};
-use crate::description::{Law, ModelSurface, Shape, Supply, Trajectory};
+use crate::description::{BacksteppingKeys, Law, ModelSurface, SetPoint, Shape, Supply, Trajectory};
 
 /// Grid size of the fringing-denominator check on (0, z_max].
 const DENOMINATOR_GRID: usize = 1000;
@@ -156,6 +156,9 @@ pub(super) fn check_controller(
     {
         return check_position(root, s, z_ref, trajectory.is_some(), mechanics);
     }
+    if let Law::Backstepping(keys) = c.law {
+        return check_set_point(root, s, c, &keys, trajectory.is_some(), mechanics);
+    }
     let Some(t) = trajectory else {
         let hold = if let Law::ModelSlidingMode(_) = c.law {
             " (or, with this law, controller.position = z_ref to hold a constant position)"
@@ -212,6 +215,43 @@ fn check_position(
         let msg = "controller.creep_speed shapes the reference after a trajectory's landing; \
                    a constant position has none: remove it";
         return Err(s.err("creep_speed", msg, "not with controller.position"));
+    }
+    Ok(())
+}
+
+/// The backstepping law's reference: `position` (as the hold's) or `square`,
+/// within the stroke and sampled at least 10 times per half period.
+fn check_set_point(
+    root: &Sect,
+    s: &Sect,
+    c: &Controller,
+    keys: &BacksteppingKeys,
+    with_trajectory: bool,
+    m: &Mechanics,
+) -> Res<()> {
+    let (low, high, period) = match keys.reference {
+        SetPoint::Position(z) => return check_position(root, s, z, with_trajectory, m),
+        SetPoint::Square { low, high, period } => (low, high, period),
+    };
+    // the conflicts first, then the range of both positions
+    check_position(root, s, low.clamp(m.z_min, m.z_max), with_trajectory, m)?;
+    if !(m.z_min..=m.z_max).contains(&low) || !(m.z_min..=m.z_max).contains(&high) {
+        let msg = format!(
+            "expected z_low and z_high in [mechanics.z_min, mechanics.z_max] = [{}, {}] [m], \
+             found [{low}, {high}]: the armature can only be held within its stroke",
+            m.z_min, m.z_max
+        );
+        return Err(s.err("square", msg, "outside the stroke"));
+    }
+    let limit = period / 20.0;
+    if c.sample_period > limit {
+        let msg = format!(
+            "expected controller.sample_period <= period/20 = {limit:e} [s] for \
+             controller.square's period {period:e} s, found {:e}: each half period must span at \
+             least 10 samples",
+            c.sample_period
+        );
+        return Err(s.err("sample_period", msg, "too long for the square reference"));
     }
     Ok(())
 }

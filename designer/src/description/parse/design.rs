@@ -7,8 +7,8 @@ use super::physics::input_unit;
 use super::sect::{Res, Sect};
 use crate::description::schema;
 use crate::description::{
-    Controller, Estimator, FloatType, Gains, Law, ModelSurface, Operation, Shape, SlidingSurface,
-    Supply, Trajectory,
+    BacksteppingKeys, Controller, Estimator, FloatType, Gains, Law, ModelSurface, Operation,
+    SetPoint, Shape, SlidingSurface, Supply, Switching, Trajectory,
 };
 
 pub(super) fn parse_trajectory(s: &Sect, supply: &Supply) -> Res<Trajectory> {
@@ -55,6 +55,7 @@ pub(super) fn parse_controller(s: &Sect) -> Res<Controller> {
     let law = match name {
         "feedback-linearization" => Law::FeedbackLinearization(parse_gains(s)?),
         "sliding-mode" => Law::SlidingMode(parse_surface(s)?),
+        "backstepping" => Law::Backstepping(parse_backstepping(s)?),
         _ => Law::ModelSlidingMode(ModelSurface {
             p: s.req("p")?,
             k: s.req("k")?,
@@ -119,6 +120,69 @@ fn parse_surface(s: &Sect) -> Res<SlidingSurface> {
         eta: s.req("eta")?,
         nonnegative_current: s.opt_bool("nonnegative_current")?.unwrap_or(false),
     })
+}
+
+/// The backstepping law's keys [SFB]: three gains, the switching strategy,
+/// the decay, and exactly one of `position` and `square`.
+fn parse_backstepping(s: &Sect) -> Res<BacksteppingKeys> {
+    let gains = exactly::<3>(s, "gains", "α₁, α₂, α₃ [1/s], each > 0")?
+        .ok_or_else(|| s.missing("gains", "controller.gains = [α₁, α₂, α₃] [1/s], each > 0"))?;
+    let switching = match s.opt_choice("switching", "switching strategy")? {
+        Some("none") => Switching::None,
+        Some("intuitive") => Switching::Intuitive,
+        _ => Switching::Hybrid,
+    };
+    let decay = s.opt("decay")?;
+    let position = s.opt("position")?;
+    let square = exactly::<3>(s, "square", "[z_low, z_high, period] ([m], [m], [s])")?;
+    let reference = match (position, square) {
+        (Some(z), None) => SetPoint::Position(z),
+        (None, Some([low, high, period])) => {
+            if low >= high {
+                let msg = format!(
+                    "expected z_low < z_high in controller.square = [z_low, z_high, period], \
+                     found z_low = {low}, z_high = {high}"
+                );
+                return Err(s.err("square", msg, "z_low must be below z_high"));
+            }
+            SetPoint::Square { low, high, period }
+        }
+        (Some(_), Some(_)) => {
+            return Err(s.err(
+                "square",
+                "give either controller.position or controller.square, not both (each is the \
+                 reference y_r)",
+                "conflicts with `position`",
+            ))
+        }
+        (None, None) => {
+            return Err(s.missing(
+                "position",
+                "exactly one of controller.position = z_ref [m] or controller.square = \
+                 [z_low, z_high, period]",
+            ))
+        }
+    };
+    Ok(BacksteppingKeys {
+        gains,
+        switching,
+        decay,
+        reference,
+    })
+}
+
+/// An optional array of exactly `N` numbers.
+fn exactly<const N: usize>(s: &Sect, key: &str, what: &str) -> Res<Option<[f64; N]>> {
+    let Some(found) = s.opt_numbers(key)? else {
+        return Ok(None);
+    };
+    match <[f64; N]>::try_from(found.as_slice()) {
+        Ok(values) => Ok(Some(values)),
+        Err(_) => {
+            let msg = format!("expected exactly {N} numbers, {what}; found {}", found.len());
+            Err(s.err(key, msg, &format!("needs {N} numbers")))
+        }
+    }
 }
 
 /// `float` of `[controller]` and `[observer]`: optional, default both;
