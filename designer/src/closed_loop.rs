@@ -80,7 +80,7 @@ pub struct LoopRun {
 /// The observer that drives the controller from the measured voltage and
 /// current (`[controller] estimator`), with the seeded measurement noise of
 /// `[observer]`.
-struct Observer {
+pub(crate) struct Observer {
     filter: Filter,
     noise: SplitMix64,
     sigma_v: f64,
@@ -109,21 +109,21 @@ impl Observer {
 /// What a loop's controller reads at each sample: the plant's state, or the
 /// observer's estimate from the measured voltage and current; and the input
 /// held since the last sample.
-struct Sensing<'a> {
-    plant: &'a ModelPlant,
-    observer: Option<Observer>,
+pub(crate) struct Sensing<'a> {
+    pub(crate) plant: &'a ModelPlant,
+    pub(crate) observer: Option<Observer>,
     /// φ is read as the coil current ([SM §5]'s non-negative current).
-    nonnegative_current: bool,
+    pub(crate) nonnegative_current: bool,
     /// The input held over the last sample period (the current depends on it
     /// through the eddy-current term).
-    held: f64,
-    estimates: Vec<(f64, Estimate)>,
+    pub(crate) held: f64,
+    pub(crate) estimates: Vec<(f64, Estimate)>,
 }
 
 impl Sensing<'_> {
     /// [z, v, φ, H_c] and the acceleration a at the sample `m` (H_c is 0
     /// where neither the plant nor the observer has it).
-    fn read(&mut self, m: &Measurement) -> ([f64; 4], f64) {
+    pub(crate) fn read(&mut self, m: &Measurement) -> ([f64; 4], f64) {
         let x = &m.x;
         match &mut self.observer {
             Some(o) => {
@@ -152,7 +152,7 @@ impl Sensing<'_> {
 
     /// The run's current at every sample, its records at the samples (the
     /// reference `z_ref` starting from `z_ref_before`), and the estimates.
-    fn record(
+    pub(crate) fn record(
         &self,
         trajectory: &Trajectory,
         z_ref: &[(f64, f64)],
@@ -448,7 +448,7 @@ fn settled_from(t: &[f64], error: &[f64], band: f64) -> Option<usize> {
 /// the law where no observer does, and a law on a Jiles–Atherton design
 /// reads H_c, which only a Jiles–Atherton plant has. (A reluctance design on
 /// a Jiles–Atherton plant is the mismatch study of the sensorless loops.)
-fn check_plant(design: &Design, plant: &Model) -> Result<(), LoopError> {
+pub(crate) fn check_plant(design: &Design, plant: &Model) -> Result<(), LoopError> {
     let observed = (design.description.controller.as_ref()).is_some_and(|c| c.estimator.is_some());
     if design.model.dim() > plant.dim() && !observed {
         return Err(LoopError::PlantMismatch {
@@ -491,7 +491,7 @@ const NO_ESTIMATE: Estimate = Estimate {
 };
 
 /// The observer `[controller] estimator` names, at the loop's sample period.
-fn observer(
+pub(crate) fn observer(
     design: &Design,
     sample_period: f64,
     noise: Noise,
@@ -526,7 +526,7 @@ fn observer(
 
 /// At rest at the first operation's z₀: z_max without flux, or z_min held by
 /// 1.2× the flux that balances the passive force there.
-fn start_state(model: &mut Model, first: Option<Operation>) -> (State, Mode) {
+pub(crate) fn start_state(model: &mut Model, first: Option<Operation>) -> (State, Mode) {
     let mut x0: State = [0.0; crate::sim::MAX_DIM];
     let (z_min, z_max) = (
         model.description.mechanics.z_min,

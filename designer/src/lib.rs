@@ -4,6 +4,7 @@
 //! - [`sym`]: the symbolic core (hash-consed expression DAG, simplification,
 //!   differentiation, CSE, flat-tape evaluation). Knows nothing of actuators.
 //! - [`design`]: controller derivations (Lie derivatives, feedback linearization).
+//! - [`backstepping_loop`]: the backstepping position controller in a sampled loop (`loop`).
 //! - [`closed_loop`]: the designed controller in a sampled loop on a plant (`loop`, `sweep`).
 //! - [`description`]: the validated actuator description (`valve.toml`).
 //! - [`model`]: the actuator's state-space model, built symbolically.
@@ -13,6 +14,7 @@
 //! - [`replay`]: an input replayed through the hybrid model (`simulate`).
 //! - [`sim`]: the hybrid-automaton simulator (knows nothing of magnetics).
 
+pub mod backstepping_loop;
 pub mod closed_loop;
 pub mod description;
 pub mod design;

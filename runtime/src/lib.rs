@@ -15,6 +15,7 @@
     clippy::as_conversions
 )]
 
+pub mod backstepping;
 pub mod control;
 pub mod hold;
 pub mod integral;

@@ -88,5 +88,7 @@ pub use region::{
     decay_limit, design_region, level, quadratic, Level, Region, RegionError, Target, REST_MARGIN,
 };
 pub use robustness::{operation_end, ErrorBounds, Evaluator, Robustness, Sample};
-pub use runtime::{RuntimeController, RuntimeHold, RuntimePlan};
+pub use runtime::{
+    runtime_switching, RuntimeBackstepping, RuntimeController, RuntimeHold, RuntimePlan,
+};
 pub use segments::{Segment, Segments};

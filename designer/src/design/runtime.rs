@@ -10,14 +10,18 @@
 
 use std::cell::RefCell;
 
+use reldesign_runtime::backstepping::{
+    self, Backstepping, BacksteppingSettings, SwitchedBackstepping,
+};
 use reldesign_runtime::control::{Landing, Law, Motion, Plan, Settings, SoftLanding};
 use reldesign_runtime::hold::{Hold, HoldSettings, PositionHold};
 use reldesign_runtime::sliding::{SlidingMode, Surface, SurfaceSettings};
 
-use crate::description::Operation;
+use crate::description::{Operation, SetPoint, Switching};
 use crate::model::Model;
 use crate::sym::Tape;
 
+use super::backstepping_design::BacksteppingDesign;
 use super::decisions::{ControllerDesign, LawDesign};
 use super::hold::HoldDesign;
 use super::linearization::Linearization;
@@ -234,5 +238,126 @@ impl Hold<f64> for RuntimeHold<'_> {
     /// [JA 89] as [PT 50] with K = [K·p², p² + 2pK, 2p + K].
     fn law(&self, x: [f64; 4], reference: [f64; 4]) -> f64 {
         self.law.law(self.design.gains(), x, reference)
+    }
+}
+
+/// F_d [SFB Theorem 1], u [SFB 19] and the force F from one tape: (x, u = 0,
+/// t = 0, y_r) → [F_d, u, F], the gains and P bound to the design's values.
+struct BacksteppingTape {
+    tape: Tape,
+    scratch: RefCell<Vec<f64>>,
+    dim: usize,
+}
+
+impl BacksteppingTape {
+    fn new(model: &mut Model, design: &BacksteppingDesign) -> BacksteppingTape {
+        let law = &design.law;
+        let [_, p12, p22] = design.region.p;
+        let values = [design.gains[0], design.gains[1], design.gains[2], p12, p22];
+        let symbols = [law.gains[0], law.gains[1], law.gains[2], law.coupling[0], law.coupling[1]];
+        let map = symbols
+            .iter()
+            .zip(values)
+            .map(|(&s, x)| (s, model.graph.constant(x)))
+            .collect();
+        let exprs = (model.graph).substitute_all(&[law.desired_force, law.law, law.force], &map);
+        let bound = model.bind_params(&exprs);
+        let mut inputs = model.tape_inputs();
+        inputs.push(law.target);
+        let tape = Tape::compile(&model.graph, &inputs, &bound)
+            .unwrap_or_else(|e| unreachable!("the law reads states, u, t, y_r only: {}", e.0));
+        BacksteppingTape {
+            scratch: RefCell::new(tape.scratch()),
+            tape,
+            dim: model.dim(),
+        }
+    }
+
+    fn eval(&self, x: [f64; 4], y_r: f64) -> [f64; 3] {
+        let mut inputs = [0.0; 7];
+        inputs[..self.dim].copy_from_slice(&x[..self.dim]);
+        inputs[self.dim + 2] = y_r;
+        let mut out = [0.0; 3];
+        (self.tape).eval(&inputs[..self.dim + 3], &mut self.scratch.borrow_mut(), &mut out);
+        out
+    }
+}
+
+/// A [`BacksteppingDesign`] as the runtime's `backstepping::Backstepping`,
+/// F_d and the law from a tape.
+pub struct RuntimeBackstepping<'a> {
+    design: &'a BacksteppingDesign,
+    tape: BacksteppingTape,
+}
+
+impl<'a> RuntimeBackstepping<'a> {
+    /// The controller of `design` on `model` (the model the design was made on).
+    pub fn new(model: &mut Model, design: &'a BacksteppingDesign) -> RuntimeBackstepping<'a> {
+        let tape = BacksteppingTape::new(model, design);
+        RuntimeBackstepping { design, tape }
+    }
+
+    /// The runtime's controller over this plan.
+    pub fn controller(self) -> SwitchedBackstepping<RuntimeBackstepping<'a>, f64> {
+        SwitchedBackstepping::with(self)
+    }
+
+    /// V = ZᵀPZ + ½·(F − F_d)² at x for y_r [SFB 21], [SFB 18]: non-increasing
+    /// wherever the law is applied unsaturated.
+    pub fn lyapunov(&self, x: [f64; 4], y_r: f64) -> f64 {
+        let [desired, _, force] = self.tape.eval(x, y_r);
+        let [z, v, ..] = x;
+        let mechanical = backstepping::lyapunov(&self.settings(), z, v, y_r);
+        mechanical + 0.5 * (force - desired) * (force - desired)
+    }
+}
+
+/// The runtime's switching strategy of the description's.
+pub fn runtime_switching(s: Switching) -> backstepping::Switching {
+    match s {
+        Switching::None => backstepping::Switching::None,
+        Switching::Intuitive => backstepping::Switching::Intuitive,
+        Switching::Hybrid => backstepping::Switching::Hybrid,
+    }
+}
+
+impl BacksteppingDesign {
+    /// The reference with each target's level C, as the runtime reads it.
+    pub fn set_point(&self) -> backstepping::SetPoint<f64> {
+        let target = |i: usize| backstepping::Target {
+            position: self.region.targets.get(i).map_or(f64::NAN, |t| t.position),
+            level: self.region.levels.get(i).map_or(f64::NAN, |l| l.c),
+        };
+        match self.reference {
+            SetPoint::Position(_) => backstepping::SetPoint::Position(target(0)),
+            SetPoint::Square { period, .. } => backstepping::SetPoint::Square {
+                low: target(0),
+                high: target(1),
+                period,
+            },
+        }
+    }
+}
+
+impl Backstepping<f64> for RuntimeBackstepping<'_> {
+    fn settings(&self) -> BacksteppingSettings<f64> {
+        let d = self.design;
+        BacksteppingSettings {
+            u_min: d.u_min,
+            u_max: d.u_max,
+            phi_guard: d.phi_guard,
+            alpha1: d.gains[0],
+            p: d.region.p,
+            switching: runtime_switching(d.switching),
+            reference: d.set_point(),
+        }
+    }
+
+    fn desired_force(&self, z: f64, v: f64, y_r: f64) -> f64 {
+        self.tape.eval([z, v, 0.0, 0.0], y_r)[0]
+    }
+
+    fn law(&self, x: [f64; 4], y_r: f64) -> f64 {
+        self.tape.eval(x, y_r)[1]
     }
 }
