@@ -112,8 +112,13 @@ pub fn design_hold(
     let at_stop = position <= mech.z_min + band || position >= mech.z_max - band;
     let mut rest_flux_squared =
         FluxSquared::new(model, &linearization).map_err(PlanError::UnboundSymbol)?;
-    let (holding_flux, holding_input) =
-        holding(description, model, &mut rest_flux_squared, position, at_stop)?;
+    let (holding_flux, holding_input) = holding(
+        description,
+        model,
+        &mut rest_flux_squared,
+        position,
+        at_stop,
+    )?;
     let u_max = description.supply.u_max;
     // the guard: 10⁻³ of the holding flux (of mid-stroke's at a stop)
     let guard_base = if holding_flux > 0.0 {

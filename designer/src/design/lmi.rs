@@ -49,7 +49,10 @@ pub struct Sdp2 {
 /// What the solver found.
 #[derive(Debug, Clone, PartialEq)]
 pub enum SdpOutcome {
-    Optimal { x: Vec<f64>, objective: f64 },
+    Optimal {
+        x: Vec<f64>,
+        objective: f64,
+    },
     /// Certified infeasible (a dual certificate).
     Infeasible,
     /// Anything else (unbounded, iteration limit, numerical trouble), named.
@@ -87,7 +90,11 @@ impl Sdp2 {
         if !self.equalities.is_empty() {
             cones.push(SupportedConeT::ZeroConeT(self.equalities.len()));
         }
-        cones.extend(self.lmis.iter().map(|_| SupportedConeT::SecondOrderConeT(3)));
+        cones.extend(
+            self.lmis
+                .iter()
+                .map(|_| SupportedConeT::SecondOrderConeT(3)),
+        );
         let a = CscMatrix::from(&rows);
         let p = CscMatrix::zeros((n, n));
         let settings = match DefaultSettingsBuilder::default()
@@ -101,8 +108,7 @@ impl Sdp2 {
             Ok(s) => s,
             Err(e) => return SdpOutcome::Failed(format!("solver settings: {e}")),
         };
-        let mut solver = match DefaultSolver::new(&p, &self.objective, &a, &rhs, &cones, settings)
-        {
+        let mut solver = match DefaultSolver::new(&p, &self.objective, &a, &rhs, &cones, settings) {
             Ok(s) => s,
             Err(e) => return SdpOutcome::Failed(format!("solver setup: {e:?}")),
         };

@@ -15,10 +15,10 @@ use crate::description::{
 use crate::model::Model;
 use crate::observe::discrete::{DiscreteModel, KalmanSettings, ResistanceSettings};
 
+use super::backstepping_design::{design_backstepping, BacksteppingDesign};
 use super::decisions::{gains, ControllerDesign, ControllerSpec, DesignedOperation, LawDesign};
 use super::feasibility::check as check_feasibility;
 use super::fit_segments::{fit_segments, SegmentTolerance};
-use super::backstepping_design::{design_backstepping, BacksteppingDesign};
 use super::hold::{design_hold, HoldDesign};
 use super::linearization::{DesignError, Linearization};
 use super::optimal::{energy_optimal, OptimalError, OptimalSpec, OptimalTrajectory};

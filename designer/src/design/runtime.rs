@@ -254,7 +254,13 @@ impl BacksteppingTape {
         let law = &design.law;
         let [_, p12, p22] = design.region.p;
         let values = [design.gains[0], design.gains[1], design.gains[2], p12, p22];
-        let symbols = [law.gains[0], law.gains[1], law.gains[2], law.coupling[0], law.coupling[1]];
+        let symbols = [
+            law.gains[0],
+            law.gains[1],
+            law.gains[2],
+            law.coupling[0],
+            law.coupling[1],
+        ];
         let map = symbols
             .iter()
             .zip(values)
@@ -278,7 +284,11 @@ impl BacksteppingTape {
         inputs[..self.dim].copy_from_slice(&x[..self.dim]);
         inputs[self.dim + 2] = y_r;
         let mut out = [0.0; 3];
-        (self.tape).eval(&inputs[..self.dim + 3], &mut self.scratch.borrow_mut(), &mut out);
+        (self.tape).eval(
+            &inputs[..self.dim + 3],
+            &mut self.scratch.borrow_mut(),
+            &mut out,
+        );
         out
     }
 }

@@ -4,8 +4,10 @@
 //! the controller's estimator against `[observer]`.
 
 use super::sect::{Res, Sect};
+use crate::description::{
+    BacksteppingKeys, Law, ModelSurface, SetPoint, Shape, Supply, Trajectory,
+};
 use crate::description::{Coil, Controller, Core, Drive, Estimator, Gap, Mechanics, Observer};
-use crate::description::{BacksteppingKeys, Law, ModelSurface, SetPoint, Shape, Supply, Trajectory};
 
 /// Grid size of the fringing-denominator check on (0, z_max].
 const DENOMINATOR_GRID: usize = 1000;

@@ -179,7 +179,10 @@ fn exactly<const N: usize>(s: &Sect, key: &str, what: &str) -> Res<Option<[f64; 
     match <[f64; N]>::try_from(found.as_slice()) {
         Ok(values) => Ok(Some(values)),
         Err(_) => {
-            let msg = format!("expected exactly {N} numbers, {what}; found {}", found.len());
+            let msg = format!(
+                "expected exactly {N} numbers, {what}; found {}",
+                found.len()
+            );
             Err(s.err(key, msg, &format!("needs {N} numbers")))
         }
     }
