@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use designer::description::{parse_file, Estimator, FloatType};
 use designer::design::{Design, LawDesign, PlanError};
 
+use crate::backstepping::{emit_backstepping, BacksteppingInput};
 use crate::controller::{emit_controller, ControllerError, ControllerInput};
 use crate::emit::params_macro;
 use crate::error::EmitError;
@@ -95,6 +96,24 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
             source,
         })?);
     }
+    if let Some(b) = &design.backstepping {
+        let floats = d
+            .controller
+            .as_ref()
+            .map(|c| floats(&c.floats))
+            .unwrap_or_default();
+        let input = BacksteppingInput {
+            model: &design.model,
+            design: b,
+            floats,
+        };
+        modules.push(
+            emit_backstepping(&input).map_err(|source| BuildError::Emit {
+                file: file(),
+                source,
+            })?,
+        );
+    }
     if let Some(input) = SemeraInput::from_description(d) {
         let items = emit_semera(&input).map_err(|e: SemeraError| BuildError::Observer {
             file: file(),
@@ -162,6 +181,10 @@ fn invokes_params(module: &str) -> bool {
 fn header(design: &Design) -> String {
     let d = &design.description;
     let what = match design.controller.as_ref().map(|c| c.law) {
+        None if design.backstepping.is_some() => format!(
+            "position controller of `{}` (backstepping through the force, [SFB 19])",
+            d.name
+        ),
         None if design.hold.is_some() => format!(
             "position hold of `{}` (model-based sliding mode, [JA 89])",
             d.name

@@ -28,11 +28,13 @@
 //! | `build.rs` | a description → the emitted file ([`build_file`], [`compile`], [`emit`]) |
 //! | `operations.rs` | what every controller module states: the plan's consts, tables, `Operation`, `Design` with `control::Plan` |
 //! | `controller.rs` | the tracking-law controller (feedback linearization, and the model-based sliding mode [JA 89] which is it with other gains): the `law!` macro and the float modules (over `reldesign_runtime::control`) |
+//! | `backstepping.rs` | the backstepping position controller [SFB 19]: the `law!` macro of its stages and the float modules (over `reldesign_runtime::backstepping`) |
 //! | `hold.rs` | the position hold of the model-based sliding mode: the float modules (over `reldesign_runtime::hold`) |
 //! | `sliding.rs` | the model-free sliding-mode controller: λ₁, λ₂ and the float modules (over `reldesign_runtime::sliding`) |
 //! | `semera.rs` | the SEMERA and integral estimator modules |
 //! | `observer/` | the EKF and UKF: `model!` macros and float modules |
 
+mod backstepping;
 mod build;
 mod controller;
 mod emit;
@@ -52,6 +54,7 @@ mod plan;
 mod semera;
 mod sliding;
 
+pub use backstepping::{emit_backstepping, BacksteppingInput};
 pub use build::{build_file, compile, emit, write_if_changed, BuildError};
 pub use controller::{emit_controller, ControllerError, ControllerInput};
 pub use emit::{

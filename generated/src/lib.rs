@@ -23,5 +23,13 @@ pub mod sliding_mode_valve;
 #[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
 pub mod semera_valve;
 
+/// `examples/jiles-atherton-valve.toml`: the valve of jiles-atherton-actuator-model
+/// Tables 1–2 with the position hold of its §6.3.
 #[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
 pub mod jiles_atherton_valve;
+
+/// `examples/backstepping-valve.toml`: backstepping position control
+/// (switched-force-backstepping) on the perfect-tracking valve, with its
+/// certified region and the hybrid switching strategy.
+#[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
+pub mod backstepping_valve;
