@@ -1,9 +1,10 @@
 //! The controller `reldesign loop` and `sweep` run (the runtime's own logic on
 //! the designer's run-time design, `designer::design::RuntimePlan` and
-//! `RuntimeHold`) equals the emitted, compiled code (`generated/`), at random
-//! states and times, for the three laws and both floats: the sliding-mode law
-//! bit for bit in f64, the feedback-linearizing law and the position hold of
-//! the model-based sliding mode to 1e-9 (tape against emitted arithmetic).
+//! `RuntimeHold`, `RuntimeBackstepping`) equals the emitted, compiled code
+//! (`generated/`), at random states and times, for the four laws and both
+//! floats: the sliding-mode law bit for bit in f64, the feedback-linearizing
+//! law, the position hold of the model-based sliding mode and the
+//! backstepping law to 1e-9 (tape against emitted arithmetic).
 
 use designer::description::{parse_file, Operation};
 use designer::design::{Design, RuntimePlan};
@@ -224,6 +225,111 @@ fn hold_runtime_equals_the_emitted_controller() {
     assert!(f32_disagree * 1000 <= n, "f32: {f32_disagree} of {n}");
     eprintln!(
         "hold: {law} of {n} states unsaturated; f64 within {worst64:.1e} relative, \
+         f32 within {worst32:.1e} V ({f32_disagree} beyond 1e-4·u_max)"
+    );
+}
+
+/// The backstepping controller [SFB 19] with its hybrid switching [SFB 31–33]
+/// the designer runs (`RuntimeBackstepping`: the runtime's
+/// `SwitchedBackstepping` on the law's tape) equals the emitted one along
+/// 20 000 samples of random states at increasing times (two periods of the
+/// square reference): the same switching mode at every sample, f64 bit for
+/// bit where the output is decided by a rule (waiting, guard, saturation)
+/// and within 1e-9 relative where the law is evaluated; f32 (the states
+/// rounded to f32) within 1e-4 of u_max at all but 0.1 % of the samples
+/// (a rule's decision can flip inside the f32 rounding of V ≤ C or F_d's
+/// sign). F_d and u of the law alone are compared too.
+#[test]
+fn backstepping_runtime_equals_the_emitted_controller() {
+    use reldesign_generated::backstepping_valve as bs;
+    use reldesign_runtime::backstepping::Backstepping;
+    let d = design("backstepping-valve.toml");
+    let b = d
+        .backstepping
+        .as_ref()
+        .expect("the example designs backstepping");
+    let mut model = d.model.clone();
+    let plan = designer::design::RuntimeBackstepping::new(&mut model, b);
+    let mut reference = designer::design::RuntimeBackstepping::new(&mut model, b).controller();
+    let (mut e64, mut e32) = (bs::f64::Controller::new(), bs::f32::Controller::new());
+    let mut rng = SplitMix64::new(17);
+    let n = 20_000;
+    let t_end = 2.0 * bs::f64::PERIOD;
+    let (mut law, mut f32_disagree, mut worst64, mut worst32) = (0, 0, 0.0f64, 0.0f64);
+    let (flux, u_max) = (b.holding[0].0, b.u_max);
+    for k in 0..n {
+        let t = t_end * k as f64 / n as f64;
+        let r = |rng: &mut SplitMix64, lo: f64, hi: f64| lo + (hi - lo) * rng.uniform();
+        // half the samples near a target (the law runs), half anywhere
+        let near = k % 2 == 0;
+        let z = if near {
+            r(&mut rng, 3.5e-4, 7.5e-4)
+        } else {
+            r(&mut rng, 0.0, b.z_max)
+        };
+        let v = if near {
+            r(&mut rng, -0.02, 0.02)
+        } else {
+            r(&mut rng, -1.0, 1.0)
+        };
+        let phi = if near {
+            flux * r(&mut rng, 0.9, 1.15)
+        } else {
+            r(&mut rng, -2.0, 2.0) * flux
+        };
+        let y_r = if near {
+            4e-4
+        } else {
+            r(&mut rng, 0.0, b.z_max)
+        };
+        // the law and F_d alone
+        let (want_law, got_law) = (
+            plan.law([z, v, phi, 0.0], y_r),
+            bs::f64::law(z, v, phi, y_r),
+        );
+        assert!(
+            (got_law - want_law).abs() <= 1e-9 * want_law.abs().max(1.0),
+            "law {got_law} vs {want_law}"
+        );
+        let (want_fd, got_fd) = (
+            plan.desired_force(z, v, y_r),
+            bs::f64::desired_force(z, v, y_r),
+        );
+        assert!(
+            (got_fd - want_fd).abs() <= 1e-12 * want_fd.abs().max(1.0),
+            "F_d {got_fd} vs {want_fd}"
+        );
+        // the controllers, stepped alike
+        let want = reference.step(t, z, v, phi, 0.0);
+        let got = e64.step(t, z, v, phi, 0.0);
+        assert_eq!(
+            format!("{:?}", e64.mode()),
+            format!("{:?}", reference.mode()),
+            "mode at t = {t}"
+        );
+        if want > b.u_min && want < u_max && want != 0.0 {
+            law += 1;
+            let rel = (got - want).abs() / want.abs();
+            worst64 = worst64.max(rel);
+            assert!(rel <= 1e-9, "f64 {got} vs {want} at t = {t}");
+        } else {
+            assert_eq!(got, want, "f64 at t = {t}");
+        }
+        let got32 = f64::from(e32.step(t as f32, z as f32, v as f32, phi as f32, 0.0));
+        let dev = (got32 - want).abs();
+        if dev <= 1e-4 * u_max {
+            worst32 = worst32.max(dev);
+        } else {
+            f32_disagree += 1;
+        }
+    }
+    assert!(
+        law * 10 > n,
+        "the law ran unsaturated at {law} of {n} samples"
+    );
+    assert!(f32_disagree * 1000 <= n, "f32: {f32_disagree} of {n}");
+    eprintln!(
+        "backstepping: {law} of {n} samples by the law; f64 within {worst64:.1e} relative, \
          f32 within {worst32:.1e} V ({f32_disagree} beyond 1e-4·u_max)"
     );
 }
