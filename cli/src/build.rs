@@ -4,7 +4,8 @@
 
 use std::path::PathBuf;
 
-use designer::design::LawDesign;
+use designer::description::{SetPoint, Switching};
+use designer::design::{BacksteppingDesign, LawDesign};
 use miette::Report;
 
 use crate::fail;
@@ -20,7 +21,8 @@ pub struct Args {
     #[arg(long)]
     quiet: bool,
     /// Also write the design figures as JSON (per operation: J, max |u|,
-    /// saturation switches, mesh size, residuals, table size)
+    /// saturation switches, mesh size, residuals, table size; the backstepping
+    /// law's certified region)
     #[arg(long)]
     report_json: Option<PathBuf>,
 }
@@ -54,6 +56,69 @@ pub fn run(args: &Args) -> Result<(), Report> {
         print!("{code}");
     }
     Ok(())
+}
+
+/// The backstepping law's keys and design values.
+fn backstepping_json(b: &BacksteppingDesign) -> serde_json::Value {
+    let switching = match b.switching {
+        Switching::None => "none",
+        Switching::Intuitive => "intuitive",
+        Switching::Hybrid => "hybrid",
+    };
+    let reference = match b.reference {
+        SetPoint::Position(z) => serde_json::json!({ "position": z }),
+        SetPoint::Square { low, high, period } => {
+            serde_json::json!({ "square": [low, high, period] })
+        }
+    };
+    serde_json::json!({
+        "law": "backstepping",
+        "gains": b.gains,
+        "switching": switching,
+        "reference": reference,
+        "rest_position": b.rest,
+        "phi_guard": b.phi_guard,
+        "holding": b.holding.iter().map(|&(flux, input)| serde_json::json!({"flux": flux, "input": input})).collect::<Vec<_>>(),
+    })
+}
+
+/// The certified region [SFB lemma 1], [SFB Theorem 3]: A, P, C and whether
+/// the spring's rest is in D, for the design's P and the paper's P = ½I; per
+/// target where there are two (a square reference), the first in `c`.
+fn region_json(b: &BacksteppingDesign) -> serde_json::Value {
+    let r = &b.region;
+    let [p11, p12, p22] = r.p;
+    let level = |l: Option<&designer::design::Level>| {
+        l.map_or(
+            serde_json::json!({ "c": null, "contains_rest": false }),
+            |l| serde_json::json!({ "c": l.c, "contains_rest": l.contains_rest }),
+        )
+    };
+    let targets: Vec<serde_json::Value> = (r.targets.iter().zip(&r.levels).zip(&r.identity))
+        .map(|((t, l), i)| {
+            serde_json::json!({
+                "position": t.position,
+                "holding_force": t.holding_force,
+                "rest": t.rest,
+                "c": l.c,
+                "contains_rest": l.contains_rest,
+                "identity": { "c": i.c, "contains_rest": i.contains_rest },
+            })
+        })
+        .collect();
+    let first = level(r.levels.first());
+    serde_json::json!({
+        "a": r.a,
+        "p": [[p11, p12], [p12, p22]],
+        "c": first["c"],
+        "decay": r.decay,
+        "contains_rest": first["contains_rest"],
+        "identity": level(r.identity.first()),
+        "extended": r.extended,
+        "force_gradient": r.force_gradient,
+        "trace": p11 + p22,
+        "targets": targets,
+    })
 }
 
 /// The design figures, for scripts and oracles.
@@ -114,9 +179,13 @@ fn report_json(design: &designer::design::Design) -> String {
             })
         })
     });
+    let law = law.or_else(|| design.backstepping.as_ref().map(backstepping_json));
     let gains = (design.controller.as_ref())
         .and_then(|c| c.law.tracking_gains())
         .or_else(|| design.hold.as_ref().map(|h| h.gains()));
-    let value = serde_json::json!({ "name": design.description.name, "controller": law, "gains": gains, "operations": operations });
+    let mut value = serde_json::json!({ "name": design.description.name, "controller": law, "gains": gains, "operations": operations });
+    if let (Some(b), Some(map)) = (&design.backstepping, value.as_object_mut()) {
+        map.insert("region".into(), region_json(b));
+    }
     serde_json::to_string_pretty(&value).unwrap_or_default() + "\n"
 }

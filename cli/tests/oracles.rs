@@ -12,10 +12,13 @@
 //!   terms; model-free-sliding-mode (13), (14), (48)–(52)),
 //! - `check_simulate.py RELDESIGN`: `reldesign simulate` on the three-pulse
 //!   record against a scipy `solve_ivp` hybrid automaton (i and φ to 1e-6),
-//! - `check_simulate.py --self-test`: the scipy automaton against closed forms.
+//! - `check_simulate.py --self-test`: the scipy automaton against closed forms,
+//! - `check_region.py RELDESIGN MODEL.toml…`: the backstepping law's certified
+//!   region of `build --report-json` against a cvxpy SDP (PSD cones) set up
+//!   from the TOML alone (tr P to 1e-6, C and X₀ ∈ D recomputed).
 //!
-//! They need python3 with casadi, numpy and scipy (`pip install casadi numpy
-//! scipy`; CI installs them). A missing interpreter or package is a test
+//! They need python3 with casadi, numpy, scipy and cvxpy (`pip install casadi
+//! numpy scipy cvxpy`; CI installs them). A missing interpreter or package is a test
 //! failure, not a skip. `RELDESIGN_PYTHON` overrides the interpreter.
 
 use std::ffi::OsString;
@@ -24,8 +27,8 @@ use std::process::Command;
 use support::{example_paths, root};
 
 const BIN: &str = env!("CARGO_BIN_EXE_reldesign");
-const INSTALL: &str = "the oracles need python3 with casadi, numpy and scipy: \
-                       run `pip install casadi numpy scipy` (or set RELDESIGN_PYTHON \
+const INSTALL: &str = "the oracles need python3 with casadi, numpy, scipy and cvxpy: \
+                       run `pip install casadi numpy scipy cvxpy` (or set RELDESIGN_PYTHON \
                        to an interpreter that has them)";
 
 fn python() -> OsString {
@@ -36,7 +39,7 @@ fn python() -> OsString {
 fn require_python() {
     let py = python();
     let out = Command::new(&py)
-        .args(["-c", "import casadi, numpy, scipy"])
+        .args(["-c", "import casadi, numpy, scipy, cvxpy"])
         .output()
         .unwrap_or_else(|e| panic!("cannot run {py:?}: {e}\n{INSTALL}"));
     assert!(
@@ -157,4 +160,40 @@ fn robustness_agrees_with_the_python_oracle() {
         &[BIN.into(), short.into_os_string()],
         "check_robustness: OK",
     );
+}
+
+/// The backstepping region [SFB Theorem 3] on the bundled example (square
+/// reference, two targets), on the sliding-mode valve with unequal gains
+/// (where the paper's min tr P is not the identity) and on the
+/// perfect-tracking valve with a given decay and no switching.
+#[test]
+fn backstepping_region_agrees_with_the_cvxpy_oracle() {
+    let dir = support::TempDir::new("oracle-region");
+    let variant = |example: &str, keys: &str| {
+        let text = std::fs::read_to_string(root().join("examples").join(example)).unwrap();
+        let physics = text.split("\n[trajectory]").next().unwrap_or(&text);
+        let physics = physics.split("\n[controller]").next().unwrap_or(physics);
+        format!("{physics}\n[controller]\nlaw = \"backstepping\"\nsample_period = 1e-5\n{keys}")
+    };
+    let unequal = dir.write(
+        "sm_unequal.toml",
+        variant(
+            "sliding-mode-valve.toml",
+            "gains = [150.0, 60.0, 2000.0]\nswitching = \"hybrid\"\nposition = 4e-4\n",
+        ),
+    );
+    let decay = dir.write(
+        "pt_decay.toml",
+        variant(
+            "perfect-tracking-valve.toml",
+            "gains = [300.0, 80.0, 3000.0]\nswitching = \"none\"\ndecay = 30.0\nposition = 6e-4\n",
+        ),
+    );
+    let args: Vec<OsString> = vec![
+        BIN.into(),
+        "examples/backstepping-valve.toml".into(),
+        unequal.into_os_string(),
+        decay.into_os_string(),
+    ];
+    oracle("check_region.py", &args, "check_region: OK");
 }

@@ -6,6 +6,7 @@ use std::fmt::Write as _;
 
 use crate::description::Estimator;
 
+use super::backstepping_design::BacksteppingDesign;
 use super::decisions::LawDesign;
 use super::optimal::OptimalTrajectory;
 use super::plan::Design;
@@ -27,6 +28,9 @@ impl Design {
                 "hold at z_ref = {:e} m: flux {:.4e} Wb, steady input {:.4} (supply ≤ {}), guard φ ≤ {:e} Wb",
                 h.position, h.holding_flux, h.holding_input, h.u_max, h.phi_guard
             );
+        }
+        if let Some(b) = &self.backstepping {
+            let _ = write!(s, "{}", backstepping_text(b));
         }
         if let Some(c) = &self.controller {
             let _ = writeln!(s, "{}", law_text(&c.law));
@@ -103,6 +107,46 @@ fn rest_text(opt: &OptimalTrajectory) -> Option<String> {
         (tb - ta) * 1e3,
         opt.rest_cost,
     ))
+}
+
+/// The backstepping law's lines: gains, the region per target, the guard.
+fn backstepping_text(b: &BacksteppingDesign) -> String {
+    let mut s = String::new();
+    let [a1, a2, a3] = b.gains;
+    let r = &b.region;
+    let _ = writeln!(
+        s,
+        "backstepping through the force [SFB 19]: α₁ = {a1:e} s⁻¹, α₂ = {a2:e} s⁻¹, α₃ = {a3:e} s⁻¹, switching {:?}",
+        b.switching
+    );
+    let [p11, p12, p22] = r.p;
+    let _ = writeln!(
+        s,
+        "region [SFB Theorem 3]: P = [[{p11:.6e}, {p12:.6e}], [{p12:.6e}, {p22:.6e}]] (tr P = {:.6e}), decay α = {:e} s⁻¹{}",
+        p11 + p22,
+        r.decay,
+        if r.extended {
+            " (with the spring's rest inside D: the paper's min tr P alone leaves it out)"
+        } else {
+            ""
+        }
+    );
+    for ((t, l), i) in r.targets.iter().zip(&r.levels).zip(&r.identity) {
+        let yes = |b: bool| if b { "inside" } else { "outside" };
+        let _ = writeln!(
+            s,
+            "  y_r = {:e} m: holding force {:.4} N, C = {:.4e} (rest z = {:e} m {} D); with P = ½I [SFB 11]: C = {:.4e}, rest {}",
+            t.position,
+            t.holding_force,
+            l.c,
+            b.rest,
+            yes(l.contains_rest),
+            i.c,
+            yes(i.contains_rest)
+        );
+    }
+    let _ = writeln!(s, "guard φ ≤ {:e} Wb (g_F ∝ φ)", b.phi_guard);
+    s
 }
 
 /// The law's line of the report.
