@@ -25,6 +25,10 @@ pub struct Args {
     /// law's certified region)
     #[arg(long)]
     report_json: Option<PathBuf>,
+    /// Also draw the backstepping law's certified region (the (z₁, z₂) plane: F_d = 0,
+    /// the paper's V₁ region and the LMI's) to this SVG file
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 pub fn run(args: &Args) -> Result<(), Report> {
@@ -44,12 +48,28 @@ pub fn run(args: &Args) -> Result<(), Report> {
         .report_json
         .as_ref()
         .map(|path| (path, report_json(&design)));
+    let plot = match (&args.plot, &design.backstepping) {
+        (None, _) => None,
+        (Some(path), Some(b)) => {
+            let title = format!("{}: the backstepping law's certified region", description.name);
+            Some((path, crate::region_plot::svg(b, &title).map_err(fail)?))
+        }
+        (Some(_), None) => {
+            return Err(fail(format!(
+                "--plot draws the region of [controller] law = \"backstepping\"; {} designs no such law",
+                args.model.display()
+            )))
+        }
+    };
     let mut files: Vec<(&std::path::Path, &[u8])> = Vec::new();
     if let Some(path) = &args.out {
         files.push((path.as_path(), code.as_bytes()));
     }
     if let Some((path, json)) = &report {
         files.push((path.as_path(), json.as_bytes()));
+    }
+    if let Some((path, svg)) = &plot {
+        files.push((path.as_path(), svg.as_bytes()));
     }
     crate::atomic::write_all(&files).map_err(fail)?;
     if args.out.is_none() {

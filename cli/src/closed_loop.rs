@@ -52,6 +52,10 @@ pub struct Args {
     /// still starts from 0)
     #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
     initial_field: f64,
+    /// The plant's initial state z,v,phi [m, m/s, Wb] (law = "backstepping"; default: at
+    /// rest on the spring's stop without flux)
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    initial_state: Option<Vec<f64>>,
 }
 
 pub fn run(args: &Args) -> Result<(), Report> {
@@ -90,7 +94,21 @@ pub fn run(args: &Args) -> Result<(), Report> {
             ..
         })
     );
-    if !holds {
+    let positions = matches!(controller.law, Law::Backstepping(_));
+    let initial = match args.initial_state.as_deref() {
+        None => None,
+        Some(&[z, v, phi]) if positions && [z, v, phi].iter().all(|x| x.is_finite()) => {
+            Some([z, v, phi])
+        }
+        Some(other) if positions => return Err(fail(format!(
+            "--initial-state: expected three finite numbers z,v,phi [m, m/s, Wb], found {other:?}"
+        ))),
+        Some(_) => return Err(fail(
+            "--initial-state: only for law = \"backstepping\" (the other laws start at rest at \
+                 the first operation's z₀)",
+        )),
+    };
+    if !holds && !positions {
         check_sample_period(&description, ts).map_err(|e| fail(format!("{file}: {e}")))?;
     }
     let mut designed = description.clone();
@@ -101,6 +119,28 @@ pub fn run(args: &Args) -> Result<(), Report> {
         resample_observer(o, ts);
     }
     let design = Design::new(&designed).map_err(|e| fail(format!("{file}: {e}")))?;
+    if positions {
+        let (run, summary) =
+            crate::position_loop::run(&design, plant.as_ref(), ts, duration, noise, initial)
+                .map_err(|e| fail(format!("{file}: {e}")))?;
+        let extra = |k: usize| crate::position_loop::columns(&run, k);
+        let csv = to_csv(
+            &run.run,
+            design.model.dim() > 3,
+            Some((",switching,lyapunov,desired_force", &extra)),
+        );
+        let svg = match &args.plot {
+            Some(_) => Some(plot(&run.run, &description.name, ts).map_err(fail)?),
+            None => None,
+        };
+        let mut files: Vec<(&std::path::Path, &[u8])> = vec![(args.out.as_path(), csv.as_bytes())];
+        if let (Some(path), Some(svg)) = (&args.plot, &svg) {
+            files.push((path.as_path(), svg.as_bytes()));
+        }
+        atomic::write_all(&files).map_err(fail)?;
+        print!("{summary}");
+        return Ok(());
+    }
     let run = if holds {
         run_hold(
             &design,
@@ -122,7 +162,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
         )
     }
     .map_err(|e| fail(format!("{file}: {e}")))?;
-    let csv = to_csv(&run, design.model.dim() > 3);
+    let csv = to_csv(&run, design.model.dim() > 3, None);
     let svg = match &args.plot {
         Some(_) => Some(plot(&run, &description.name, ts).map_err(fail)?),
         None => None,
@@ -214,7 +254,10 @@ fn hold_summary(o: &HoldOutcome, z_ref: Option<f64>, ts: f64) -> String {
     s
 }
 
-fn to_csv(run: &LoopRun, with_field: bool) -> String {
+/// Extra columns: their header (with the leading comma) and each sample's.
+type Extra<'a> = (&'a str, &'a dyn Fn(usize) -> String);
+
+fn to_csv(run: &LoopRun, with_field: bool, extra: Option<Extra>) -> String {
     let tr = &run.trajectory;
     let mut s = String::from(if with_field {
         "t,u,i,z,vz,phi,Hc,mode,z_ref"
@@ -227,6 +270,9 @@ fn to_csv(run: &LoopRun, with_field: bool) -> String {
         } else {
             ",z_hat,v_hat,phi_hat"
         });
+    }
+    if let Some((header, _)) = extra {
+        s.push_str(header);
     }
     s.push('\n');
     for k in 0..tr.t.len() {
@@ -245,6 +291,9 @@ fn to_csv(run: &LoopRun, with_field: bool) -> String {
             if with_field {
                 let _ = write!(s, ",{:?}", e.hc.unwrap_or(f64::NAN));
             }
+        }
+        if let Some((_, columns)) = extra {
+            s.push_str(&columns(k));
         }
         s.push('\n');
     }

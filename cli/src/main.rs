@@ -14,6 +14,8 @@ mod fit;
 mod limits;
 mod observe;
 mod plot;
+mod position_loop;
+mod region_plot;
 mod robustness;
 mod simulate;
 mod sweep;

@@ -12,7 +12,8 @@
 //! switching mode, whether Z ∈ D, F_d and the Lyapunov function
 //! V = ZᵀPZ + ½·(F − F_d)² of the proof of [SFB Theorem 2].
 
-use reldesign_runtime::backstepping::{Backstepping, Mode};
+use reldesign_runtime::backstepping::Backstepping;
+pub use reldesign_runtime::backstepping::Mode;
 
 use crate::closed_loop::{check_plant, observer, LoopError, LoopRun, Noise, Sensing};
 use crate::description::{Description, SetPoint};
@@ -35,11 +36,12 @@ pub struct BacksteppingRun {
 }
 
 /// Default length of a backstepping loop [s]: 50 ms at a constant position,
-/// two periods of a square reference.
-pub fn default_duration(reference: &SetPoint) -> f64 {
+/// two periods of a square reference (up to the last sample before the
+/// reference's next change).
+pub fn default_duration(reference: &SetPoint, sample_period: f64) -> f64 {
     match *reference {
         SetPoint::Position(_) => 50e-3,
-        SetPoint::Square { period, .. } => 2.0 * period,
+        SetPoint::Square { period, .. } => 2.0 * period - 0.5 * sample_period,
     }
 }
 
@@ -92,7 +94,7 @@ pub fn run_backstepping(
         u
     };
     let (x0, mode0) = start(&plant_model, b.rest, initial);
-    let t_end = duration.unwrap_or_else(|| default_duration(&b.reference));
+    let t_end = duration.unwrap_or_else(|| default_duration(&b.reference, sample_period));
     let trajectory = simulate_sampled(
         &model_plant,
         &mut control,
@@ -168,6 +170,9 @@ impl BacksteppingRun {
         let mut out = Vec::new();
         for (i, &k0) in changes.iter().enumerate() {
             let k1 = changes.get(i + 1).copied().unwrap_or(r.len());
+            if k1 < k0 + 2 {
+                continue; // the run ended on the change
+            }
             let (from, to) = (r[k0 - 1], r[k0]);
             let step = to - from;
             let band = STEP_BAND * step.abs();
