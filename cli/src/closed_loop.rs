@@ -100,9 +100,11 @@ pub fn run(args: &Args) -> Result<(), Report> {
         Some(&[z, v, phi]) if positions && [z, v, phi].iter().all(|x| x.is_finite()) => {
             Some([z, v, phi])
         }
-        Some(other) if positions => return Err(fail(format!(
+        Some(other) if positions => {
+            return Err(fail(format!(
             "--initial-state: expected three finite numbers z,v,phi [m, m/s, Wb], found {other:?}"
-        ))),
+        )))
+        }
         Some(_) => return Err(fail(
             "--initial-state: only for law = \"backstepping\" (the other laws start at rest at \
                  the first operation's z₀)",

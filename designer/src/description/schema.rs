@@ -257,8 +257,8 @@ pub const KEYS: &[Key] = &[
     number("controller.sample_period", Domain::Positive, "s", Presence::Required, "T_s: the emitted step runs once per sample; at most (landing − takeoff)/10"),
     names("controller.float", &["f32", "f64"], Presence::Optional("both"), "the float types to emit code for"),
     Key { kind: Kind::Choice(&["ekf", "ukf"]), ..number("controller.estimator", Domain::Any, "", Presence::Optional("the closed loops of `loop` and `sweep` feed the controller the plant's state"), "the observer of [observer] that drives the controller in `reldesign loop` and `sweep` from the measured voltage and current (it must be listed in observer.estimators)") },
-    number("controller.landed_band", Domain::Positive, "m", Presence::Optional("10⁻⁹ of the stroke"), "within this distance of its end stop the armature counts as in contact (the expert rules [SM 43], and z_min of sgn* [SM 35]): size it to the position measurement or estimate the controller reads"),
-    number("controller.creep_speed", Domain::Positive, "m/s", Presence::Optional("2.5e-3 of the stroke per motion time"), "after t_f the reference creeps beyond the stop at this speed, so that a loop held short still lands"),
+    Key { variants: &["feedback-linearization", "sliding-mode", "model-sliding-mode"], ..number("controller.landed_band", Domain::Positive, "m", Presence::Optional("10⁻⁹ of the stroke"), "within this distance of its end stop the armature counts as in contact (the expert rules [SM 43], and z_min of sgn* [SM 35]): size it to the position measurement or estimate the controller reads") },
+    Key { variants: &["feedback-linearization", "sliding-mode", "model-sliding-mode"], ..number("controller.creep_speed", Domain::Positive, "m/s", Presence::Optional("2.5e-3 of the stroke per motion time"), "after t_f the reference creeps beyond the stop at this speed, so that a loop held short still lands") },
     // [observer]
     names("observer.estimators", &["semera", "integral", "ekf", "ukf"], Presence::Required, "the estimators to design and emit"),
     number("observer.sample_period", Domain::Positive, "s", Presence::Required, "Δ: one estimator step per sample"),
