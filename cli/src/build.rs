@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use designer::description::{SetPoint, Switching};
+use designer::description::SetPoint;
 use designer::design::{BacksteppingDesign, LawDesign};
 use miette::Report;
 
@@ -80,11 +80,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
 
 /// The backstepping law's keys and design values.
 fn backstepping_json(b: &BacksteppingDesign) -> serde_json::Value {
-    let switching = match b.switching {
-        Switching::None => "none",
-        Switching::Intuitive => "intuitive",
-        Switching::Hybrid => "hybrid",
-    };
+    let switching = b.switching.name();
     let reference = match b.reference {
         SetPoint::Position(z) => serde_json::json!({ "position": z }),
         SetPoint::Square { low, high, period } => {
@@ -102,7 +98,7 @@ fn backstepping_json(b: &BacksteppingDesign) -> serde_json::Value {
     })
 }
 
-/// The certified region [SFB lemma 1], [SFB Theorem 3]: A, P, C and whether
+/// The certified region [SB lemma 1], [SB Theorem 3]: A, P, C and whether
 /// the spring's rest is in D, for the design's P and the paper's P = ½I; per
 /// target where there are two (a square reference), the first in `c`.
 fn region_json(b: &BacksteppingDesign) -> serde_json::Value {

@@ -134,12 +134,12 @@ fn design_text(d: &Description) -> String {
                 }
             ),
             Law::Backstepping(b) => format!(
-                "backstepping through the force [SFB 19], α = {:?} s⁻¹, switching {}, {}",
+                "backstepping through the force [SB 19], α = {:?} s⁻¹, switching {}, {}",
                 b.gains,
                 match b.switching {
                     Switching::None => "none",
-                    Switching::Intuitive => "intuitive [SFB 28]",
-                    Switching::Hybrid => "hybrid [SFB 31–33]",
+                    Switching::Intuitive => "intuitive [SB 28]",
+                    Switching::Hybrid => "hybrid [SB 31–33]",
                 },
                 match b.reference {
                     SetPoint::Position(z) => format!("holding y_r = {z:e} m"),

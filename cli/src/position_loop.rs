@@ -1,5 +1,5 @@
 //! `reldesign loop` for `[controller] law = "backstepping"`: the backstepping
-//! position controller (switched-force-backstepping [SFB]) in a sampled loop
+//! position controller (switched-force-backstepping [SB]) in a sampled loop
 //! from rest on the spring's stop, or from `--initial-state z,v,phi` (the
 //! paper's three kinds of initial condition are states). Writes the loop's
 //! CSV with three more columns, `switching` (0 waiting with u = 0, 1 the law

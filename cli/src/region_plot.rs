@@ -1,8 +1,8 @@
 //! `reldesign build --plot FILE.svg` for the backstepping law: the (z₁, z₂)
 //! plane of each target, as switched-force-backstepping's Fig. 5–6 draw it:
 //! the line F_d = 0 (the magnet cannot push beyond it), the region of the
-//! paper's V₁ = ½‖Z‖² (P = ½I, [SFB lemma 1]), the region of the design's P
-//! ([SFB Theorem 3], extended to the spring's rest where needed), the
+//! paper's V₁ = ½‖Z‖² (P = ½I, [SB lemma 1]), the region of the design's P
+//! ([SB Theorem 3], extended to the spring's rest where needed), the
 //! spring's rest X₀ and the target (the origin); dashed, the stroke's stops.
 //! The lower row zooms to the stroke, where the armature can be: the regions'
 //! extent in z₁ is far beyond it, their extent in velocity is what matters.
@@ -10,7 +10,7 @@
 use designer::design::{BacksteppingDesign, Sym2};
 use plotters::prelude::*;
 
-/// The paper's P of V₁ = ½‖Z‖² [SFB 11].
+/// The paper's P of V₁ = ½‖Z‖² [SB 11].
 const HALF_IDENTITY: Sym2 = [0.5, 0.0, 0.5];
 
 /// Points of the ellipse ZᵀPZ = C: Z = √C·L⁻ᵀ·(cos θ, sin θ), P = L·Lᵀ.

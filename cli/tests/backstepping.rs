@@ -1,5 +1,5 @@
 //! `reldesign build` and `reldesign loop` for `[controller] law =
-//! "backstepping"` (switched-force-backstepping [SFB]): the region in
+//! "backstepping"` (switched-force-backstepping [SB]): the region in
 //! `--report-json` (the fixed keys), the region's SVG, the loop from
 //! the paper's initial conditions, and designs that cannot be certified
 //! rejected with the reason and what to change, nothing written.

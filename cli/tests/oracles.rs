@@ -162,7 +162,7 @@ fn robustness_agrees_with_the_python_oracle() {
     );
 }
 
-/// The backstepping region [SFB Theorem 3] on the bundled example (square
+/// The backstepping region [SB Theorem 3] on the bundled example (square
 /// reference, two targets), on the sliding-mode valve with unequal gains
 /// (where the paper's min tr P is not the identity) and on the
 /// perfect-tracking valve with a given decay and no switching.

@@ -1,17 +1,17 @@
 //! The backstepping position controller as emitted Rust
-//! (switched-force-backstepping [SFB]): a rendering of
+//! (switched-force-backstepping [SB]): a rendering of
 //! `designer::design::BacksteppingDesign`.
 //!
 //! `macro_rules! law { ($f:ty) => { … } }` holds the model's part, written
 //! once over the float type: `law_terms` (the law's stages z₁, z₂, F, F_d,
-//! Ḟ_d, f_F, g_F, u [SFB 9], [SFB Theorem 1], [SFB 19] through the
+//! Ḟ_d, f_F, g_F, u [SB 9], [SB Theorem 1], [SB 19] through the
 //! expression emitter), `law` and `force_terms`/`desired_force` (F_d alone,
 //! for the switching). Per float type a module holds `params!`, `law!`, the
 //! gains α₁, α₂, α₃, the decay α, P and the level C of each target
-//! [SFB Theorem 3], the reference, the limits and guard, `Design` with the
+//! [SB Theorem 3], the reference, the limits and guard, `Design` with the
 //! runtime's `backstepping::Backstepping`, and
 //! `Controller = backstepping::SwitchedBackstepping<Design, f…>`, whose
-//! switching state is the token M [SFB 31–33]. The switching rules, the
+//! switching state is the token M [SB 31–33]. The switching rules, the
 //! guard at φ → 0 and the saturation are `reldesign_runtime::backstepping`,
 //! written once. No `unwrap`, indexing, `panic`, `as` or allocation.
 
@@ -121,7 +121,7 @@ fn law_macro(input: &BacksteppingInput, f32: bool) -> Result<String, ControllerE
         ""
     };
     let doc = format!(
-        "The backstepping law [SFB 19] at the state x = [z, v, φ]{field} and the reference\n\
+        "The backstepping law [SB 19] at the state x = [z, v, φ]{field} and the reference\n\
          y_r, in its stages (not saturated, not guarded: g_F ∝ φ, so φ = 0 makes u infinite)."
     );
     let outputs: Vec<(&str, Id, &str)> = law
@@ -148,7 +148,7 @@ fn law_macro(input: &BacksteppingInput, f32: bool) -> Result<String, ControllerE
         .filter(|(_, id)| reached.contains(id))
         .copied()
         .collect();
-    let force_doc = "F_d [N] at (z, v) for y_r [SFB Theorem 1]: the force that makes\nż₂ = −z₁ − α₂·z₂ [SFB 14]; the switching reads its sign.";
+    let force_doc = "F_d [N] at (z, v) for y_r [SB Theorem 1]: the force that makes\nż₂ = −z₁ − α₂·z₂ [SB 14]; the switching reads its sign.";
     let force = FunctionSpec {
         name: "force_terms",
         doc: force_doc,
@@ -157,7 +157,7 @@ fn law_macro(input: &BacksteppingInput, f32: bool) -> Result<String, ControllerE
             ("v", model.states[1]),
             ("y_ref", law.target),
         ],
-        outputs: vec![("desired_force", law.desired_force, "[SFB Theorem 1] F_d")],
+        outputs: vec![("desired_force", law.desired_force, "[SB Theorem 1] F_d")],
         named: force_named,
         output_symbols: Vec::new(),
         float: Float::F64,
@@ -171,7 +171,7 @@ fn law_macro(input: &BacksteppingInput, f32: bool) -> Result<String, ControllerE
     let tokens = quote! {
         #terms
 
-        /// u of the backstepping law [SFB 19], not saturated and not guarded.
+        /// u of the backstepping law [SB 19], not saturated and not guarded.
         #[must_use]
         pub fn law(#(#state: #ty,)* y_ref: #ty) -> #ty {
             law_terms(#(#state,)* y_ref).u
@@ -179,7 +179,7 @@ fn law_macro(input: &BacksteppingInput, f32: bool) -> Result<String, ControllerE
 
         #force
 
-        /// F_d [N] [SFB Theorem 1].
+        /// F_d [N] [SB Theorem 1].
         #[must_use]
         pub fn desired_force(z: #ty, v: #ty, y_ref: #ty) -> #ty {
             force_terms(z, v, y_ref).desired_force
@@ -187,7 +187,7 @@ fn law_macro(input: &BacksteppingInput, f32: bool) -> Result<String, ControllerE
     };
     let text = comment_lets(&space_items(&format_items(tokens)?), "law_terms", &comments);
     let doc = format!(
-        "The backstepping law [SFB 19] of `{}` over the float type `$f`, written once:\n\
+        "The backstepping law [SB 19] of `{}` over the float type `$f`, written once:\n\
          `law_terms`, `law`, `force_terms` and `desired_force`, declared in each float\n\
          module as `law!(f64)` / `law!(f32)` beside the module's `params!`, gains and\n\
          `Design`.\n{MACRO_LITERALS}",
@@ -208,7 +208,7 @@ fn reference_items(
                 float,
                 &[
                     ("POSITION", z, "y_r [m]: the position held."),
-                    ("REGION_C", level(0), "C of the certified region D = {ZᵀPZ ≤ C} at POSITION [SFB lemma 1]: the\nlargest level set of V inside F_d ≥ 0, C = g²/(kᵀP⁻¹k)."),
+                    ("REGION_C", level(0), "C of the certified region D = {ZᵀPZ ≤ C} at POSITION [SB lemma 1]: the\nlargest level set of V inside F_d ≥ 0, C = g²/(kᵀP⁻¹k)."),
                 ],
             )?,
             quote!(backstepping::SetPoint::Position(backstepping::Target {
@@ -223,8 +223,8 @@ fn reference_items(
                     ("POSITION_LOW", low, "y_r [m] for the first half of each period."),
                     ("POSITION_HIGH", high, "y_r [m] for the second half of each period."),
                     ("PERIOD", period, "The square reference's period [s]."),
-                    ("REGION_C_LOW", level(0), "C of D = {ZᵀPZ ≤ C} at POSITION_LOW [SFB lemma 1]: C = g²/(kᵀP⁻¹k)."),
-                    ("REGION_C_HIGH", level(1), "C of D at POSITION_HIGH [SFB lemma 1]."),
+                    ("REGION_C_LOW", level(0), "C of D = {ZᵀPZ ≤ C} at POSITION_LOW [SB lemma 1]: C = g²/(kᵀP⁻¹k)."),
+                    ("REGION_C_HIGH", level(1), "C of D at POSITION_HIGH [SB lemma 1]."),
                 ],
             )?,
             quote!(backstepping::SetPoint::Square {
@@ -252,11 +252,11 @@ fn float_module(input: &BacksteppingInput, float: Float) -> Result<String, Contr
     let consts = documented_consts(
         float,
         &[
-            ("GAIN_A1", a1, "α₁ [1/s]: z₂ = v + α₁·(z − y_r) [SFB 9]."),
-            ("GAIN_A2", a2, "α₂ [1/s]: F_d makes ż₂ = −z₁ − α₂·z₂ [SFB 14]."),
-            ("GAIN_A3", a3, "α₃ [1/s]: F − F_d decays at α₃ [SFB 18]."),
-            ("DECAY", d.region.decay, "α [1/s] of the region's LMI AᵀP + PA ⪯ −α·P [SFB Theorem 3] (not read by the\nstep; the certificate P was solved for it)."),
-            ("REGION_P11", p11, "P of V = ZᵀPZ [SFB 21], min tr P s.t. AᵀP + PA ⪯ −α·P, P ⪰ I [SFB Theorem 3]\n(with the spring's rest inside D where the paper's program leaves it out): p₁₁."),
+            ("GAIN_A1", a1, "α₁ [1/s]: z₂ = v + α₁·(z − y_r) [SB 9]."),
+            ("GAIN_A2", a2, "α₂ [1/s]: F_d makes ż₂ = −z₁ − α₂·z₂ [SB 14]."),
+            ("GAIN_A3", a3, "α₃ [1/s]: F − F_d decays at α₃ [SB 18]."),
+            ("DECAY", d.region.decay, "α [1/s] of the region's LMI AᵀP + PA ⪯ −α·P [SB Theorem 3] (not read by the\nstep; the certificate P was solved for it)."),
+            ("REGION_P11", p11, "P of V = ZᵀPZ [SB 21], min tr P s.t. AᵀP + PA ⪯ −α·P, P ⪰ I [SB Theorem 3]\n(with the spring's rest inside D where the paper's program leaves it out): p₁₁."),
             ("REGION_P12", p12, "p₁₂ of P."),
             ("REGION_P22", p22, "p₂₂ of P."),
             ("U_MIN", d.u_min, "Supply limits: every output lies in [U_MIN, U_MAX]."),
@@ -287,8 +287,8 @@ fn float_module(input: &BacksteppingInput, float: Float) -> Result<String, Contr
     };
     let controller_doc = crate::emit::doc_attrs(&format!(
         "The armature positioned at the reference (`reldesign_runtime::backstepping::\n\
-         SwitchedBackstepping`): the law [SFB 19] in the certified region D, u = 0 where the\n\
-         switching strategy waits for the spring [SFB 28], [SFB 31–33]; the switching state\n\
+         SwitchedBackstepping`): the law [SB 19] in the certified region D, u = 0 where the\n\
+         switching strategy waits for the spring [SB 28], [SB 31–33]; the switching state\n\
          is the token M. `new`, `start`, `mode`,\n{step}. Allocation- and panic-free."
     ));
     let tokens = quote! {

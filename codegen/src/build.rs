@@ -182,7 +182,7 @@ fn header(design: &Design) -> String {
     let d = &design.description;
     let what = match design.controller.as_ref().map(|c| c.law) {
         None if design.backstepping.is_some() => format!(
-            "position controller of `{}` (backstepping through the force, [SFB 19])",
+            "position controller of `{}` (backstepping through the force, [SB 19])",
             d.name
         ),
         None if design.hold.is_some() => format!(

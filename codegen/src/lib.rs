@@ -28,7 +28,7 @@
 //! | `build.rs` | a description → the emitted file ([`build_file`], [`compile`], [`emit`]) |
 //! | `operations.rs` | what every controller module states: the plan's consts, tables, `Operation`, `Design` with `control::Plan` |
 //! | `controller.rs` | the tracking-law controller (feedback linearization, and the model-based sliding mode [JA 89] which is it with other gains): the `law!` macro and the float modules (over `reldesign_runtime::control`) |
-//! | `backstepping.rs` | the backstepping position controller [SFB 19]: the `law!` macro of its stages and the float modules (over `reldesign_runtime::backstepping`) |
+//! | `backstepping.rs` | the backstepping position controller [SB 19]: the `law!` macro of its stages and the float modules (over `reldesign_runtime::backstepping`) |
 //! | `hold.rs` | the position hold of the model-based sliding mode: the float modules (over `reldesign_runtime::hold`) |
 //! | `sliding.rs` | the model-free sliding-mode controller: λ₁, λ₂ and the float modules (over `reldesign_runtime::sliding`) |
 //! | `semera.rs` | the SEMERA and integral estimator modules |

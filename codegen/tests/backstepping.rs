@@ -1,5 +1,5 @@
 //! The emitted backstepping position controller (`codegen/src/backstepping.rs`,
-//! switched-force-backstepping [SFB]) on the bundled backstepping valve: it
+//! switched-force-backstepping [SB]) on the bundled backstepping valve: it
 //! compiles as a `#![no_std]` crate against the runtime, passes clippy with
 //! the panic lints denied, gives an input in [u_min, u_max] for any input
 //! (NaN, ±∞, 0, φ = 0, z at both stops and beyond them, any time), keeps the
@@ -72,11 +72,11 @@ fn emission_is_deterministic_and_holds_the_law_once() {
     }
     // the equations are cited where they are computed
     for tag in [
-        "[SFB 9]",
-        "[SFB Theorem 1]",
-        "[SFB 19]",
-        "[SFB Theorem 3]",
-        "[SFB lemma 1]",
+        "[SB 9]",
+        "[SB Theorem 1]",
+        "[SB 19]",
+        "[SB Theorem 3]",
+        "[SB lemma 1]",
     ] {
         assert!(a.contains(tag), "{tag} not cited");
     }

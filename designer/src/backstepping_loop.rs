@@ -1,4 +1,4 @@
-//! The backstepping position controller (switched-force-backstepping [SFB])
+//! The backstepping position controller (switched-force-backstepping [SB])
 //! in a sampled loop on a plant: the library call behind `reldesign loop` for
 //! `law = "backstepping"`.
 //!
@@ -10,7 +10,7 @@
 //! (the paper's three kinds of initial condition are states, see
 //! [`run_backstepping`]). Besides the trajectory it records, per sample, the
 //! switching mode, whether Z ∈ D, F_d and the Lyapunov function
-//! V = ZᵀPZ + ½·(F − F_d)² of the proof of [SFB Theorem 2].
+//! V = ZᵀPZ + ½·(F − F_d)² of the proof of [SB Theorem 2].
 
 use reldesign_runtime::backstepping::Backstepping;
 pub use reldesign_runtime::backstepping::Mode;
@@ -29,7 +29,7 @@ pub struct BacksteppingRun {
     pub modes: Vec<Mode>,
     /// At every sample: ZᵀPZ ≤ C (the state in D).
     pub inside: Vec<bool>,
-    /// At every sample: F_d [N] [SFB Theorem 1].
+    /// At every sample: F_d [N] [SB Theorem 1].
     pub desired_force: Vec<f64>,
     /// At every sample: V = ZᵀPZ + ½·(F − F_d)², on the state read.
     pub lyapunov: Vec<f64>,

@@ -1,4 +1,4 @@
-//! The backstepping law [SFB 19] and its region [SFB Theorem 3], checked
+//! The backstepping law [SB 19] and its region [SB Theorem 3], checked
 //! against independent oracles: finite differences of the model's own f for
 //! the force dynamics the law imposes, eigenvalues for the LMI certificate,
 //! the closed loop for V and the switching counts.
@@ -32,7 +32,7 @@ fn force(
 
 #[test]
 fn the_law_imposes_the_force_dynamics_of_the_proof() {
-    // [SFB 18]: with u of [SFB 19], Ḟ = Ḟ_d − α₃·(F − F_d) + (2/m)·(PZ)₂,
+    // [SB 18]: with u of [SB 19], Ḟ = Ḟ_d − α₃·(F − F_d) + (2/m)·(PZ)₂,
     // every derivative by central differences along the model's own f
     let design = design("backstepping-valve.toml");
     let b = design.backstepping.as_ref().expect("backstepping design");
@@ -90,7 +90,7 @@ fn the_region_is_certified_and_touches_the_half_plane() {
             format!("gains = [100.0, 100.0, 2000.0]\nswitching = \"hybrid\"\nposition = {y_r}");
         let design = on_valve(example, &keys);
         let r = &design.backstepping.as_ref().expect("backstepping").region;
-        // [SFB Theorem 3] by eigenvalues: P ≻ 0, AᵀP + PA + αP ⪯ 0
+        // [SB Theorem 3] by eigenvalues: P ≻ 0, AᵀP + PA + αP ⪯ 0
         let (p_eig, lyap_eig) = r.certificate();
         let norm = p_eig[1];
         assert!(
@@ -101,7 +101,7 @@ fn the_region_is_certified_and_touches_the_half_plane() {
             lyap_eig[1] <= 1e-7 * norm * r.decay.max(1.0),
             "{example}: AᵀP + PA + αP has {lyap_eig:?}"
         );
-        // [SFB lemma 1]: the largest level set inside F_d ≥ 0 touches F_d = 0:
+        // [SB lemma 1]: the largest level set inside F_d ≥ 0 touches F_d = 0:
         // the maximum of kᵀZ on V = C (sampled) is g
         let [a, b, c] = r.p;
         let (l11, l21) = (a.sqrt(), b / a.sqrt());
@@ -162,7 +162,7 @@ fn the_law_is_odd_in_the_flux() {
     }
 }
 
-/// The paper's three kinds of initial condition [SFB §IV] for the design's
+/// The paper's three kinds of initial condition [SB §IV] for the design's
 /// first target, as (name, [z, v, φ]): inside D (the spring's rest, which the
 /// region holds), outside D with F_d < 0 (rushing towards z_min: F_d = −g/4),
 /// outside D with F_d > 0 (F_d = 3g, beyond D's largest 2g). F_d is affine in
@@ -223,7 +223,7 @@ fn every_strategy_converges_from_the_papers_three_initial_conditions() {
                 // converges to y_r (α = 100 s⁻¹: 80 ms is 8 time constants)
                 let end = tr.x[n - 1][0];
                 assert!((end - 5e-4).abs() < 5e-6, "{case}: z(80 ms) = {end:e}");
-                // at most one switch (intuitive), two (hybrid) [SFB Remarks 4, 6]
+                // at most one switch (intuitive), two (hybrid) [SB Remarks 4, 6]
                 assert!(r.switches() <= most, "{case}: {} switches", r.switches());
                 // V non-increasing wherever the law runs unsaturated between
                 // two samples without an impact

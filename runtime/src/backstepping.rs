@@ -1,21 +1,21 @@
 //! Position control by backstepping through the magnetic force with the
-//! switching strategies of switched-force-backstepping [SFB §IV], written
+//! switching strategies of switched-force-backstepping [SB §IV], written
 //! once for every design and both floats.
 //!
 //! The emitted module holds the model: F_d ([`Backstepping::desired_force`],
-//! [SFB Theorem 1]) and the law u ([`Backstepping::law`], [SFB 19]), and the
+//! [SB Theorem 1]) and the law u ([`Backstepping::law`], [SB 19]), and the
 //! numbers ([`BacksteppingSettings`]): α₁, P and the level C of the certified
 //! region D = {V ≤ C} per target, V = ZᵀPZ, Z = (z − y_r, v + α₁·(z − y_r))
-//! [SFB 9], [SFB 21]. Per sample:
+//! [SB 9], [SB 21]. Per sample:
 //!
 //! - the reference y_r: a constant position, or a square wave (`low` for the
 //!   first half of each period, then `high`); each change of y_r starts the
-//!   switching afresh (a new initial condition of [SFB Theorems 4–5]);
-//! - the mode ([`Mode`], the token M of [SFB 31–33]):
-//!   - `None`: the law everywhere [SFB 19];
-//!   - `Intuitive` [SFB 28]: u = 0 until V ≤ C, then the law (one switch at
+//!   switching afresh (a new initial condition of [SB Theorems 4–5]);
+//! - the mode ([`Mode`], the token M of [SB 31–33]):
+//!   - `None`: the law everywhere [SB 19];
+//!   - `Intuitive` [SB 28]: u = 0 until V ≤ C, then the law (one switch at
 //!     most, Remark 4);
-//!   - `Hybrid` [SFB 31–33]: inside D the law; outside D the law while
+//!   - `Hybrid` [SB 31–33]: inside D the law; outside D the law while
 //!     F_d > 0, and from F_d ≤ 0 on u = 0 until V ≤ C (two switches at most,
 //!     Remark 6);
 //!   once in D the law stays (D is invariant under it);
@@ -43,7 +43,7 @@ pub enum Switching {
 pub struct Target<T> {
     /// y_r [m].
     pub position: T,
-    /// C of D = {ZᵀPZ ≤ C} [SFB lemma 1].
+    /// C of D = {ZᵀPZ ≤ C} [SB lemma 1].
     pub level: T,
 }
 
@@ -67,9 +67,9 @@ pub struct BacksteppingSettings<T> {
     pub u_max: T,
     /// [Wb]: where φ ≤ `phi_guard` the law is not evaluated and u = u_max.
     pub phi_guard: T,
-    /// α₁ of z₂ = v + α₁·z₁ [SFB 9].
+    /// α₁ of z₂ = v + α₁·z₁ [SB 9].
     pub alpha1: T,
-    /// P of V = ZᵀPZ as [p₁₁, p₁₂, p₂₂] [SFB 21].
+    /// P of V = ZᵀPZ as [p₁₁, p₁₂, p₂₂] [SB 21].
     pub p: [T; 3],
     pub switching: Switching,
     pub reference: SetPoint<T>,
@@ -78,13 +78,13 @@ pub struct BacksteppingSettings<T> {
 /// A backstepping module: its settings, F_d and the law.
 pub trait Backstepping<T> {
     fn settings(&self) -> BacksteppingSettings<T>;
-    /// F_d [N] at (z, v) for y_r [SFB Theorem 1].
+    /// F_d [N] at (z, v) for y_r [SB Theorem 1].
     fn desired_force(&self, z: T, v: T, y_r: T) -> T;
-    /// u [SFB 19] at x = [z, v, φ, H_c] for y_r: not guarded, not saturated.
+    /// u [SB 19] at x = [z, v, φ, H_c] for y_r: not guarded, not saturated.
     fn law(&self, x: [T; 4], y_r: T) -> T;
 }
 
-/// The switching state: the token M of [SFB 31–33] and where the state was
+/// The switching state: the token M of [SB 31–33] and where the state was
 /// first seen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
@@ -115,7 +115,7 @@ fn saturate<T: Scalar>(u: T, s: &BacksteppingSettings<T>) -> T {
     }
 }
 
-/// V(Z) = ZᵀPZ at (z, v) for y_r [SFB 21].
+/// V(Z) = ZᵀPZ at (z, v) for y_r [SB 21].
 #[inline]
 pub fn lyapunov<T: Scalar>(s: &BacksteppingSettings<T>, z: T, v: T, y_r: T) -> T {
     let z1 = z - y_r;
@@ -230,18 +230,18 @@ impl<B: Backstepping<T>, T: Scalar> SwitchedBackstepping<B, T> {
         let s = self.plan.settings();
         let target = self.target(t);
         let y_r = target.position;
-        // [SFB lemma 1] Z ∈ D
+        // [SB lemma 1] Z ∈ D
         let inside = lyapunov(&s, z, v, y_r) <= target.level;
         let desired = self.plan.desired_force(z, v, y_r);
         self.mode = next_mode(s.switching, self.mode, inside, desired);
         if self.mode == Mode::Waiting {
-            // [SFB 28] u = 0 outside D
+            // [SB 28] u = 0 outside D
             return saturate(T::ZERO, &s);
         }
         if phi <= s.phi_guard {
             return saturate(s.u_max, &s);
         }
-        // [SFB 19]
+        // [SB 19]
         saturate(self.plan.law([z, v, phi, hc], y_r), &s)
     }
 }

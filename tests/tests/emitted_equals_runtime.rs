@@ -229,7 +229,7 @@ fn hold_runtime_equals_the_emitted_controller() {
     );
 }
 
-/// The backstepping controller [SFB 19] with its hybrid switching [SFB 31–33]
+/// The backstepping controller [SB 19] with its hybrid switching [SB 31–33]
 /// the designer runs (`RuntimeBackstepping`: the runtime's
 /// `SwitchedBackstepping` on the law's tape) equals the emitted one along
 /// 20 000 samples of random states at increasing times (two periods of the

@@ -237,8 +237,8 @@ pub enum Law {
     /// with the mode rules and saturation to [0, u_max] of [JA 94].
     ModelSlidingMode(ModelSurface),
     /// Backstepping through the magnetic force, switched-force-backstepping
-    /// [SFB 19], with a certified region [SFB Theorem 3] and the switching
-    /// strategies [SFB 28], [SFB 31–33].
+    /// [SB 19], with a certified region [SB Theorem 3] and the switching
+    /// strategies [SB 28], [SB 31–33].
     Backstepping(BacksteppingKeys),
 }
 
@@ -283,14 +283,14 @@ pub struct ModelSurface {
     pub position: Option<f64>,
 }
 
-/// The backstepping law's keys (switched-force-backstepping [SFB §III–IV]).
+/// The backstepping law's keys (switched-force-backstepping [SB §III–IV]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BacksteppingKeys {
-    /// α₁, α₂, α₃ [1/s] (> 0): z₂ = v + α₁·z₁ [SFB 9], ż₂ = −z₁ − α₂·z₂
-    /// [SFB 14], Ḟ − Ḟ_d = −α₃·(F − F_d) [SFB 18].
+    /// α₁, α₂, α₃ [1/s] (> 0): z₂ = v + α₁·z₁ [SB 9], ż₂ = −z₁ − α₂·z₂
+    /// [SB 14], Ḟ − Ḟ_d = −α₃·(F − F_d) [SB 18].
     pub gains: [f64; 3],
     pub switching: Switching,
-    /// α [1/s] of AᵀP + PA ⪯ −α·P [SFB Theorem 3]; `None`: the default
+    /// α [1/s] of AᵀP + PA ⪯ −α·P [SB Theorem 3]; `None`: the default
     /// (`design::backstepping_design`).
     pub decay: Option<f64>,
     pub reference: SetPoint,
@@ -299,13 +299,24 @@ pub struct BacksteppingKeys {
 /// What the backstepping law does where F_d < 0 (the magnet cannot push).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Switching {
-    /// The local law everywhere [SFB 19] (its output saturated).
+    /// The local law everywhere [SB 19] (its output saturated).
     None,
-    /// u = 0 until the state enters the region D, then the law [SFB 28].
+    /// u = 0 until the state enters the region D, then the law [SB 28].
     Intuitive,
     /// The law while F_d ≥ 0, u = 0 from F_d ≤ 0 until D, then the law
-    /// [SFB 31–33].
+    /// [SB 31–33].
     Hybrid,
+}
+
+impl Switching {
+    /// The `controller.switching` value.
+    pub fn name(self) -> &'static str {
+        match self {
+            Switching::None => "none",
+            Switching::Intuitive => "intuitive",
+            Switching::Hybrid => "hybrid",
+        }
+    }
 }
 
 /// The backstepping law's reference y_r.

@@ -1,23 +1,23 @@
 //! Backstepping position control through the magnetic force
-//! (switched-force-backstepping [SFB §III], Theorems 1–2), derived by the
+//! (switched-force-backstepping [SB §III], Theorems 1–2), derived by the
 //! symbolic core from the model's own f(x, u) for any gap × core × coil.
 //!
 //! reldesign's state is the flux, the paper's the current; the force is the
 //! model's F = −F_mag = ½·R_gap'(z)·φ² ≥ 0 (attracting, towards z_min), so the
-//! paper's switched force map (2)–(3), whose coefficients are unpublished,
+//! paper's switched force map [SB 2–3], whose coefficients are unpublished,
 //! is not needed. With the passive force F_p(z, v) = k_s·z + c·v + F0 and
 //! m·v̇ = −F − F_p:
 //!
-//! - [SFB 9] z₁ = z − y_r, z₂ = v + α₁·z₁;
+//! - [SB 9] z₁ = z − y_r, z₂ = v + α₁·z₁;
 //! - F_d, the force that makes ż₂ = −z₁ − α₂·z₂ (so Ż = A·Z, A = [[−α₁, 1],
-//!   [−1, −α₂]], [SFB 14]): F_d = m·(z₁ + α₂·z₂ + α₁·v) − F_p(z, v). This is
+//!   [−1, −α₂]], [SB 14]): F_d = m·(z₁ + α₂·z₂ + α₁·v) − F_p(z, v). This is
 //!   Theorem 1's F_d = m·(a·z₁ + (b + α₂)·z₂ − d) in reldesign's signs, derived
-//!   from V₁ = ½‖Z‖² (ERRATA: §IV prints it with other signs);
+//!   from V₁ = ½‖Z‖² (ERRATA: [SB §IV] prints it with other signs);
 //! - z₃ = F − F_d; with V = ZᵀPZ + ½·z₃² (P of the region, `region.rs`;
 //!   P = ½I is the paper's V), ż₂ = −z₁ − α₂·z₂ − z₃/m and the law
-//!   Ḟ = Ḟ_d − α₃·z₃ + (2/m)·(PZ)₂ gives V̇ = Zᵀ(AᵀP + PA)Z − α₃·z₃² [SFB 18];
+//!   Ḟ = Ḟ_d − α₃·z₃ + (2/m)·(PZ)₂ gives V̇ = Zᵀ(AᵀP + PA)Z − α₃·z₃² [SB 18];
 //! - Ḟ = f_F + g_F·u (f_F = L_f F, g_F = L_g F on the rows (z, v, φ)), so
-//!   u = (Ḟ_desired − f_F)/g_F [SFB 19]; g_F = R_gap'·φ·∂φ̇/∂u vanishes at
+//!   u = (Ḟ_desired − f_F)/g_F [SB 19]; g_F = R_gap'·φ·∂φ̇/∂u vanishes at
 //!   φ = 0, where the runtime does not evaluate the law.
 //!
 //! With the Jiles–Atherton core, H_c enters f_F through φ̇ (as it enters α, β
@@ -46,11 +46,11 @@ pub struct Backstepping {
     /// f_F, g_F: Ḟ = f_F + g_F·u.
     pub force_drift: Id,
     pub force_gain: Id,
-    /// F_d(z, v; y_r) [SFB Theorem 1].
+    /// F_d(z, v; y_r) [SB Theorem 1].
     pub desired_force: Id,
-    /// u [SFB 19].
+    /// u [SB 19].
     pub law: Id,
-    /// The errors z₁, z₂ [SFB 9].
+    /// The errors z₁, z₂ [SB 9].
     pub errors: [Id; 2],
     /// The law as equations: (name, symbol, expression over the symbols of
     /// the stages before it, equation), in order; u last.
@@ -74,7 +74,7 @@ pub struct Stage {
 pub enum BacksteppingError {
     #[error(transparent)]
     Linearization(#[from] DesignError),
-    #[error("the passive force is not linear in (z, v): F_d is not affine in the errors and the region of [SFB lemma 1] is not a half-plane")]
+    #[error("the passive force is not linear in (z, v): F_d is not affine in the errors and the region of [SB lemma 1] is not a half-plane")]
     NonlinearPassiveForce,
     #[error("the model has no mass parameter `m`")]
     NoMass,
@@ -125,11 +125,11 @@ impl Backstepping {
         let [target, a1, a2, a3, p12, p22] = SYMBOLS.map(|name| g.symbol(name));
         let s = STAGES.map(|name| g.symbol(&format!("bs_{name}")));
         let [s_z1, s_z2, s_force, s_desired, s_rate, s_drift, s_gain, _] = s;
-        // [SFB 9]
+        // [SB 9]
         let z1 = g.sub(z, target);
         let a1z1 = g.mul(a1, s_z1);
         let z2 = g.add(v, a1z1);
-        // [SFB Theorem 1] F_d = m·(z₁ + α₂·z₂ + α₁·v) − F_p(z, v)
+        // [SB Theorem 1] F_d = m·(z₁ + α₂·z₂ + α₁·v) − F_p(z, v)
         let a2z2 = g.mul(a2, s_z2);
         let a1v = g.mul(a1, v);
         let wanted = g.sum(&[s_z1, a2z2, a1v]);
@@ -143,7 +143,7 @@ impl Backstepping {
         let rows = &lin.system.states;
         let drift = lie(g, &lin.system.drift, rows, force);
         let gain = lie(g, &lin.system.input_field, rows, force);
-        // [SFB 18] Ḟ* = Ḟ_d − α₃·(F − F_d) + (2/m)·(p₁₂·z₁ + p₂₂·z₂)
+        // [SB 18] Ḟ* = Ḟ_d − α₃·(F − F_d) + (2/m)·(p₁₂·z₁ + p₂₂·z₂)
         let z3 = g.sub(s_force, s_desired);
         let damping = g.mul(a3, z3);
         let pz1 = g.mul(p12, s_z1);
@@ -153,19 +153,19 @@ impl Backstepping {
         let coupling = g.div(two_pz, mass);
         let without_damping = g.add(s_rate, coupling);
         let wanted_rate = g.sub(without_damping, damping);
-        // [SFB 19] u = (Ḟ* − f_F)/g_F
+        // [SB 19] u = (Ḟ* − f_F)/g_F
         let num = g.sub(wanted_rate, s_drift);
         let u = g.div(num, s_gain);
         let exprs = [z1, z2, force, desired, rate, drift, gain, u];
         let equations = [
-            "[SFB 9] z₁ = z − y_r",
-            "[SFB 9] z₂ = v + α₁·z₁",
+            "[SB 9] z₁ = z − y_r",
+            "[SB 9] z₂ = v + α₁·z₁",
             "[PT 11] F = −F_mag = ½·R_gap'(z)·φ² (attracting)",
-            "[SFB Theorem 1] F_d = m·(z₁ + α₂·z₂ + α₁·v) − F_p(z, v): ż₂ = −z₁ − α₂·z₂ [SFB 14]",
+            "[SB Theorem 1] F_d = m·(z₁ + α₂·z₂ + α₁·v) − F_p(z, v): ż₂ = −z₁ − α₂·z₂ [SB 14]",
             "Ḟ_d = ∂F_d/∂z·v + ∂F_d/∂v·v̇ (y_r constant)",
             "f_F = L_f F: Ḟ = f_F + g_F·u",
             "g_F = L_g F (∝ φ: 0 at φ = 0)",
-            "[SFB 19] u = (Ḟ_d − α₃·(F − F_d) + (2/m)·(p₁₂·z₁ + p₂₂·z₂) − f_F)/g_F",
+            "[SB 19] u = (Ḟ_d − α₃·(F − F_d) + (2/m)·(p₁₂·z₁ + p₂₂·z₂) − f_F)/g_F",
         ];
         let stages: Vec<Stage> = (0..STAGES.len())
             .map(|k| Stage {

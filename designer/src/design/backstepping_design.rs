@@ -1,5 +1,5 @@
 //! The backstepping position controller (`[controller] law = "backstepping"`,
-//! switched-force-backstepping [SFB]) as plain data: the derived law, its
+//! switched-force-backstepping [SB]) as plain data: the derived law, its
 //! gains, the reference, the certified region and the switching strategy.
 //! Code generation renders a [`BacksteppingDesign`]; the runtime's
 //! `backstepping` module applies it.
@@ -9,7 +9,7 @@
 //! - the spring's rest X₀, the state u = 0 converges to: the zero of the
 //!   passive force F_p(z, 0) within the stroke, or the stop it pushes
 //!   against (z_max for the bundled valves, whose preload holds them open);
-//! - the region (`region.rs`) on A = [[−α₁, 1], [−1, −α₂]] [SFB 14] and
+//! - the region (`region.rs`) on A = [[−α₁, 1], [−1, −α₂]] [SB 14] and
 //!   F_d = g − kᵀZ, whose g and k are read off the derived F_d (affine,
 //!   checked by `backstepping.rs`); the switching strategies need X₀ ∈ D.
 

@@ -5,10 +5,10 @@
 //!   the jerk terms;
 //! - `reference.rs`: soft-landing position references (polynomial);
 //! - `backstepping.rs`: backstepping through the force for y = z
-//!   [SFB §III]: F_d, Ḟ = f_F + g_F·u, the law u [SFB 19];
+//!   [SB §III]: F_d, Ḟ = f_F + g_F·u, the law u [SB 19];
 //! - `lmi.rs`: small SDPs of 2×2 LMIs, as second-order cone programs (generic);
-//! - `region.rs`: the backstepping law's certified region [SFB lemma 1],
-//!   [SFB Theorem 3], extended to the spring's rest;
+//! - `region.rs`: the backstepping law's certified region [SB lemma 1],
+//!   [SB Theorem 3], extended to the spring's rest;
 //! - `backstepping_design.rs`: the backstepping controller as plain data,
 //!   [`BacksteppingDesign`];
 //! - `feasibility.rs`: conditions [PT 54], [PT 56], [PT 57] along a reference;

@@ -1,18 +1,18 @@
 //! The validity region of the backstepping position law
-//! (switched-force-backstepping [SFB lemma 1], [SFB Theorem 3]): where the
+//! (switched-force-backstepping [SB lemma 1], [SB Theorem 3]): where the
 //! desired force F_d stays ≥ 0, so that an only-attracting magnet can apply it.
 //!
-//! In the errors Z = (z₁, z₂) the mechanical loop is Ż = A·Z [SFB 14] and F_d
+//! In the errors Z = (z₁, z₂) the mechanical loop is Ż = A·Z [SB 14] and F_d
 //! is affine, F_d = g − kᵀZ (g: the force that holds the target). For a
 //! quadratic V = ZᵀPZ with AᵀP + PA ⪯ −α·P, the level set D = {V ≤ C} is
-//! invariant, and the largest inside {F_d ≥ 0} has C = g² / (kᵀP⁻¹k) [SFB
-//! lemma 1] (the tangent level set of a half-plane).
+//! invariant, and the largest inside {F_d ≥ 0} has C = g² / (kᵀP⁻¹k)
+//! [SB lemma 1] (the tangent level set of a half-plane).
 //!
-//! - the paper's V₁ = ½‖Z‖² [SFB 11] (P = ½I): its region (Fig. 5);
-//! - [SFB Theorem 3]: min tr P s.t. AᵀP + PA + αP ⪯ 0, P ⪰ I (the scale of P
+//! - the paper's V₁ = ½‖Z‖² [SB 11] (P = ½I): its region (Fig. 5);
+//! - [SB Theorem 3]: min tr P s.t. AᵀP + PA + αP ⪯ 0, P ⪰ I (the scale of P
 //!   is free, the region's shape is not; P ⪰ I fixes the scale);
 //! - extended: if the spring's rest X₀ (the state u = 0 converges to) is not
-//!   in D, which the switching strategies [SFB Theorems 4–5] need, the same
+//!   in D, which the switching strategies [SB Theorems 4–5] need, the same
 //!   program with, per target, Z₀ᵀPZ₀ ≤ ρ·C. With C as above that is
 //!   kᵀP⁻¹k ≤ ρ·g² / Z₀ᵀPZ₀, i.e. P − (Z₀ᵀPZ₀ / (ρ·g²))·kkᵀ ⪰ 0 by a Schur
 //!   complement: an LMI linear in P. Infeasible means no quadratic V with that
@@ -50,7 +50,7 @@ pub struct Level {
 /// paper's identity region beside it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Region {
-    /// The closed loop of (z₁, z₂) [SFB 14].
+    /// The closed loop of (z₁, z₂) [SB 14].
     pub a: [[f64; 2]; 2],
     /// α of AᵀP + PA ⪯ −αP.
     pub decay: f64,
@@ -93,7 +93,7 @@ pub enum RegionError {
     Solver(String),
 }
 
-/// V = ZᵀPZ.
+/// V = ZᵀPZ [SB 21].
 pub fn quadratic(p: Sym2, z: [f64; 2]) -> f64 {
     let [a, b, c] = p;
     a * z[0] * z[0] + 2.0 * b * z[0] * z[1] + c * z[1] * z[1]
@@ -105,7 +105,7 @@ fn inverse_quadratic(p: Sym2, k: [f64; 2]) -> f64 {
     quadratic([c, -b, a], k) / (a * c - b * b)
 }
 
-/// The level of `target` under P [SFB lemma 1].
+/// The level of `target` under P [SB lemma 1].
 pub fn level(p: Sym2, k: [f64; 2], target: &Target) -> Level {
     let g = target.holding_force;
     let c = g * g / inverse_quadratic(p, k);
@@ -129,7 +129,7 @@ fn lyapunov_term(a: [[f64; 2]; 2], decay: f64, e: Sym2) -> Sym2 {
 
 const BASIS: [Sym2; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
-/// −(AᵀP + PA + αP) ⪰ 0 [SFB Theorem 3].
+/// −(AᵀP + PA + αP) ⪰ 0 [SB Theorem 3].
 fn decay_lmi(a: [[f64; 2]; 2], decay: f64) -> Lmi2 {
     let coefficients = BASIS
         .iter()

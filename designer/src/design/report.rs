@@ -116,13 +116,13 @@ fn backstepping_text(b: &BacksteppingDesign) -> String {
     let r = &b.region;
     let _ = writeln!(
         s,
-        "backstepping through the force [SFB 19]: α₁ = {a1:e} s⁻¹, α₂ = {a2:e} s⁻¹, α₃ = {a3:e} s⁻¹, switching {:?}",
-        b.switching
+        "backstepping through the force [SB 19]: α₁ = {a1:e} s⁻¹, α₂ = {a2:e} s⁻¹, α₃ = {a3:e} s⁻¹, switching {}",
+        b.switching.name()
     );
     let [p11, p12, p22] = r.p;
     let _ = writeln!(
         s,
-        "region [SFB Theorem 3]: P = [[{p11:.6e}, {p12:.6e}], [{p12:.6e}, {p22:.6e}]] (tr P = {:.6e}), decay α = {:e} s⁻¹{}",
+        "region [SB Theorem 3]: P = [[{p11:.6e}, {p12:.6e}], [{p12:.6e}, {p22:.6e}]] (tr P = {:.6e}), decay α = {:e} s⁻¹{}",
         p11 + p22,
         r.decay,
         if r.extended {
@@ -135,7 +135,7 @@ fn backstepping_text(b: &BacksteppingDesign) -> String {
         let yes = |b: bool| if b { "inside" } else { "outside" };
         let _ = writeln!(
             s,
-            "  y_r = {:e} m: holding force {:.4} N, C = {:.4e} (rest z = {:e} m {} D); with P = ½I [SFB 11]: C = {:.4e}, rest {}",
+            "  y_r = {:e} m: holding force {:.4} N, C = {:.4e} (rest z = {:e} m {} D); with P = ½I [SB 11]: C = {:.4e}, rest {}",
             t.position,
             t.holding_force,
             l.c,

@@ -241,7 +241,7 @@ impl Hold<f64> for RuntimeHold<'_> {
     }
 }
 
-/// F_d [SFB Theorem 1], u [SFB 19] and the force F from one tape: (x, u = 0,
+/// F_d [SB Theorem 1], u [SB 19] and the force F from one tape: (x, u = 0,
 /// t = 0, y_r) → [F_d, u, F], the gains and P bound to the design's values.
 struct BacksteppingTape {
     tape: Tape,
@@ -312,7 +312,7 @@ impl<'a> RuntimeBackstepping<'a> {
         SwitchedBackstepping::with(self)
     }
 
-    /// V = ZᵀPZ + ½·(F − F_d)² at x for y_r [SFB 21], [SFB 18]: non-increasing
+    /// V = ZᵀPZ + ½·(F − F_d)² at x for y_r [SB 21], [SB 18]: non-increasing
     /// wherever the law is applied unsaturated.
     pub fn lyapunov(&self, x: [f64; 4], y_r: f64) -> f64 {
         let [desired, _, force] = self.tape.eval(x, y_r);

@@ -122,7 +122,7 @@ fn parse_surface(s: &Sect) -> Res<SlidingSurface> {
     })
 }
 
-/// The backstepping law's keys [SFB]: three gains, the switching strategy,
+/// The backstepping law's keys [SB]: three gains, the switching strategy,
 /// the decay, and exactly one of `position` and `square`.
 fn parse_backstepping(s: &Sect) -> Res<BacksteppingKeys> {
     let gains = exactly::<3>(s, "gains", "α₁, α₂, α₃ [1/s], each > 0")?
