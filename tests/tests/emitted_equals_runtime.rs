@@ -333,3 +333,80 @@ fn backstepping_runtime_equals_the_emitted_controller() {
          f32 within {worst32:.1e} V ({f32_disagree} beyond 1e-4·u_max)"
     );
 }
+
+/// The emitted backstepping controller, f64 and f32, drives the sampled loop
+/// on the valve's hybrid model (two periods of the square reference, from
+/// rest on z_max) as the run-time one does: the same modes, the position
+/// within 1e-9 m (f64) and 1e-7 m (f32, 10⁻⁴ of the stroke) of the
+/// run-time loop's at every sample.
+#[test]
+fn emitted_backstepping_drives_the_loop_as_the_runtime_one() {
+    use designer::backstepping_loop::run_backstepping;
+    use designer::closed_loop::Noise;
+    use designer::model::{Model, ModelPlant};
+    use designer::sim::{simulate_sampled, Measurement, Mode, Options, MAX_DIM};
+    use reldesign_generated::backstepping_valve as bs;
+    let d = design("backstepping-valve.toml");
+    let b = d.backstepping.as_ref().expect("backstepping");
+    let ts = b.sample_period;
+    let reference = run_backstepping(
+        &d,
+        None,
+        ts,
+        None,
+        Noise::seeded(0),
+        None,
+        &Options::default(),
+    )
+    .expect("the run-time loop runs");
+    let want = &reference.run.trajectory;
+    let mut model = Model::build(&d.description);
+    let plant = ModelPlant::new(&mut model);
+    let mut x0 = [0.0; MAX_DIM];
+    x0[0] = b.z_max;
+    let t_end = *want.t.last().expect("samples");
+    let (mut c64, mut c32) = (bs::f64::Controller::new(), bs::f32::Controller::new());
+    let mut modes = Vec::new();
+    let mut step64 = |_t: f64, m: &Measurement| {
+        let u = c64.step(m.t, m.x[0], m.x[1], m.x[2], 0.0);
+        modes.push(format!("{:?}", c64.mode()));
+        u
+    };
+    let got64 = simulate_sampled(
+        &plant,
+        &mut step64,
+        ts,
+        t_end,
+        x0,
+        Mode::StuckMax,
+        &Options::default(),
+    )
+    .expect("the f64 loop runs");
+    let mut step32 = |_t: f64, m: &Measurement| {
+        let u = c32.step(m.t as f32, m.x[0] as f32, m.x[1] as f32, m.x[2] as f32, 0.0);
+        f64::from(u)
+    };
+    let got32 = simulate_sampled(
+        &plant,
+        &mut step32,
+        ts,
+        t_end,
+        x0,
+        Mode::StuckMax,
+        &Options::default(),
+    )
+    .expect("the f32 loop runs");
+    assert_eq!(got64.t.len(), want.t.len());
+    let want_modes: Vec<String> = reference.modes.iter().map(|m| format!("{m:?}")).collect();
+    assert_eq!(modes, want_modes, "the switching modes");
+    let worst = |got: &designer::sim::Trajectory| {
+        (0..want.t.len()).fold(0.0f64, |w, k| w.max((got.x[k][0] - want.x[k][0]).abs()))
+    };
+    let (w64, w32) = (worst(&got64), worst(&got32));
+    assert!(w64 <= 1e-9, "f64: max |Δz| = {w64:e} m");
+    assert!(w32 <= 1e-7, "f32: max |Δz| = {w32:e} m");
+    eprintln!(
+        "backstepping loop: max |Δz| f64 {w64:.1e} m, f32 {w32:.1e} m over {} samples",
+        want.t.len()
+    );
+}
