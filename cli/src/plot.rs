@@ -62,13 +62,14 @@ pub fn panel(
         .draw()
         .map_err(e)?;
     for &(y, color, name) in lines {
-        let points = t
+        let points: Vec<(f64, f64)> = t
             .iter()
             .copied()
             .zip(y.iter().copied())
-            .filter(|(_, v)| v.is_finite());
+            .filter(|(_, v)| v.is_finite())
+            .collect();
         let series = chart
-            .draw_series(LineSeries::new(points, &color))
+            .draw_series(LineSeries::new(envelope(&points), &color))
             .map_err(e)?;
         if lines.len() > 1 {
             series
@@ -85,4 +86,34 @@ pub fn panel(
             .map_err(e)?;
     }
     Ok(())
+}
+
+/// At most this many points per line: more than a panel has pixels across.
+const MOST_POINTS: usize = 4000;
+
+/// `points` thinned to [`MOST_POINTS`]: per bucket of consecutive points the
+/// lowest and the highest, in time order, so peaks and ripple stay visible
+/// (an SVG of every sample of a long loop runs to megabytes).
+fn envelope(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    if points.len() <= MOST_POINTS {
+        return points.to_vec();
+    }
+    let bucket = points.len().div_ceil(MOST_POINTS / 2);
+    let mut out = Vec::with_capacity(MOST_POINTS + 2);
+    for chunk in points.chunks(bucket) {
+        let lo = chunk
+            .iter()
+            .copied()
+            .fold(chunk[0], |a, b| if b.1 < a.1 { b } else { a });
+        let hi = chunk
+            .iter()
+            .copied()
+            .fold(chunk[0], |a, b| if b.1 > a.1 { b } else { a });
+        if lo.0 <= hi.0 {
+            out.extend([lo, hi]);
+        } else {
+            out.extend([hi, lo]);
+        }
+    }
+    out
 }

@@ -248,6 +248,14 @@ fn every_strategy_converges_from_the_papers_three_initial_conditions() {
                     checked > n / 2,
                     "{case}: V checked on {checked} of {n} samples only"
                 );
+                let first_in = r.inside.iter().position(|&i| i).map(|k| tr.t[k] * 1e3);
+                println!(
+                    "| {example} | {switching} | {name} | {:+.3} | {} | {} | {:.1e} |",
+                    fd0,
+                    first_in.map_or("never".into(), |t| format!("{t:.2}")),
+                    r.switches(),
+                    (end - 5e-4).abs()
+                );
             }
         }
     }
