@@ -22,7 +22,7 @@ use designer::sym::{Graph, Id};
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
-use crate::controller::ControllerError;
+use crate::controller::{runtime_state_pattern, state_args, ControllerError};
 use crate::emit::{function_tokens_as, FunctionSpec, Inline};
 use crate::float::{Float, Scalar, MACRO_LITERALS};
 use crate::format::{comment_lets, format_items, macro_rules, space_items};
@@ -61,19 +61,6 @@ const CONSTS: &[&str] = &[
     "PHI_GUARD",
 ];
 
-/// The law's symbols bound to consts: (symbol name, value).
-fn law_params(design: &BacksteppingDesign) -> [(&'static str, f64); 5] {
-    let [a1, a2, a3] = design.gains;
-    let [_, p12, p22] = design.region.p;
-    [
-        ("gain_a1", a1),
-        ("gain_a2", a2),
-        ("gain_a3", a3),
-        ("region_p12", p12),
-        ("region_p22", p22),
-    ]
-}
-
 /// The `law!` macro and the float modules, formatted and deterministic;
 /// each module invokes the file's `params!` macro too.
 pub fn emit_backstepping(input: &BacksteppingInput) -> Result<String, ControllerError> {
@@ -86,14 +73,6 @@ pub fn emit_backstepping(input: &BacksteppingInput) -> Result<String, Controller
     Ok(out)
 }
 
-/// The state arguments: z, v, φ, and H_c on a Jiles–Atherton core.
-fn state_args(model: &Model) -> Vec<(&'static str, Id)> {
-    ["z", "v", "phi", "hc"]
-        .into_iter()
-        .zip(model.states.iter().copied())
-        .collect()
-}
-
 /// `macro_rules! law`: `law_terms`, `law`, `force_terms`, `desired_force`.
 fn law_macro(input: &BacksteppingInput, f32: bool) -> Result<String, ControllerError> {
     let model = input.model;
@@ -102,14 +81,7 @@ fn law_macro(input: &BacksteppingInput, f32: bool) -> Result<String, ControllerE
     let physical = in_scope(&mut graph, &of_model(model));
     let mut params: Vec<Param> = model.params.iter().map(Param::from).collect();
     params.extend_from_slice(&physical);
-    let symbols = [
-        law.gains[0],
-        law.gains[1],
-        law.gains[2],
-        law.coupling[0],
-        law.coupling[1],
-    ];
-    for (&id, (name, value)) in symbols.iter().zip(law_params(input.design)) {
+    for (name, id, value) in input.design.bound_symbols() {
         params.push(Param::from((name, id, value)));
     }
     let scalar = Scalar::Macro { f32 };
@@ -271,16 +243,8 @@ fn float_module(input: &BacksteppingInput, float: Float) -> Result<String, Contr
         Switching::Intuitive => quote!(backstepping::Switching::Intuitive),
         Switching::Hybrid => quote!(backstepping::Switching::Hybrid),
     };
-    let state: Vec<_> = state_args(input.model)
-        .into_iter()
-        .map(|(name, _)| format_ident!("{name}"))
-        .collect();
-    let pattern = if state.len() == 4 {
-        quote!([#(#state),*])
-    } else {
-        quote!([#(#state,)* _])
-    };
-    let step = if state.len() == 4 {
+    let (pattern, args) = runtime_state_pattern(input.model);
+    let step = if input.model.states.len() == 4 {
         "`step(t, z, v, phi, hc)` with the observer's H_c"
     } else {
         "`step(t, z, v, phi, 0.0)` (the core has no field state)"
@@ -333,7 +297,7 @@ fn float_module(input: &BacksteppingInput, float: Float) -> Result<String, Contr
 
                 #[inline(always)]
                 fn law(&self, #pattern: [#ty; 4], y_r: #ty) -> #ty {
-                    law(#(#state,)* y_r)
+                    law(#args, y_r)
                 }
             }
 

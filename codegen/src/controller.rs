@@ -113,7 +113,7 @@ pub fn law_macro_text(source: &LawSource, f32: bool) -> Result<String, Controlle
 }
 
 /// The law's state arguments: z, v, φ, and H_c on a Jiles–Atherton core.
-fn state_args(model: &Model) -> Vec<(&'static str, Id)> {
+pub(crate) fn state_args(model: &Model) -> Vec<(&'static str, Id)> {
     let names = ["z", "v", "phi", "hc"];
     names
         .into_iter()

@@ -31,31 +31,14 @@ fn emitted(text: &str) -> String {
 
 /// `text` with `from` replaced once (which must be there).
 fn changed(text: &str, from: &str, to: &str) -> String {
-    assert!(text.contains(from), "`{from}` is not in the example");
-    text.replacen(from, to, 1)
-}
-
-/// The lines of `text` without its comments (`//` lines, `/* … */` blocks:
-/// prettyplease writes a multi-line doc attribute as one).
-fn code_only(text: &str) -> Vec<&str> {
-    let mut in_block = false;
-    let mut code = Vec::new();
-    for line in text.lines() {
-        let t = line.trim_start();
-        if in_block || t.starts_with("/*") {
-            in_block = !line.contains("*/");
-        } else if !t.starts_with("//") {
-            code.push(line);
-        }
-    }
-    code
+    support::replaced_once(text, from, to)
 }
 
 #[test]
 fn emission_is_deterministic_and_holds_the_law_once() {
     let (a, b) = (emitted(&example_text()), emitted(&example_text()));
     assert_eq!(a, b);
-    let code = code_only(&a);
+    let code = support::code_only(&a);
     for word in [
         " as ", "unwrap", "expect(", "panic", "[0]", "unsafe", "alloc",
     ] {

@@ -15,7 +15,7 @@
 use reldesign_runtime::backstepping::Backstepping;
 pub use reldesign_runtime::backstepping::Mode;
 
-use crate::closed_loop::{check_plant, observer, LoopError, LoopRun, Noise, Sensing};
+use crate::closed_loop::{check_plant, LoopError, LoopRun, Noise, Sensing};
 use crate::description::{Description, SetPoint};
 use crate::design::{Design, RuntimeBackstepping};
 use crate::model::{Model, ModelPlant};
@@ -68,13 +68,7 @@ pub fn run_backstepping(
     let mut design_model = design.model.clone();
     let runtime = RuntimeBackstepping::new(&mut design_model, b);
     let mut controller = RuntimeBackstepping::new(&mut design_model, b).controller();
-    let mut sensing = Sensing {
-        plant: &model_plant,
-        observer: observer(design, sample_period, noise)?,
-        nonnegative_current: false,
-        held: 0.0,
-        estimates: Vec::new(),
-    };
+    let mut sensing = Sensing::new(design, &model_plant, sample_period, noise, false)?;
     let settings = runtime.settings();
     let mut z_ref = Vec::new();
     let (mut modes, mut inside, mut desired, mut lyapunov) =

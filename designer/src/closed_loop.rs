@@ -80,7 +80,7 @@ pub struct LoopRun {
 /// The observer that drives the controller from the measured voltage and
 /// current (`[controller] estimator`), with the seeded measurement noise of
 /// `[observer]`.
-pub(crate) struct Observer {
+struct Observer {
     filter: Filter,
     noise: SplitMix64,
     sigma_v: f64,
@@ -110,17 +110,36 @@ impl Observer {
 /// observer's estimate from the measured voltage and current; and the input
 /// held since the last sample.
 pub(crate) struct Sensing<'a> {
-    pub(crate) plant: &'a ModelPlant,
-    pub(crate) observer: Option<Observer>,
+    plant: &'a ModelPlant,
+    observer: Option<Observer>,
     /// φ is read as the coil current ([SM §5]'s non-negative current).
-    pub(crate) nonnegative_current: bool,
+    nonnegative_current: bool,
     /// The input held over the last sample period (the current depends on it
     /// through the eddy-current term).
     pub(crate) held: f64,
-    pub(crate) estimates: Vec<(f64, Estimate)>,
+    estimates: Vec<(f64, Estimate)>,
 }
 
-impl Sensing<'_> {
+impl<'a> Sensing<'a> {
+    /// What `design`'s controller reads on `plant` at `sample_period`: the
+    /// observer of `[controller] estimator` (noise seeded by `noise`) or the
+    /// plant's state; nothing held yet.
+    pub(crate) fn new(
+        design: &Design,
+        plant: &'a ModelPlant,
+        sample_period: f64,
+        noise: Noise,
+        nonnegative_current: bool,
+    ) -> Result<Sensing<'a>, LoopError> {
+        Ok(Sensing {
+            plant,
+            observer: observer(design, sample_period, noise)?,
+            nonnegative_current,
+            held: 0.0,
+            estimates: Vec::new(),
+        })
+    }
+
     /// [z, v, φ, H_c] and the acceleration a at the sample `m` (H_c is 0
     /// where neither the plant nor the observer has it).
     pub(crate) fn read(&mut self, m: &Measurement) -> ([f64; 4], f64) {
@@ -247,13 +266,13 @@ pub fn run_loop(
         plan: controllers,
         operations: operations.clone(),
         current: 0,
-        sensing: Sensing {
-            plant: &model_plant,
-            observer: observer(design, sample_period, noise)?,
+        sensing: Sensing::new(
+            design,
+            &model_plant,
+            sample_period,
+            noise,
             nonnegative_current,
-            held: 0.0,
-            estimates: Vec::new(),
-        },
+        )?,
         z_ref: Vec::new(),
     };
     let (x0, mode0) = start_state(&mut plant_model, operations.first().map(|o| o.0));
@@ -308,13 +327,7 @@ pub fn run_hold(
     let model_plant = ModelPlant::new(&mut plant_model);
     let mut design_model = design.model.clone();
     let hold = RuntimeHold::new(&mut design_model, h).controller();
-    let mut sensing = Sensing {
-        plant: &model_plant,
-        observer: observer(design, sample_period, noise)?,
-        nonnegative_current: false,
-        held: 0.0,
-        estimates: Vec::new(),
-    };
+    let mut sensing = Sensing::new(design, &model_plant, sample_period, noise, false)?;
     let mut z_ref = Vec::new();
     let mut control = |_t: f64, m: &Measurement| {
         let ([z, v, phi, hc], _) = sensing.read(m);
@@ -491,7 +504,7 @@ const NO_ESTIMATE: Estimate = Estimate {
 };
 
 /// The observer `[controller] estimator` names, at the loop's sample period.
-pub(crate) fn observer(
+fn observer(
     design: &Design,
     sample_period: f64,
     noise: Noise,
@@ -526,7 +539,7 @@ pub(crate) fn observer(
 
 /// At rest at the first operation's z₀: z_max without flux, or z_min held by
 /// 1.2× the flux that balances the passive force there.
-pub(crate) fn start_state(model: &mut Model, first: Option<Operation>) -> (State, Mode) {
+fn start_state(model: &mut Model, first: Option<Operation>) -> (State, Mode) {
     let mut x0: State = [0.0; crate::sim::MAX_DIM];
     let (z_min, z_max) = (
         model.description.mechanics.z_min,

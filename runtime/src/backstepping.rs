@@ -98,21 +98,10 @@ pub enum Mode {
     Inside,
 }
 
-/// `u` clamped to [u_min, u_max]; a NaN gives the bound nearest 0, ±∞ the bounds.
+/// `u` clamped to [u_min, u_max] (NaN → the bound nearest 0).
 #[inline]
 fn saturate<T: Scalar>(u: T, s: &BacksteppingSettings<T>) -> T {
-    // NaN is the one value unordered with itself
-    let u = if u.partial_cmp(&u).is_none() {
-        T::ZERO
-    } else {
-        u
-    };
-    let u = if u > s.u_min { u } else { s.u_min };
-    if u < s.u_max {
-        u
-    } else {
-        s.u_max
-    }
+    crate::control::saturate_to(u, s.u_min, s.u_max)
 }
 
 /// V(Z) = ZᵀPZ at (z, v) for y_r [SB 21].

@@ -124,21 +124,24 @@ pub fn eval_segment<T: Scalar + From<u8>>(row: &Row<T>, tau: T) -> [T; 4] {
 /// [`crate::saturate`]).
 #[inline]
 pub fn saturate<T: Scalar>(u: T, settings: &Settings<T>) -> T {
+    saturate_to(u, settings.u_min, settings.u_max)
+}
+
+/// `u` clamped to [lo, hi] (lo ≤ hi); a NaN gives the bound nearest 0, ±∞
+/// the bounds: [`saturate`] for any pair of limits.
+#[inline]
+pub fn saturate_to<T: Scalar>(u: T, lo: T, hi: T) -> T {
     // NaN is the one value unordered with itself
     let u = if u.partial_cmp(&u).is_none() {
         T::ZERO
     } else {
         u
     };
-    let u = if u > settings.u_min {
+    let u = if u > lo { u } else { lo };
+    if u < hi {
         u
     } else {
-        settings.u_min
-    };
-    if u < settings.u_max {
-        u
-    } else {
-        settings.u_max
+        hi
     }
 }
 

@@ -17,7 +17,7 @@ pub mod temp;
 
 pub use cli::{assert_no_panic, squeeze, Cli, Run};
 pub use close::{assert_close, close, Tol};
-pub use lines::changed_lines;
+pub use lines::{changed_lines, code_only, replaced_once};
 pub use paths::{example_path, example_paths, root, toml_files};
 pub use scratch::ScratchCrate;
 pub use temp::{files_in, TempDir};

@@ -14,9 +14,39 @@ pub fn changed_lines<'a>(a: &'a str, b: &'a str) -> Vec<(&'a str, &'a str)> {
     la.into_iter().zip(lb).filter(|(x, y)| x != y).collect()
 }
 
+/// `text` with `from` replaced once; panics when `from` is not there (a
+/// test that changes an example must change something).
+pub fn replaced_once(text: &str, from: &str, to: &str) -> String {
+    assert!(text.contains(from), "`{from}` is not in the text");
+    text.replacen(from, to, 1)
+}
+
+/// The lines of emitted code without its comments (`//` lines, `/* … */`
+/// blocks: prettyplease writes a multi-line doc attribute as one), for tests
+/// that look for words the code must not contain.
+pub fn code_only(text: &str) -> Vec<&str> {
+    let mut in_block = false;
+    let mut code = Vec::new();
+    for line in text.lines() {
+        let t = line.trim_start();
+        if in_block || t.starts_with("/*") {
+            in_block = !line.contains("*/");
+        } else if !t.starts_with("//") {
+            code.push(line);
+        }
+    }
+    code
+}
+
 #[cfg(test)]
 mod tests {
-    use super::changed_lines;
+    use super::{changed_lines, code_only};
+
+    #[test]
+    fn comments_are_not_code() {
+        let text = "// a\nlet x = 1;\n/** doc\n  more */\nfn f() {}\n    /// d\n";
+        assert_eq!(code_only(text), ["let x = 1;", "fn f() {}"]);
+    }
 
     #[test]
     fn only_the_differing_lines_in_order() {

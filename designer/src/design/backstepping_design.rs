@@ -55,6 +55,23 @@ pub struct BacksteppingDesign {
     pub holding: Vec<(f64, f64)>,
 }
 
+impl BacksteppingDesign {
+    /// The law's design symbols and their values: α₁, α₂, α₃ (`gain_a…`)
+    /// and p₁₂, p₂₂ of P (`region_p…`), for the tapes and the emitted consts.
+    pub fn bound_symbols(&self) -> [(&'static str, Id, f64); 5] {
+        let law = &self.law;
+        let [a1, a2, a3] = self.gains;
+        let [_, p12, p22] = self.region.p;
+        [
+            ("gain_a1", law.gains[0], a1),
+            ("gain_a2", law.gains[1], a2),
+            ("gain_a3", law.gains[2], a3),
+            ("region_p12", law.coupling[0], p12),
+            ("region_p22", law.coupling[1], p22),
+        ]
+    }
+}
+
 impl From<RegionError> for PlanError {
     fn from(e: RegionError) -> Self {
         PlanError::Region(e)

@@ -252,19 +252,8 @@ struct BacksteppingTape {
 impl BacksteppingTape {
     fn new(model: &mut Model, design: &BacksteppingDesign) -> BacksteppingTape {
         let law = &design.law;
-        let [_, p12, p22] = design.region.p;
-        let values = [design.gains[0], design.gains[1], design.gains[2], p12, p22];
-        let symbols = [
-            law.gains[0],
-            law.gains[1],
-            law.gains[2],
-            law.coupling[0],
-            law.coupling[1],
-        ];
-        let map = symbols
-            .iter()
-            .zip(values)
-            .map(|(&s, x)| (s, model.graph.constant(x)))
+        let map = (design.bound_symbols().iter())
+            .map(|&(_, symbol, value)| (symbol, model.graph.constant(value)))
             .collect();
         let exprs = (model.graph).substitute_all(&[law.desired_force, law.law, law.force], &map);
         let bound = model.bind_params(&exprs);
