@@ -173,10 +173,12 @@ fn design_text(d: &Description) -> String {
             c.sample_period,
             floats.join(" and ")
         );
-        let _ = writeln!(
-            s,
-            "  `reldesign build` designs the references and emits the code"
-        );
+        let designs = match c.law {
+            Law::Backstepping(_) => "certifies the region (its LMI)",
+            Law::ModelSlidingMode(m) if m.position.is_some() => "checks the position",
+            _ => "designs the references",
+        };
+        let _ = writeln!(s, "  `reldesign build` {designs} and emits the code");
     }
     s
 }

@@ -123,6 +123,9 @@ fn uncertifiable_designs_are_rejected_with_the_reason_and_nothing_is_written() {
     .ok();
     let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(report["region"]["contains_rest"], Value::Bool(false));
+    // sweep compares landings: a positioner is refused with the command to use
+    let example = example_path("backstepping-valve.toml");
+    rd!("sweep", example).rejected(&["backstepping", "no soft landing to sweep", "reldesign loop"]);
     // --plot is the backstepping law's
     let other = example_path("perfect-tracking-valve.toml");
     rd!(

@@ -31,6 +31,8 @@ use crate::sim::{
 pub enum LoopError {
     #[error("the description designs no controller: add [trajectory] and [controller]")]
     NoController,
+    #[error("{0} positions the armature and has no soft landing to sweep: run it with `reldesign loop --sample-period`")]
+    Positions(&'static str),
     #[error("the design's law reads the core's field H_c, which a plant without a Jiles–Atherton core does not have: feed it an observer's estimate ([controller] estimator) or use a Jiles–Atherton plant")]
     PlantMismatch { plant: usize, design: usize },
     #[error("the design at T_s = {sample_period:e} s: {message}")]
@@ -297,6 +299,19 @@ pub fn run_loop(
         operation_length: length,
         estimates,
     })
+}
+
+/// The name of a law that positions the armature rather than landing it
+/// (backstepping, the model-based sliding mode's hold), if `description`'s is one.
+fn design_positions(description: &Description) -> Option<&'static str> {
+    use crate::description::Law;
+    match description.controller.as_ref()?.law {
+        Law::Backstepping(_) => Some("law = \"backstepping\""),
+        Law::ModelSlidingMode(m) if m.position.is_some() => {
+            Some("law = \"model-sliding-mode\" with controller.position")
+        }
+        _ => None,
+    }
 }
 
 /// Default length of a position-hold loop [s].
@@ -732,6 +747,9 @@ pub fn sweep(
     options: &Options,
 ) -> Result<Vec<SweepRow>, LoopError> {
     use rayon::prelude::*;
+    if let Some(law) = design_positions(description) {
+        return Err(LoopError::Positions(law));
+    }
     let Some(t) = &description.trajectory else {
         return Err(LoopError::NoController);
     };

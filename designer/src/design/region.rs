@@ -225,14 +225,11 @@ pub fn design_region(
                 extended = true;
             }
             None if need_rest => {
-                let t = targets
-                    .iter()
-                    .find(|t| !level(paper, k, t).contains_rest)
-                    .unwrap_or(&targets[0]);
+                let outside = targets.iter().find(|t| !level(paper, k, t).contains_rest);
                 return Err(RegionError::RestOutside {
                     decay,
-                    rest: t.position + t.rest[0],
-                    position: t.position,
+                    rest: outside.map_or(f64::NAN, |t| t.position + t.rest[0]),
+                    position: outside.map_or(f64::NAN, |t| t.position),
                 });
             }
             None => {}
