@@ -38,8 +38,8 @@ Measures:
    is single precision): add/sub 50-100, mul 50-100, div 150-400, sqrt 200-1000,
    compare/min/max 20-40, conversion 20-40 cycles (the low end: Arm's hand-written
    libraries; the high end: generic ones such as Rust's compiler-builtins). The two
-   ends give the range printed. The law's ln is inlined code (runtime's own f64 ln;
-   f32 likewise), so it is in the instruction count, not a call.
+   ends give the range printed. The law's ln (the runtime's own f64 `ln`, libm's
+   `logf` in f32) is inlined into `law`, so it is in the instruction count.
 5. sanity (exit 1 otherwise): over one pass of the record every step output (f64 and
    f32) is finite and in [U_MIN, U_MAX]; where the f64 law runs unsaturated
    (|u| < u_max) the f32 law is finite and within 1e-4·u_max of it. Reported besides:
