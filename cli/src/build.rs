@@ -100,7 +100,8 @@ fn backstepping_json(b: &BacksteppingDesign) -> serde_json::Value {
 
 /// The certified region [SB lemma 1], [SB Theorem 3]: A, P, C and whether
 /// the spring's rest is in D, for the design's P and the paper's P = ½I; per
-/// target where there are two (a square reference), the first in `c`.
+/// target where there are two (a square reference): `c` is the first
+/// target's, `contains_rest` holds for every target.
 fn region_json(b: &BacksteppingDesign) -> serde_json::Value {
     let r = &b.region;
     let [p11, p12, p22] = r.p;
@@ -123,13 +124,16 @@ fn region_json(b: &BacksteppingDesign) -> serde_json::Value {
         })
         .collect();
     let first = level(r.levels.first());
+    let all = |levels: &[designer::design::Level]| levels.iter().all(|l| l.contains_rest);
+    let mut identity = level(r.identity.first());
+    identity["contains_rest"] = all(&r.identity).into();
     serde_json::json!({
         "a": r.a,
         "p": [[p11, p12], [p12, p22]],
         "c": first["c"],
         "decay": r.decay,
-        "contains_rest": first["contains_rest"],
-        "identity": level(r.identity.first()),
+        "contains_rest": all(&r.levels),
+        "identity": identity,
         "extended": r.extended,
         "force_gradient": r.force_gradient,
         "trace": p11 + p22,

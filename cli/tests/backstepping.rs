@@ -55,7 +55,16 @@ fn build_reports_the_region_with_its_fixed_keys_and_draws_it() {
     assert!(number(&region["c"]) > 0.0 && number(&region["decay"]) == 40.0);
     assert_eq!(region["contains_rest"], Value::Bool(true));
     assert_eq!(region["identity"]["contains_rest"], Value::Bool(false));
-    assert!(number(&region["identity"]["c"]) < number(&region["c"]));
+    // the regions' velocity extent max |z₂| = √(C·(P⁻¹)₂₂), scale-free: the
+    // paper's V₁ (P = ½I) admits 0.0122 m/s, the LMI's 0.0632 m/s (the rest
+    // on z_max has z₂ = α₁·(z_max − y_r) = 0.06 m/s)
+    let det = p[0][0] * p[1][1] - p[0][1] * p[0][1];
+    let extent = (number(&region["c"]) * p[0][0] / det).sqrt();
+    let paper = (number(&region["identity"]["c"]) * 2.0).sqrt();
+    assert!(
+        (extent - 0.0632).abs() < 5e-4 && (paper - 0.0122).abs() < 2e-4,
+        "{extent} {paper}"
+    );
     assert_eq!(report["controller"]["law"], "backstepping");
     assert_eq!(report["controller"]["switching"], "hybrid");
     let svg = std::fs::read_to_string(&svg).unwrap();
@@ -104,6 +113,33 @@ fn uncertifiable_designs_are_rejected_with_the_reason_and_nothing_is_written() {
         for f in [&out, &json, &svg] {
             assert!(!f.exists(), "{name}: {} written", f.display());
         }
+    }
+    // targets the magnet cannot hold: one where the spring pulls closed (no
+    // attracting flux balances it), one beyond the supply's steady input
+    for (name, keys, needles) in [
+        (
+            "pulls.toml",
+            "gains = [100.0, 100.0, 2000.0]\nposition = 5e-4",
+            vec!["cannot be held", "the magnet only attracts"],
+        ),
+        (
+            "supply.toml",
+            "gains = [100.0, 100.0, 2000.0]\nposition = 5e-4",
+            vec!["needs a steady input", "supply.u_max"],
+        ),
+    ] {
+        let text = std::fs::read_to_string(variant(&dir, name, keys)).unwrap();
+        let text = if name == "pulls.toml" {
+            text.replace("preload = -0.75", "preload = 0.0")
+        } else {
+            text.replace("u_max = 24.0", "u_max = 5.0")
+        };
+        let model = dir.write(name, text);
+        let out = dir.join("c.rs");
+        let mut all = vec![name];
+        all.extend(needles.iter().copied());
+        rd!("build", model, "--out", out).rejected(&all);
+        assert!(!out.exists(), "{name}: code written");
     }
     // without switching the same gains design (the region is reported, X₀ outside)
     let model = variant(

@@ -164,8 +164,10 @@ fn robustness_agrees_with_the_python_oracle() {
 
 /// The backstepping region [SB Theorem 3] on the bundled example (square
 /// reference, two targets), on the sliding-mode valve with unequal gains
-/// (where the paper's min tr P is not the identity) and on the
-/// perfect-tracking valve with a given decay and no switching.
+/// (where the paper's min tr P is not the identity), on the perfect-tracking
+/// valve with a given decay and no switching (all three extended to hold the
+/// rest), and on the sliding-mode valve where the paper's program alone holds
+/// it (not extended).
 #[test]
 fn backstepping_region_agrees_with_the_cvxpy_oracle() {
     let dir = support::TempDir::new("oracle-region");
@@ -189,11 +191,19 @@ fn backstepping_region_agrees_with_the_cvxpy_oracle() {
             "gains = [300.0, 80.0, 3000.0]\nswitching = \"none\"\ndecay = 30.0\nposition = 6e-4\n",
         ),
     );
+    let paper = dir.write(
+        "sm_paper.toml",
+        variant(
+            "sliding-mode-valve.toml",
+            "gains = [100.0, 100.0, 2000.0]\nswitching = \"hybrid\"\nposition = 4e-4\n",
+        ),
+    );
     let args: Vec<OsString> = vec![
         BIN.into(),
         "examples/backstepping-valve.toml".into(),
         unequal.into_os_string(),
         decay.into_os_string(),
+        paper.into_os_string(),
     ];
     oracle("check_region.py", &args, "check_region: OK");
 }

@@ -151,6 +151,21 @@ pub struct StepOutcome {
     pub overshoot: f64,
 }
 
+/// What happened after the law first took over (the state first in D):
+/// the region D = {ZᵀPZ ≤ C} is invariant under the law only while F = F_d
+/// (z₃ = 0), and at the entry z₃ = −F_d (no flux yet), so these count what
+/// the proof does not cover.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AfterEntry {
+    /// Samples with the state outside D.
+    pub outside: usize,
+    /// Samples with F_d < 0 (the magnet asked to push).
+    pub pushing: usize,
+    /// Samples at which the input jumped between the supply's bounds (a
+    /// bang-bang chatter: u_max at one sample, u_min at the next, or back).
+    pub bang_bang: usize,
+}
+
 /// Settled: within this fraction of the step.
 pub const STEP_BAND: f64 = 0.05;
 
@@ -187,6 +202,30 @@ impl BacksteppingRun {
             });
         }
         out
+    }
+
+    /// After the law first took over (`None`: it never did), within each
+    /// constant stretch of the reference: see [`AfterEntry`].
+    pub fn after_entry(&self, u_min: f64, u_max: f64) -> Option<AfterEntry> {
+        let first = self.modes.iter().position(|&m| m == Mode::Inside)?;
+        let u = &self.run.trajectory.u;
+        let r = &self.run.z_ref;
+        let same_stretch = |k: usize| r.get(k) == r.get(k - 1);
+        let mut out = AfterEntry {
+            outside: 0,
+            pushing: 0,
+            bang_bang: 0,
+        };
+        for k in first..self.modes.len() {
+            out.outside += usize::from(!self.inside[k]);
+            out.pushing += usize::from(self.desired_force[k] < 0.0);
+            if k > first && same_stretch(k) {
+                let jump =
+                    (u[k - 1] >= u_max && u[k] <= u_min) || (u[k - 1] <= u_min && u[k] >= u_max);
+                out.bang_bang += usize::from(jump);
+            }
+        }
+        Some(out)
     }
 
     /// How often the input law switched on or off (modes `Waiting` ↔ others).

@@ -17,6 +17,7 @@ and solves with cvxpy's PSD cone (not reldesign's second-order-cone form):
     paper:    min tr P  s.t.  AᵀP + PA + αP ⪯ 0,  P ⪰ I
     extended: the same with, per target, P − (Z₀ᵀPZ₀ / (0.9·g²))·kkᵀ ⪰ 0
               (X₀ inside D at 90 % of its level), where the paper's leaves X₀ out
+              (decided here from the oracle's own solution of the paper's program)
 
 It compares `reldesign build --report-json`'s region: tr P within --tol
 (relative), reldesign's P certified by eigenvalues, C = g²/(kᵀP⁻¹k) and
@@ -105,8 +106,13 @@ def check(bin_, model, tol):
     norm = max(np.linalg.eigvalsh(P))
     assert min(np.linalg.eigvalsh(P - np.eye(2))) > -1e-7 * norm, "P ⪰ I fails"
     assert max(np.linalg.eigvalsh(lyap)) < 1e-7 * norm * decay, f"AᵀP + PA + αP: {np.linalg.eigvalsh(lyap)}"
-    # the optimum of the same program
-    oracle = solve(A, k, decay, targets, region["extended"])
+    # the paper's program decides whether the rest constraints are needed
+    paper = solve(A, k, decay, targets, False)
+    def holds_rest(P_):
+        return all(z0 @ P_ @ z0 < g * g / (k @ np.linalg.solve(P_, k)) for _, g, z0 in targets)
+    extended = not holds_rest(paper)
+    assert extended == region["extended"], f"extended: oracle {extended}, reldesign {region['extended']}"
+    oracle = solve(A, k, decay, targets, True) if extended else paper
     want, got = np.trace(oracle), region["trace"]
     rel = abs(got - want) / want
     assert rel <= tol, f"tr P = {got}, the oracle's {want} (relative {rel:.2e})"

@@ -303,7 +303,7 @@ pub enum Switching {
     None,
     /// u = 0 until the state enters the region D, then the law [SB 28].
     Intuitive,
-    /// The law while F_d ≥ 0, u = 0 from F_d ≤ 0 until D, then the law
+    /// The law while F_d > 0, u = 0 from F_d ≤ 0 until D, then the law
     /// [SB 31–33].
     Hybrid,
 }

@@ -1,6 +1,7 @@
 //! Small semidefinite programs whose constraints are all 2×2 linear matrix
-//! inequalities, solved exactly as second-order cone programs (generic:
-//! nothing here knows about actuators).
+//! inequalities, written exactly as second-order cone programs and solved by
+//! an interior-point method to 1e-10 (generic: nothing here knows about
+//! actuators).
 //!
 //! A symmetric 2×2 matrix [[a, b], [b, c]] is positive semidefinite exactly
 //! when a + c ≥ ‖(a − c, 2b)‖ (both eigenvalues ½(a + c ± ‖(a − c, 2b)‖) are
@@ -53,7 +54,8 @@ pub enum SdpOutcome {
         x: Vec<f64>,
         objective: f64,
     },
-    /// Certified infeasible (a dual certificate).
+    /// Certified infeasible (a dual certificate; "almost infeasible" is a
+    /// failure, not a certificate).
     Infeasible,
     /// Anything else (unbounded, iteration limit, numerical trouble), named.
     Failed(String),
@@ -114,13 +116,12 @@ impl Sdp2 {
         };
         solver.solve();
         match solver.solution.status {
+            // an almost-solved program's solution is checked by its caller
             SolverStatus::Solved | SolverStatus::AlmostSolved => SdpOutcome::Optimal {
                 objective: solver.solution.obj_val,
                 x: solver.solution.x.clone(),
             },
-            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
-                SdpOutcome::Infeasible
-            }
+            SolverStatus::PrimalInfeasible => SdpOutcome::Infeasible,
             other => SdpOutcome::Failed(format!("{other:?}")),
         }
     }

@@ -15,10 +15,17 @@
 //!   in D, which the switching strategies [SB Theorems 4–5] need, the same
 //!   program with, per target, Z₀ᵀPZ₀ ≤ ρ·C. With C as above that is
 //!   kᵀP⁻¹k ≤ ρ·g² / Z₀ᵀPZ₀, i.e. P − (Z₀ᵀPZ₀ / (ρ·g²))·kkᵀ ⪰ 0 by a Schur
-//!   complement: an LMI linear in P. Infeasible means no quadratic V with that
-//!   decay has X₀ in its region: a certificate, not a search that gave up.
+//!   complement: an LMI linear in P. Infeasible (a dual certificate) means no
+//!   one P with that decay puts every target's X₀ within ρ·C: not a search
+//!   that gave up. The targets are then tried one by one to name the culprit.
 //!
-//! Every constraint is a 2×2 LMI, solved exactly by `lmi.rs`.
+//! Every constraint is a 2×2 LMI, a second-order cone (`lmi.rs`). The
+//! solution is then certified independently of the solver: P ≻ 0,
+//! λ_max(AᵀP + PA + αP) ≤ 1e-7·λ_max(P)·α, and every X₀ inside D where the
+//! switching needs it; otherwise the design is refused.
+//!
+//! The scale of P does not change D, but it is part of the law: its coupling
+//! term (2/m)·(PZ)₂ [SB 18] reads P as normalised here (P ⪰ I).
 
 use super::lmi::{eigenvalues, Lmi2, Sdp2, SdpOutcome, Sym2};
 
@@ -77,16 +84,21 @@ pub enum RegionError {
     )]
     DecayTooFast { decay: f64, limit: f64 },
     #[error(
-        "no quadratic V with decay α = {decay} s⁻¹ has the spring's rest (z = {rest:e} m, v = 0) \
-         inside its region F_d ≥ 0 for the target {position:e} m (the LMI program is infeasible): \
-         the switching strategies cannot reach the region; lower `controller.decay`, change the \
-         gains, move the target towards the rest, or use `switching = \"none\"`"
+        "no quadratic V = ZᵀPZ with decay α = {decay} s⁻¹ has the spring's rest (z = {rest:e} m, \
+         v = 0) inside its region F_d ≥ 0 {which} (the LMI program is infeasible): the \
+         switching strategies cannot reach the region; change the gains (a stiffer mechanical \
+         loop α₁·α₂), move the target towards the rest, lower `controller.decay`, or use \
+         `switching = \"none\"`"
     )]
     RestOutside {
         decay: f64,
         rest: f64,
-        position: f64,
+        which: String,
     },
+    #[error("the LMI solution is not certified: {0}")]
+    Uncertified(String),
+    /// (`design_region`'s own check of its input: a design refuses such a
+    /// target before, as one that cannot be held.)
     #[error("the target {position:e} m needs a pushing force (F_d = {force:e} N at rest there): the magnet only attracts")]
     Pushing { position: f64, force: f64 },
     #[error("the LMI solver failed: {0}")]
@@ -225,17 +237,16 @@ pub fn design_region(
                 extended = true;
             }
             None if need_rest => {
-                let outside = targets.iter().find(|t| !level(paper, k, t).contains_rest);
                 return Err(RegionError::RestOutside {
                     decay,
-                    rest: outside.map_or(f64::NAN, |t| t.position + t.rest[0]),
-                    position: outside.map_or(f64::NAN, |t| t.position),
+                    rest: targets.first().map_or(f64::NAN, |t| t.position + t.rest[0]),
+                    which: culprit(a, decay, k, &targets)?,
                 });
             }
             None => {}
         }
     }
-    Ok(Region {
+    let region = Region {
         a,
         decay,
         force_gradient: k,
@@ -244,12 +255,56 @@ pub fn design_region(
         identity: levels([0.5, 0.0, 0.5]),
         extended,
         targets,
-    })
+    };
+    region.certify(need_rest)?;
+    Ok(region)
 }
 
+/// Which target's rest no P can hold: the first that is infeasible alone, or
+/// all of them together.
+fn culprit(
+    a: [[f64; 2]; 2],
+    decay: f64,
+    k: [f64; 2],
+    targets: &[Target],
+) -> Result<String, RegionError> {
+    for t in targets {
+        let alone = vec![decay_lmi(a, decay), scale_lmi(), rest_lmi(k, t)];
+        if min_trace(alone)?.is_none() {
+            return Ok(format!("for the target {:e} m", t.position));
+        }
+    }
+    Ok("for both targets at once (each alone has one: one P must serve both)".to_string())
+}
+
+/// Relative tolerance of the certificate's eigenvalue checks.
+const CERTIFICATE_TOLERANCE: f64 = 1e-7;
+
 impl Region {
-    /// The certificate checked by eigenvalues: P ≻ 0 and AᵀP + PA + αP ⪯ 0
-    /// within `tolerance` (relative to ‖P‖); the largest violation.
+    /// The solution checked independently of the solver (module docs).
+    fn certify(&self, need_rest: bool) -> Result<(), RegionError> {
+        let (p, lyap) = self.certificate();
+        if !(p[0] > 0.0) {
+            return Err(RegionError::Uncertified(format!(
+                "P's eigenvalues {p:?} are not > 0"
+            )));
+        }
+        if !(lyap[1] <= CERTIFICATE_TOLERANCE * p[1] * self.decay.max(1.0)) {
+            return Err(RegionError::Uncertified(format!(
+                "AᵀP + PA + αP has the eigenvalue {:e} > 0",
+                lyap[1]
+            )));
+        }
+        if need_rest && self.levels.iter().any(|l| !l.contains_rest) {
+            return Err(RegionError::Uncertified(
+                "the spring's rest lies outside a target's region".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The eigenvalues (smaller first) of P and of AᵀP + PA + αP: P ≻ 0 and
+    /// the second ⪯ 0 make V = ZᵀPZ decay at α.
     pub fn certificate(&self) -> ([f64; 2], [f64; 2]) {
         let lyap = BASIS
             .iter()

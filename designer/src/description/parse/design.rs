@@ -138,6 +138,13 @@ fn parse_backstepping(s: &Sect) -> Res<BacksteppingKeys> {
     let reference = match (position, square) {
         (Some(z), None) => SetPoint::Position(z),
         (None, Some([low, high, period])) => {
+            if !(period > 0.0) {
+                let msg = format!(
+                    "expected a period > 0 [s] in controller.square = [z_low, z_high, period], \
+                     found {period}"
+                );
+                return Err(s.err("square", msg, "needs a positive period"));
+            }
             if low >= high {
                 let msg = format!(
                     "expected z_low < z_high in controller.square = [z_low, z_high, period], \
