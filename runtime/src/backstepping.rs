@@ -190,7 +190,9 @@ impl<B: Backstepping<T>, T: Scalar> SwitchedBackstepping<B, T> {
         self.mode
     }
 
-    /// The target at `t` (y_r and C); a change of y_r restarts the switching.
+    /// The target at `t` (y_r and C). It advances the square reference: a
+    /// change of y_r restarts the switching, as [`SwitchedBackstepping::step`]
+    /// (which calls it) does; call it with the times `step` sees.
     pub fn target(&mut self, t: T) -> Target<T> {
         match self.plan.settings().reference {
             SetPoint::Position(target) => target,
