@@ -8,6 +8,13 @@
 //! plots `<DATA>.current.svg`, `<DATA>.residual.svg`, `<DATA>.loop.svg`,
 //! next to the data or in `--out DIR`. With `--json`, stdout carries exactly
 //! one JSON object; otherwise a readable report.
+//!
+//! `reldesign diagnose MODEL.toml --batch DIR [--out DIR]`: every `*.csv` of
+//! DIR (one unit each, the same model), diagnosed in parallel across records
+//! (rayon); per record its files as above and one JSON line on stdout, in
+//! file-name order (`"file"` added; a record that cannot be read or
+//! diagnosed gives `{"file", "error"}` and the others go on); progress and a
+//! summary table per cause on stderr; exit status 1 when any record failed.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -27,7 +34,12 @@ pub struct Args {
     /// The actuator description (valve.toml)
     model: PathBuf,
     /// The recording: CSV with columns t, v, i and optionally z, phi, lambda
-    data: PathBuf,
+    #[arg(required_unless_present = "batch", conflicts_with = "batch")]
+    data: Option<PathBuf>,
+    /// Diagnose every *.csv of this directory (one unit each, the same model): one JSON
+    /// line per record on stdout, in file-name order; progress and a summary on stderr
+    #[arg(long)]
+    batch: Option<PathBuf>,
     /// Print one JSON object on stdout (the spec's fields and more)
     #[arg(long)]
     json: bool,
@@ -51,17 +63,12 @@ struct Outputs {
 }
 
 impl Outputs {
-    fn new(args: &Args) -> Outputs {
-        let dir = match &args.out {
-            Some(dir) => dir.clone(),
-            None => args
-                .data
-                .parent()
-                .map(Path::to_path_buf)
-                .unwrap_or_default(),
+    fn new(out: Option<&Path>, data: &Path) -> Outputs {
+        let dir = match out {
+            Some(dir) => dir.to_path_buf(),
+            None => data.parent().map(Path::to_path_buf).unwrap_or_default(),
         };
-        let stem = args
-            .data
+        let stem = data
             .file_stem()
             .map_or_else(|| "data".to_owned(), |s| s.to_string_lossy().into_owned());
         let file = |suffix: &str| dir.join(format!("{stem}.{suffix}"));
@@ -82,7 +89,6 @@ pub fn run(args: &Args) -> Result<(), Report> {
         )));
     }
     let description = crate::load(&args.model)?;
-    let data = Measured::read(&args.data).map_err(fail)?;
     let mut options = Options {
         holdout: args.holdout,
         ..Options::default()
@@ -90,12 +96,48 @@ pub fn run(args: &Args) -> Result<(), Report> {
     if !args.causes.is_empty() {
         options.causes = args.causes.clone();
     }
-    let d = diagnose(&description, &data, &options).map_err(fail)?;
-    let localisation = localisation(&d, &data);
+    if let Some(dir) = &args.batch {
+        return batch(&description, dir, args.out.as_deref(), &options);
+    }
+    let Some(data_path) = &args.data else {
+        return Err(fail("diagnose needs DATA.csv or --batch DIR"));
+    };
+    let data = Measured::read(data_path).map_err(fail)?;
+    let one = diagnose_one(
+        &description,
+        &data,
+        args.out.as_deref(),
+        data_path,
+        &options,
+    )?;
+    if args.json {
+        println!("{}", one.json);
+    } else {
+        print!("{}", one.text);
+    }
+    Ok(())
+}
 
-    let outputs = Outputs::new(args);
-    let toml = extended_toml(&description, &d)?;
-    let plots = plots(&d, &data, &localisation, &description)?;
+/// One record's diagnosis: its files written, its JSON and its report.
+struct One {
+    json: Value,
+    text: String,
+    cause: Cause,
+    gain: f64,
+}
+
+fn diagnose_one(
+    description: &Description,
+    data: &Measured,
+    out: Option<&Path>,
+    data_path: &Path,
+    options: &Options,
+) -> Result<One, Report> {
+    let d = diagnose(description, data, options).map_err(fail)?;
+    let localisation = localisation(&d, data);
+    let outputs = Outputs::new(out, data_path);
+    let toml = extended_toml(description, &d)?;
+    let plots = plots(&d, data, &localisation, description)?;
     crate::atomic::write_all(&[
         (&outputs.extended, toml.as_bytes()),
         (&outputs.current, plots[0].as_bytes()),
@@ -103,17 +145,113 @@ pub fn run(args: &Args) -> Result<(), Report> {
         (&outputs.flux_loop, plots[2].as_bytes()),
     ])
     .map_err(fail)?;
+    let parameters = d.parameters(description, data);
+    Ok(One {
+        json: json_report(&d, &outputs, &localisation, &parameters),
+        text: text_report(
+            &description.source.file_name,
+            data_path,
+            data,
+            &d,
+            &localisation,
+            &outputs,
+            &parameters,
+        ),
+        cause: d.cause,
+        gain: d.whole.gain,
+    })
+}
 
-    let parameters = d.parameters(&description, &data);
-    if args.json {
-        println!("{}", json_report(&d, &outputs, &localisation, &parameters));
-    } else {
-        print!(
-            "{}",
-            text_report(args, &data, &d, &localisation, &outputs, &parameters)
-        );
+/// `--batch DIR`: every record of DIR, in parallel (module docs).
+fn batch(
+    description: &Description,
+    dir: &Path,
+    out: Option<&Path>,
+    options: &Options,
+) -> Result<(), Report> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| fail(format!("--batch {}: {e}", dir.display())))?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        return Err(fail(format!(
+            "--batch {}: no *.csv record in the directory",
+            dir.display()
+        )));
+    }
+    let done = AtomicUsize::new(0);
+    let total = files.len();
+    let results: Vec<Result<One, String>> = files
+        .par_iter()
+        .map(|path| {
+            let one = Measured::read(path)
+                .map_err(|e| e.to_string())
+                .and_then(|data| {
+                    diagnose_one(description, &data, out, path, options).map_err(|e| e.to_string())
+                });
+            let k = done.fetch_add(1, Ordering::Relaxed) + 1;
+            let what = match &one {
+                Ok(o) => format!("{} (gain {})", o.cause.name(), percent(o.gain)),
+                Err(_) => "failed".to_owned(),
+            };
+            eprintln!("[{k}/{total}] {}: {what}", path.display());
+            one
+        })
+        .collect();
+    let mut failed = 0;
+    let mut by_cause: Vec<(String, usize, f64)> = Vec::new();
+    for (path, result) in files.iter().zip(&results) {
+        let file = path.display().to_string();
+        match result {
+            Ok(one) => {
+                let mut line = one.json.clone();
+                if let Some(map) = line.as_object_mut() {
+                    map.insert("file".into(), json!(file));
+                }
+                println!("{line}");
+                let name = one.cause.name().to_owned();
+                match by_cause.iter_mut().find(|(c, _, _)| *c == name) {
+                    Some(row) => {
+                        row.1 += 1;
+                        row.2 += one.gain;
+                    }
+                    None => by_cause.push((name, 1, one.gain)),
+                }
+            }
+            Err(e) => {
+                failed += 1;
+                println!("{}", json!({"file": file, "error": e}));
+            }
+        }
+    }
+    eprint!("{}", batch_summary(&by_cause, failed, total));
+    if failed > 0 {
+        return Err(fail(format!(
+            "{failed} of {total} records could not be diagnosed (their lines say why)"
+        )));
     }
     Ok(())
+}
+
+/// The batch's summary table: per cause the records and their mean gain.
+fn batch_summary(by_cause: &[(String, usize, f64)], failed: usize, total: usize) -> String {
+    let mut rows = by_cause.to_vec();
+    rows.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    let mut s = format!(
+        "\n{total} records\n  {:<18} {:>7} {:>10}\n",
+        "cause", "records", "mean gain"
+    );
+    for (cause, n, gain) in rows {
+        let _ = writeln!(s, "  {cause:<18} {n:>7} {:>10}", percent(gain / n as f64));
+    }
+    if failed > 0 {
+        let _ = writeln!(s, "  {:<18} {failed:>7}", "(failed)");
+    }
+    s
 }
 
 /// The winner written over the original text, comments kept.
@@ -223,7 +361,8 @@ fn percent(x: f64) -> String {
 }
 
 fn text_report(
-    args: &Args,
+    model: &str,
+    data_path: &Path,
     data: &Measured,
     d: &Diagnosis,
     loc: &Localisation,
@@ -235,8 +374,8 @@ fn text_report(
     let _ = writeln!(
         s,
         "diagnose {} against {} ({n} samples, Δ = {:e} s)",
-        args.model.display(),
-        args.data.display(),
+        model,
+        data_path.display(),
         data.dt
     );
     let _ = writeln!(

@@ -348,3 +348,90 @@ fn bad_options_are_rejected() {
     names.push("none");
     rejected_without_output(model, data, &["--causes", "saturation,eddy"], &names);
 }
+
+// ---------------------------------------------------------------------------
+// --batch: a production line's records
+// ---------------------------------------------------------------------------
+
+/// `--batch DIR`: one JSON line per record in file-name order, each the
+/// single-record diagnosis plus `"file"`; a broken record gives an error
+/// line naming it while the others are diagnosed; the files of each record
+/// go to `--out`; a summary per cause on stderr; exit status 1 for the
+/// broken one.
+#[test]
+fn batch_diagnoses_every_record_and_reports_the_broken_one() {
+    let dir = TempDir::new("batch");
+    let eddy = semera_case(Cause::EddyCurrents, 31);
+    let none = semera_case(Cause::None, 32);
+    let records = dir.path().join("records");
+    std::fs::create_dir_all(&records).unwrap();
+    let (model, _) = write_case(&dir.path().join("model"), &eddy);
+    std::fs::write(records.join("unit-1.csv"), &eddy.data_csv).unwrap();
+    std::fs::write(records.join("unit-2.csv"), &none.data_csv).unwrap();
+    let broken = set_field(&none.data_csv, 5, 1, "x");
+    std::fs::write(records.join("unit-3.csv"), broken).unwrap();
+    std::fs::write(records.join("notes.txt"), "not a record").unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let run = rd!(
+        "diagnose",
+        model,
+        "--batch",
+        records,
+        "--out",
+        out,
+        "--causes",
+        QUICK_CAUSES
+    );
+    assert!(
+        !run.succeeded(),
+        "a broken record fails the batch: {}",
+        run.context()
+    );
+    let lines: Vec<Value> = run
+        .stdout()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}")))
+        .collect();
+    assert_eq!(lines.len(), 3, "{}", run.context());
+    let file = |v: &Value| v["file"].as_str().unwrap_or_default().to_owned();
+    assert!(file(&lines[0]).ends_with("unit-1.csv") && file(&lines[2]).ends_with("unit-3.csv"));
+    assert_eq!(lines[0]["cause"], "eddy-currents", "{}", run.context());
+    assert_eq!(lines[1]["cause"], "none", "{}", run.context());
+    let error = lines[2]["error"].as_str().unwrap_or_default();
+    assert!(
+        error.contains("unit-3.csv:5:") && error.contains("column `v`"),
+        "{error}"
+    );
+    // the same answer as the record diagnosed alone
+    let alone = dir.path().join("alone");
+    std::fs::create_dir_all(&alone).unwrap();
+    let single = rd!(
+        "diagnose",
+        model,
+        records.join("unit-1.csv"),
+        "--json",
+        "--out",
+        alone,
+        "--causes",
+        QUICK_CAUSES
+    );
+    let single = one_object(&single.ok());
+    for key in [
+        "cause",
+        "baseline_wnrmse",
+        "extended_wnrmse",
+        "gain",
+        "parameters",
+    ] {
+        assert_eq!(lines[0][key], single[key], "{key}");
+    }
+    for stem in ["unit-1", "unit-2"] {
+        assert_outputs(&out, stem);
+    }
+    let stderr = run.context();
+    assert!(
+        stderr.contains("[3/3]") && stderr.contains("mean gain") && stderr.contains("(failed)"),
+        "{stderr}"
+    );
+}
