@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use designer::description::Description;
 use miette::Report;
 use reldesign_identify::diagnose::localise::{localise, Localisation, Signals};
-use reldesign_identify::diagnose::{diagnose, Cause, Diagnosis, FittedParameter, Options};
+use reldesign_identify::diagnose::{diagnose_causes, Cause, Diagnosis, FittedParameter, Options};
 use reldesign_identify::edit::{annotate, write_physics};
 use reldesign_identify::{flux_from_data, Measured, SimOutputs};
 use serde_json::{json, Value};
@@ -133,11 +133,14 @@ fn diagnose_one(
     data_path: &Path,
     options: &Options,
 ) -> Result<One, Report> {
-    let d = diagnose(description, data, options).map_err(fail)?;
-    let localisation = localisation(&d, data);
+    let steps = diagnose_causes(description, data, options).map_err(fail)?;
+    let (Some(first), Some(d)) = (steps.first(), steps.last()) else {
+        return Err(fail("internal error: a diagnosis without a step"));
+    };
+    let localisation = localisation(d, data);
     let outputs = Outputs::new(out, data_path);
-    let toml = extended_toml(description, &d)?;
-    let plots = plots(&d, data, &localisation, description)?;
+    let toml = extended_toml(description, d)?;
+    let plots = plots(d, data, &localisation, description)?;
     crate::atomic::write_all(&[
         (&outputs.extended, toml.as_bytes()),
         (&outputs.current, plots[0].as_bytes()),
@@ -145,20 +148,90 @@ fn diagnose_one(
         (&outputs.flux_loop, plots[2].as_bytes()),
     ])
     .map_err(fail)?;
-    let parameters = d.parameters(description, data);
+    // every step's fitted values against the original description, a later
+    // step's refit (the resistance) replacing an earlier one's
+    let mut parameters: Vec<FittedParameter> = Vec::new();
+    for step in &steps {
+        for p in step.parameters(description, data) {
+            parameters.retain(|q| q.path != p.path);
+            parameters.push(p);
+        }
+    }
+    let mut json = json_report(d, &outputs, &localisation, &parameters);
+    let overall = overall_gain(first, d);
+    if let Some(map) = json.as_object_mut() {
+        map.insert("cause".into(), json!(first.cause.name()));
+        map.insert("causes".into(), json!(causes(&steps)));
+        map.insert("baseline_wnrmse".into(), json!(first.whole.baseline_wnrmse));
+        map.insert("gain".into(), json!(overall));
+        map.insert(
+            "steps".into(),
+            json!(steps.iter().map(step_json).collect::<Vec<_>>()),
+        );
+    }
+    let mut text = text_report(
+        &description.source.file_name,
+        data_path,
+        data,
+        d,
+        &localisation,
+        &outputs,
+        &parameters,
+    );
+    if steps.len() > 1 {
+        let _ = writeln!(
+            text,
+            "\nseveral causes, strongest first (each fitted on top of the ones before):"
+        );
+        for step in &steps {
+            let _ = writeln!(
+                text,
+                "  {:<18} wNRMSE {} → {} (gain {})",
+                step.cause.name(),
+                percent(step.whole.baseline_wnrmse),
+                percent(step.whole.extended_wnrmse),
+                percent(step.whole.gain)
+            );
+        }
+        let _ = writeln!(
+            text,
+            "  all together: gain {} on the whole record",
+            percent(overall)
+        );
+    }
     Ok(One {
-        json: json_report(&d, &outputs, &localisation, &parameters),
-        text: text_report(
-            &description.source.file_name,
-            data_path,
-            data,
-            &d,
-            &localisation,
-            &outputs,
-            &parameters,
-        ),
-        cause: d.cause,
-        gain: d.whole.gain,
+        json,
+        text,
+        cause: first.cause,
+        gain: overall,
+    })
+}
+
+/// The named causes, strongest first (`["none"]` when there is none).
+fn causes(steps: &[Diagnosis]) -> Vec<&'static str> {
+    steps.iter().map(|s| s.cause.name()).collect()
+}
+
+/// 1 − (the last step's error)/(the original baseline's), on the whole record.
+fn overall_gain(first: &Diagnosis, last: &Diagnosis) -> f64 {
+    let base = first.whole.baseline_wnrmse;
+    if base > 0.0 {
+        1.0 - last.whole.extended_wnrmse / base
+    } else {
+        0.0
+    }
+}
+
+/// One step of the forward selection: its cause and its gain over the model
+/// before it.
+fn step_json(step: &Diagnosis) -> Value {
+    json!({
+        "cause": step.cause.name(),
+        "baseline_wnrmse": step.whole.baseline_wnrmse,
+        "extended_wnrmse": step.whole.extended_wnrmse,
+        "gain": step.whole.gain,
+        "held_out_gain": step.held_out.map(|h| h.gain),
+        "noise_floor": step.noise_floor,
     })
 }
 

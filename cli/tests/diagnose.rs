@@ -435,3 +435,98 @@ fn batch_diagnoses_every_record_and_reports_the_broken_one() {
         "{stderr}"
     );
 }
+
+// ---------------------------------------------------------------------------
+// several causes at once (forward selection)
+// ---------------------------------------------------------------------------
+
+/// Two hidden effects at once, on two actuators, with and without `z`: both
+/// are named (`causes`, strongest first, `cause` its first), each step gains
+/// at least `MIN_STEP_GAIN` over the model before it, the extended model
+/// carries both, and `gain` is the whole selection's. A single effect stays
+/// single (no cause is added on a model at the noise). Seeds apart from the
+/// ones the step gate was chosen on.
+#[test]
+fn several_causes_are_named_strongest_first() {
+    use reldesign_identify::diagnose::MIN_STEP_GAIN;
+    use reldesign_tests::hidden::hidden_pair;
+    let cases = [
+        (
+            EXAMPLE,
+            false,
+            [Cause::EddyCurrents, Cause::ResistanceDrift],
+            71,
+        ),
+        (
+            EXAMPLE,
+            false,
+            [Cause::Saturation, Cause::ResistanceDrift],
+            72,
+        ),
+        (
+            "perfect-tracking-valve.toml",
+            true,
+            [Cause::Saturation, Cause::Bouncing],
+            73,
+        ),
+        (
+            "perfect-tracking-valve.toml",
+            true,
+            [Cause::Fringing, Cause::EddyCurrents],
+            74,
+        ),
+    ];
+    for (example, with_z, pair, seed) in cases {
+        let text = std::fs::read_to_string(example_path(example)).unwrap();
+        let desc = parse_str(&text, example).unwrap_or_else(|e| panic!("{e}"));
+        let excitation = Excitation::square_wave(&baseline(&desc));
+        let case = hidden_pair(example, pair, &excitation, with_z, seed);
+        let dir = TempDir::new("pair");
+        let (model, data) = write_case(dir.path(), &case);
+        let r = rd!("diagnose", model, data, "--json", "--causes", QUICK_CAUSES);
+        let m = one_object(&r.ok());
+        let named: Vec<&str> = m["causes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(Value::as_str)
+            .collect();
+        let mut want: Vec<&str> = pair.iter().map(|c| c.name()).collect();
+        let mut got = named.clone();
+        want.sort_unstable();
+        got.sort_unstable();
+        assert_eq!(
+            got,
+            want,
+            "{example} (z: {with_z}) {pair:?}: {}",
+            r.context()
+        );
+        assert_eq!(m["cause"].as_str(), named.first().copied());
+        let steps = m["steps"].as_array().unwrap();
+        assert_eq!(steps.len(), 2);
+        for step in steps {
+            assert!(step["gain"].as_f64().unwrap() >= MIN_STEP_GAIN, "{step}");
+        }
+        let overall = number(&m, "gain");
+        assert!(overall >= steps[0]["gain"].as_f64().unwrap(), "{overall}");
+        let extended = checked_model(&PathBuf::from(m["extended_model"].as_str().unwrap()));
+        for cause in pair {
+            let has = match cause {
+                Cause::EddyCurrents => extended.coil.eddy > 0.0,
+                Cause::ResistanceDrift => extended.coil.resistance_drift != 0.0,
+                Cause::Saturation => matches!(extended.core, Core::Saturating { .. }),
+                Cause::Bouncing => extended.mechanics.restitution > 0.0,
+                Cause::Fringing => {
+                    !matches!(extended.gap, designer::description::Gap::Linear { .. })
+                }
+                _ => true,
+            };
+            assert!(has, "{pair:?}: the extended model lacks {cause:?}");
+        }
+    }
+    let single = semera_case(Cause::EddyCurrents, 75);
+    let dir = TempDir::new("single");
+    let (model, data) = write_case(dir.path(), &single);
+    let m = one_object(&rd!("diagnose", model, data, "--json", "--causes", QUICK_CAUSES).ok());
+    assert_eq!(m["causes"], serde_json::json!(["eddy-currents"]));
+}

@@ -734,6 +734,42 @@ pub fn hidden_case_of(
     }
 }
 
+/// [`hidden_case`] with two effects at once (issue 17 §1): `causes[0]`'s
+/// extension drawn on the baseline, then `causes[1]`'s on top of it; the
+/// case's `cause` is the first, `drawn` holds both draws.
+pub fn hidden_pair(
+    example_file: &str,
+    causes: [Cause; 2],
+    excitation: &Excitation,
+    with_z: bool,
+    seed: u64,
+) -> HiddenCase {
+    let path = example_path(example_file);
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: cannot read: {e}", path.display()));
+    let text = &without_design_sections(&text);
+    let desc = parse_str(text, example_file).unwrap_or_else(|e| panic!("{e}"));
+    let base = baseline(&desc);
+    let baseline_toml = write_physics(text, example_file, &base)
+        .unwrap_or_else(|e| panic!("writing the baseline: {e}"));
+    let mut rng = Rng::new(seed);
+    let (first, mut drawn) = with_effect_for(&base, causes[0], excitation, &mut rng);
+    let (truth, second) = with_effect_for(&first, causes[1], excitation, &mut rng);
+    drawn.extend(second);
+    let sampling = Sampling::daq(&mut rng);
+    let noise = Noise::for_device(&base, excitation);
+    let data_csv = experiment(&truth, excitation, sampling, noise, with_z, &mut rng);
+    HiddenCase {
+        baseline_toml,
+        data_csv,
+        cause: causes[0],
+        drawn,
+        truth,
+        sampling,
+        excitation: *excitation,
+    }
+}
+
 /// Writes `baseline.toml` and `data.csv` into `dir` (created if needed).
 pub fn write_case(dir: &Path, case: &HiddenCase) -> (PathBuf, PathBuf) {
     std::fs::create_dir_all(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
