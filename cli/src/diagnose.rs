@@ -140,7 +140,8 @@ fn diagnose_one(
     let localisation = localisation(d, data);
     let outputs = Outputs::new(out, data_path);
     let toml = extended_toml(description, d)?;
-    let plots = plots(d, data, &localisation, description)?;
+    let named = causes(&steps).join(" + ");
+    let plots = plots(d, first, &named, data, &localisation, description)?;
     crate::atomic::write_all(&[
         (&outputs.extended, toml.as_bytes()),
         (&outputs.current, plots[0].as_bytes()),
@@ -179,25 +180,7 @@ fn diagnose_one(
         &parameters,
     );
     if steps.len() > 1 {
-        let _ = writeln!(
-            text,
-            "\nseveral causes, strongest first (each fitted on top of the ones before):"
-        );
-        for step in &steps {
-            let _ = writeln!(
-                text,
-                "  {:<18} wNRMSE {} → {} (gain {})",
-                step.cause.name(),
-                percent(step.whole.baseline_wnrmse),
-                percent(step.whole.extended_wnrmse),
-                percent(step.whole.gain)
-            );
-        }
-        let _ = writeln!(
-            text,
-            "  all together: gain {} on the whole record",
-            percent(overall)
-        );
+        text = format!("{}{text}", steps_text(&steps, overall));
     }
     Ok(One {
         json,
@@ -205,6 +188,37 @@ fn diagnose_one(
         cause: first.cause,
         gain: overall,
     })
+}
+
+/// The head of a report with several causes: the causes, each step's gain,
+/// the whole selection's; the last step's report follows in detail.
+fn steps_text(steps: &[Diagnosis], overall: f64) -> String {
+    let mut s = format!(
+        "causes: {} (strongest first; each fitted on top of the ones before)\n",
+        causes(steps).join(", ")
+    );
+    for (k, step) in steps.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "  {}. {:<18} wNRMSE {} → {} on the whole record (gain {})",
+            k + 1,
+            step.cause.name(),
+            percent(step.whole.baseline_wnrmse),
+            percent(step.whole.extended_wnrmse),
+            percent(step.whole.gain)
+        );
+    }
+    if let (Some(first), Some(last)) = (steps.first(), steps.last()) {
+        let _ = writeln!(
+            s,
+            "  together: {} → {} (gain {}); the extended model holds every cause\n\nthe last step ({}), in detail:",
+            percent(first.whole.baseline_wnrmse),
+            percent(last.whole.extended_wnrmse),
+            percent(overall),
+            last.cause.name()
+        );
+    }
+    s
 }
 
 /// The named causes, strongest first (`["none"]` when there is none).
@@ -373,21 +387,26 @@ fn localisation(d: &Diagnosis, data: &Measured) -> Localisation {
 }
 
 /// The three plots: measured vs simulated, residual, λ–i loop.
+/// The three plots of the last step `d`; the comparison shows the original
+/// baseline (`first`'s) against the model with every cause (`causes`).
 fn plots(
     d: &Diagnosis,
+    first: &Diagnosis,
+    causes: &str,
     data: &Measured,
     localisation: &Localisation,
     description: &Description,
 ) -> Result<[String; 3], Report> {
     let base = &d.baseline_replay;
     let ext = &d.extended_replay;
+    let original = &first.baseline_replay;
     let mut measured: Vec<(&str, &[f64])> = vec![("current i [A]", &data.i)];
-    let mut simulated: Vec<(&str, &[f64])> = vec![("current i [A]", &base.current)];
-    let extended_label = format!("current i [A], extended ({})", d.cause);
+    let mut simulated: Vec<(&str, &[f64])> = vec![("current i [A]", &original.current)];
+    let extended_label = format!("current i [A], extended ({causes})");
     simulated.push((&extended_label, &ext.current));
     if let Some(z) = &data.z {
         measured.push(("position z [m]", z));
-        simulated.push(("position z [m]", &base.z));
+        simulated.push(("position z [m]", &original.z));
     }
     let title = format!("{}: measured vs simulated", data.file_name);
     let comparison =
@@ -404,13 +423,16 @@ fn plots(
         .iter()
         .map(|(a, b, l)| (*a, *b, l.as_str()))
         .collect();
-    let residual_svg = diagnose_plot::residual_svg(
-        "current residual (baseline − measured)",
-        &data.t,
-        &residual,
-        &marked,
-    )
-    .map_err(fail)?;
+    let residual_title = if std::ptr::eq(d, first) {
+        "current residual (baseline − measured)".to_string()
+    } else {
+        format!(
+            "current residual before the last cause, {} (model − measured)",
+            d.cause
+        )
+    };
+    let residual_svg =
+        diagnose_plot::residual_svg(&residual_title, &data.t, &residual, &marked).map_err(fail)?;
 
     let turns = description.coil.turns;
     let lambda_data: Vec<f64> = flux_from_data(data, turns, description.coil.resistance)
