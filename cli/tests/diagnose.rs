@@ -524,6 +524,32 @@ fn several_causes_are_named_strongest_first() {
             assert!(has, "{pair:?}: the extended model lacks {cause:?}");
         }
     }
+    // the text report leads with the causes and each step
+    let case = hidden_pair(
+        EXAMPLE,
+        [Cause::EddyCurrents, Cause::ResistanceDrift],
+        &Excitation::square_wave(&baseline(
+            &parse_str(
+                &std::fs::read_to_string(example_path(EXAMPLE)).unwrap(),
+                EXAMPLE,
+            )
+            .unwrap(),
+        )),
+        false,
+        71,
+    );
+    let dir = TempDir::new("pair-text");
+    let (model, data) = write_case(dir.path(), &case);
+    let text = rd!("diagnose", model, data, "--causes", QUICK_CAUSES).ok();
+    assert!(
+        text.starts_with("causes: eddy-currents, resistance-drift")
+            || text.starts_with("causes: resistance-drift, eddy-currents"),
+        "{text}"
+    );
+    assert!(
+        text.contains("  2. ") && text.contains("together: ") && text.contains("the last step"),
+        "{text}"
+    );
     let single = semera_case(Cause::EddyCurrents, 75);
     let dir = TempDir::new("single");
     let (model, data) = write_case(dir.path(), &single);
