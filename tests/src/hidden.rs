@@ -711,6 +711,19 @@ pub fn hidden_case_of(
     with_z: bool,
     seed: u64,
 ) -> HiddenCase {
+    case_of(text, file_name, &[cause], excitation, with_z, seed)
+}
+
+/// The case with the extensions `causes` drawn one on top of the other (the
+/// first is the case's `cause`).
+fn case_of(
+    text: &str,
+    file_name: &str,
+    causes: &[Cause],
+    excitation: &Excitation,
+    with_z: bool,
+    seed: u64,
+) -> HiddenCase {
     // a bench recording needs no controller; the truth (a Jiles–Atherton core,
     // say) may not admit the design's [trajectory]
     let text = &without_design_sections(text);
@@ -719,14 +732,20 @@ pub fn hidden_case_of(
     let baseline_toml = write_physics(text, file_name, &base)
         .unwrap_or_else(|e| panic!("writing the baseline: {e}"));
     let mut rng = Rng::new(seed);
-    let (truth, drawn) = with_effect_for(&base, cause, excitation, &mut rng);
+    let mut truth = base.clone();
+    let mut drawn = Vec::new();
+    for &cause in causes {
+        let (next, values) = with_effect_for(&truth, cause, excitation, &mut rng);
+        truth = next;
+        drawn.extend(values);
+    }
     let sampling = Sampling::daq(&mut rng);
     let noise = Noise::for_device(&base, excitation);
     let data_csv = experiment(&truth, excitation, sampling, noise, with_z, &mut rng);
     HiddenCase {
         baseline_toml,
         data_csv,
-        cause,
+        cause: causes.first().copied().unwrap_or(Cause::None),
         drawn,
         truth,
         sampling,
@@ -747,27 +766,7 @@ pub fn hidden_pair(
     let path = example_path(example_file);
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("{}: cannot read: {e}", path.display()));
-    let text = &without_design_sections(&text);
-    let desc = parse_str(text, example_file).unwrap_or_else(|e| panic!("{e}"));
-    let base = baseline(&desc);
-    let baseline_toml = write_physics(text, example_file, &base)
-        .unwrap_or_else(|e| panic!("writing the baseline: {e}"));
-    let mut rng = Rng::new(seed);
-    let (first, mut drawn) = with_effect_for(&base, causes[0], excitation, &mut rng);
-    let (truth, second) = with_effect_for(&first, causes[1], excitation, &mut rng);
-    drawn.extend(second);
-    let sampling = Sampling::daq(&mut rng);
-    let noise = Noise::for_device(&base, excitation);
-    let data_csv = experiment(&truth, excitation, sampling, noise, with_z, &mut rng);
-    HiddenCase {
-        baseline_toml,
-        data_csv,
-        cause: causes[0],
-        drawn,
-        truth,
-        sampling,
-        excitation: *excitation,
-    }
+    case_of(&text, example_file, &causes, excitation, with_z, seed)
 }
 
 /// Writes `baseline.toml` and `data.csv` into `dir` (created if needed).
