@@ -8,7 +8,8 @@
 //! the baseline stands clear of the noise floor (current noise, and the
 //! voltage noise the replay passes on). The record's voltage edges are
 //! placed once by the baseline (`crate::edges`); the named cause is then
-//! polished on its own placement ([`polish`]).
+//! polished on its own placement ([`polish`]). [`diagnose_causes`] names
+//! a second cause by forward selection on top of the first.
 //!
 //! Only the two inputs are read: the description and the recording.
 
@@ -427,11 +428,11 @@ pub const MIN_STEP_GAIN: f64 = 0.2;
 /// [`diagnose`] names it, then the remaining candidates fitted again on top
 /// of its extended model (the same gates: the complexity penalty, the noise
 /// floor, the held-out end) and kept if it removes at least [`MIN_STEP_GAIN`]
-/// of the remaining error, and so on up to [`MOST_CAUSES`]. One step per named cause, strongest first; a single step
-/// when the first answer is `none` or its model already explains the record
-/// within the noise floor (no further fit is tried then). Causes that replace
-/// the same part of the model (a saturating and a Jiles–Atherton core) are not
-/// stacked.
+/// of the remaining error, and so on up to [`MOST_CAUSES`]. One step per
+/// named cause, strongest first; a single step when the first answer is
+/// `none` or its model already explains the record within the noise floor
+/// (no further fit is tried then). Causes that replace the same part of the
+/// model (a saturating and a Jiles–Atherton core) are not stacked.
 pub fn diagnose_causes(
     baseline: &Description,
     data: &Measured,
