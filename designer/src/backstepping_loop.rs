@@ -66,10 +66,9 @@ pub fn run_backstepping(
     check_plant(design, &plant_model)?;
     let model_plant = ModelPlant::new(&mut plant_model);
     let mut design_model = design.model.clone();
-    let runtime = RuntimeBackstepping::new(&mut design_model, b);
     let mut controller = RuntimeBackstepping::new(&mut design_model, b).controller();
     let mut sensing = Sensing::new(design, &model_plant, sample_period, noise, false)?;
-    let settings = runtime.settings();
+    let settings = controller.plan().settings();
     let mut z_ref = Vec::new();
     let (mut modes, mut inside, mut desired, mut lyapunov) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -82,8 +81,8 @@ pub fn run_backstepping(
         modes.push(controller.mode());
         let mechanical = reldesign_runtime::backstepping::lyapunov(&settings, x[0], x[1], y_r);
         inside.push(mechanical <= target.level);
-        desired.push(runtime.desired_force(x[0], x[1], y_r));
-        lyapunov.push(runtime.lyapunov(x, y_r));
+        desired.push(controller.plan().desired_force(x[0], x[1], y_r));
+        lyapunov.push(controller.plan().lyapunov(x, y_r));
         sensing.held = u;
         u
     };

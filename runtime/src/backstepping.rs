@@ -184,6 +184,12 @@ impl<B: Backstepping<T>, T: Scalar> SwitchedBackstepping<B, T> {
         }
     }
 
+    /// The plan the controller runs (its settings, F_d and law).
+    #[must_use]
+    pub const fn plan(&self) -> &B {
+        &self.plan
+    }
+
     /// The switching state.
     #[must_use]
     pub const fn mode(&self) -> Mode {
