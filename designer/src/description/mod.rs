@@ -125,6 +125,14 @@ pub struct Mechanics {
     pub bounce_threshold: f64,
 }
 
+impl Mechanics {
+    /// The passive force at rest at `z`, F(z, 0) = k_s·z + F0 [PT 10] [N]
+    /// (positive: towards z_min).
+    pub fn passive_at_rest(&self, z: f64) -> f64 {
+        self.stiffness * z + self.preload
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Drive {
     /// Input u is the coil voltage; output is the coil current.

@@ -13,7 +13,7 @@
 //!   F_d = g − kᵀZ, whose g and k are read off the derived F_d (affine,
 //!   checked by `backstepping.rs`); the switching strategies need X₀ ∈ D.
 
-use crate::description::{BacksteppingKeys, Description, SetPoint, Switching};
+use crate::description::{BacksteppingKeys, Description, Mechanics, SetPoint, Switching};
 use crate::model::Model;
 use crate::sym::Id;
 
@@ -104,7 +104,7 @@ pub fn design_backstepping(
         .map(|&z| holding(description, model, &mut rest_flux_squared, z, false))
         .collect::<Result<Vec<_>, _>>()?;
     let [a1, a2, _] = keys.gains;
-    let rest = spring_rest(model, mech.z_min, mech.z_max);
+    let rest = spring_rest(mech);
     let (gradient, targets) = force_half_planes(model, &law, keys.gains, &positions, rest);
     let a = [[-a1, 1.0], [-1.0, -a2]];
     let decay = keys
@@ -154,10 +154,9 @@ fn evaluate(model: &Model, e: Id, values: &[(Id, f64)]) -> f64 {
 
 /// z of X₀: where F_p(z, 0) = 0 within [z_min, z_max], else the stop the
 /// passive force pushes the armature against (v̇ = −F_p/m with no flux).
-fn spring_rest(model: &Model, z_min: f64, z_max: f64) -> f64 {
-    let (z, v) = (model.states[0], model.states[1]);
-    let passive = |zz: f64| evaluate(model, model.passive_force, &[(z, zz), (v, 0.0)]);
-    let (at_min, at_max) = (passive(z_min), passive(z_max));
+fn spring_rest(m: &Mechanics) -> f64 {
+    let (z_min, z_max) = (m.z_min, m.z_max);
+    let (at_min, at_max) = (m.passive_at_rest(z_min), m.passive_at_rest(z_max));
     if at_max < 0.0 {
         z_max
     } else if at_min > 0.0 {
@@ -165,7 +164,7 @@ fn spring_rest(model: &Model, z_min: f64, z_max: f64) -> f64 {
     } else if at_min == at_max {
         z_max
     } else {
-        // F_p is affine in z (checked): its zero
+        // F_p is affine in z: its zero
         z_min + at_min * (z_max - z_min) / (at_min - at_max)
     }
 }

@@ -42,8 +42,8 @@ impl Statics {
         let gap = GapCurve::new(model);
         let d = &model.description;
         let (z_min, z_max) = (d.mechanics.z_min, d.mechanics.z_max);
-        let passive = |z: f64| d.mechanics.stiffness * z + d.mechanics.preload;
-        let (passive_at_max, passive_at_min) = (passive(z_max), passive(z_min));
+        let m = &d.mechanics;
+        let (passive_at_max, passive_at_min) = (m.passive_at_rest(z_max), m.passive_at_rest(z_min));
         let core = CoreCurve(&d.core);
         let point = |z: f64, flux: f64| steady_point(&gap, d, z, flux);
         let pull_in = if passive_at_max > 0.0 {
