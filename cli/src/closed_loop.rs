@@ -131,15 +131,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
             design.model.dim() > 3,
             Some((",switching,lyapunov,desired_force", &extra)),
         );
-        let svg = match &args.plot {
-            Some(_) => Some(plot(&run.run, &description.name, ts).map_err(fail)?),
-            None => None,
-        };
-        let mut files: Vec<(&std::path::Path, &[u8])> = vec![(args.out.as_path(), csv.as_bytes())];
-        if let (Some(path), Some(svg)) = (&args.plot, &svg) {
-            files.push((path.as_path(), svg.as_bytes()));
-        }
-        atomic::write_all(&files).map_err(fail)?;
+        write_outputs(args, &csv, &run.run, &description.name, ts)?;
         print!("{summary}");
         return Ok(());
     }
@@ -165,15 +157,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
     }
     .map_err(|e| fail(format!("{file}: {e}")))?;
     let csv = to_csv(&run, design.model.dim() > 3, None);
-    let svg = match &args.plot {
-        Some(_) => Some(plot(&run, &description.name, ts).map_err(fail)?),
-        None => None,
-    };
-    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(args.out.as_path(), csv.as_bytes())];
-    if let (Some(path), Some(svg)) = (&args.plot, &svg) {
-        files.push((path.as_path(), svg.as_bytes()));
-    }
-    atomic::write_all(&files).map_err(fail)?;
+    write_outputs(args, &csv, &run, &description.name, ts)?;
     if holds {
         let outcome = run.hold_outcome();
         print!("{}", hold_summary(&outcome, run.z_ref.first().copied(), ts));
@@ -188,6 +172,19 @@ pub fn run(args: &Args) -> Result<(), Report> {
         summary(&run.outcomes(t.0, t.1), controller.law.name(), ts)
     );
     Ok(())
+}
+
+/// The CSV and, with `--plot`, the run's SVG, written together atomically.
+fn write_outputs(args: &Args, csv: &str, run: &LoopRun, name: &str, ts: f64) -> Result<(), Report> {
+    let svg = match &args.plot {
+        Some(_) => Some(plot(run, name, ts).map_err(fail)?),
+        None => None,
+    };
+    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(args.out.as_path(), csv.as_bytes())];
+    if let (Some(path), Some(svg)) = (&args.plot, &svg) {
+        files.push((path.as_path(), svg.as_bytes()));
+    }
+    atomic::write_all(&files).map_err(fail)
 }
 
 /// `Some(x)` must be positive and finite.
