@@ -9,12 +9,7 @@ use support::{example_path, rd, TempDir};
 
 /// The backstepping example's physics with `keys` as its `[controller]`.
 fn variant(dir: &TempDir, name: &str, keys: &str) -> std::path::PathBuf {
-    let text = std::fs::read_to_string(example_path("backstepping-valve.toml")).unwrap();
-    let physics = text.split("\n[controller]").next().unwrap();
-    let physics = &physics[..physics.rfind("\n#").map_or(physics.len(), |k| {
-        // drop the comment block that introduced the example's controller
-        physics[..k].rfind("\n\n").map_or(k, |b| b + 1)
-    })];
+    let physics = support::example_physics("backstepping-valve.toml");
     dir.write(
         name,
         format!("{physics}\n[controller]\nlaw = \"backstepping\"\nsample_period = 1e-5\n{keys}\n"),

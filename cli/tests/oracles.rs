@@ -172,9 +172,7 @@ fn robustness_agrees_with_the_python_oracle() {
 fn backstepping_region_agrees_with_the_cvxpy_oracle() {
     let dir = support::TempDir::new("oracle-region");
     let variant = |example: &str, keys: &str| {
-        let text = std::fs::read_to_string(root().join("examples").join(example)).unwrap();
-        let physics = text.split("\n[trajectory]").next().unwrap_or(&text);
-        let physics = physics.split("\n[controller]").next().unwrap_or(physics);
+        let physics = support::example_physics(example);
         format!("{physics}\n[controller]\nlaw = \"backstepping\"\nsample_period = 1e-5\n{keys}")
     };
     let unequal = dir.write(

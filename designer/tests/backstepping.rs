@@ -71,9 +71,7 @@ fn the_law_imposes_the_force_dynamics_of_the_proof() {
 
 /// `example`'s physics with a backstepping `[controller]` of `keys`.
 fn on_valve(example: &str, keys: &str) -> Design {
-    let text = std::fs::read_to_string(example_path(example)).expect("example readable");
-    let physics = text.split("\n[trajectory]").next().unwrap_or(&text);
-    let physics = physics.split("\n[controller]").next().unwrap_or(physics);
+    let physics = support::example_physics(example);
     let toml =
         format!("{physics}\n[controller]\nlaw = \"backstepping\"\nsample_period = 1e-5\n{keys}\n");
     let d = designer::description::parse_str(&toml, example).expect("description parses");

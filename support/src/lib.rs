@@ -12,6 +12,7 @@ pub mod cli;
 pub mod close;
 pub mod lines;
 pub mod paths;
+pub mod physics;
 pub mod scratch;
 pub mod temp;
 
@@ -19,5 +20,6 @@ pub use cli::{assert_no_panic, squeeze, Cli, Run};
 pub use close::{assert_close, close, Tol};
 pub use lines::{changed_lines, code_only, replaced_once};
 pub use paths::{example_path, example_paths, root, toml_files};
+pub use physics::{example_physics, without_design_sections};
 pub use scratch::ScratchCrate;
 pub use temp::{files_in, TempDir};

@@ -682,25 +682,6 @@ pub fn hidden_case(
     hidden_case_of(&text, example_file, cause, excitation, with_z, seed)
 }
 
-/// `text` without its design sections `[trajectory]`, `[controller]` and
-/// `[observer…]` (each from its header to the next header).
-fn without_design_sections(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    let mut skipping = false;
-    for line in text.split_inclusive('\n') {
-        let trimmed = line.trim_start();
-        if trimmed.starts_with('[') {
-            skipping = ["[trajectory]", "[controller]", "[observer"]
-                .iter()
-                .any(|section| trimmed.starts_with(section));
-        }
-        if !skipping {
-            out.push_str(line);
-        }
-    }
-    out
-}
-
 /// [`hidden_case`] for the description `text` (an example's or a generated
 /// device's) named `file_name`; the noise as [`Noise::for_device`].
 pub fn hidden_case_of(
@@ -726,7 +707,7 @@ fn case_of(
 ) -> HiddenCase {
     // a bench recording needs no controller; the truth (a Jiles–Atherton core,
     // say) may not admit the design's [trajectory]
-    let text = &without_design_sections(text);
+    let text = &support::without_design_sections(text);
     let desc = parse_str(text, file_name).unwrap_or_else(|e| panic!("{e}"));
     let base = baseline(&desc);
     let baseline_toml = write_physics(text, file_name, &base)
