@@ -14,7 +14,7 @@ use std::fmt::Write as _;
 use designer::description::parse_str;
 use designer::design::Design;
 use reldesign_build::emit;
-use support::{example_path, ScratchCrate};
+use support::{example_path, ScratchCrate, ODD_FLOATS as ODD};
 
 fn example_text() -> String {
     std::fs::read_to_string(example_path("jiles-atherton-valve.toml")).unwrap()
@@ -112,20 +112,6 @@ fn one_change_is_one_line_where_it_is_stated() {
         );
     }
 }
-
-/// Values in every input's odd corners, written as Rust expressions of the
-/// module's float type `F`.
-const ODD: [&str; 9] = [
-    "0.0",
-    "-0.0",
-    "1e-12",
-    "-1e-3",
-    "1e30",
-    "-1e30",
-    "F::INFINITY",
-    "F::NEG_INFINITY",
-    "F::NAN",
-];
 
 #[test]
 fn emitted_module_compiles_passes_clippy_and_is_total() {

@@ -21,5 +21,5 @@ pub use close::{assert_close, close, Tol};
 pub use lines::{changed_lines, code_only, replaced_once};
 pub use paths::{example_path, example_paths, root, toml_files};
 pub use physics::{example_physics, without_design_sections};
-pub use scratch::ScratchCrate;
+pub use scratch::{ScratchCrate, ODD_FLOATS};
 pub use temp::{files_in, TempDir};

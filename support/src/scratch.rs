@@ -128,6 +128,21 @@ impl ScratchCrate {
     }
 }
 
+/// Values in every input's odd corners, written as Rust expressions of a
+/// scratch crate's float type `F`: the inputs a totality test of emitted code
+/// steps through.
+pub const ODD_FLOATS: [&str; 9] = [
+    "0.0",
+    "-0.0",
+    "1e-12",
+    "-1e-3",
+    "1e30",
+    "-1e30",
+    "F::INFINITY",
+    "F::NEG_INFINITY",
+    "F::NAN",
+];
+
 #[cfg(test)]
 mod tests {
     use super::*;
