@@ -22,7 +22,9 @@ use std::path::{Path, PathBuf};
 use designer::description::Description;
 use miette::Report;
 use reldesign_identify::diagnose::localise::{localise, Localisation, Signals};
-use reldesign_identify::diagnose::{diagnose_causes, Cause, Diagnosis, FittedParameter, Options};
+use reldesign_identify::diagnose::{
+    diagnose_causes, Cause, Causes, Diagnosis, FittedParameter, Options,
+};
 use reldesign_identify::edit::{annotate, write_physics};
 use reldesign_identify::{flux_from_data, Measured, SimOutputs};
 use serde_json::{json, Value};
@@ -122,6 +124,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
 struct One {
     json: Value,
     text: String,
+    /// The answer's first entry.
     cause: Cause,
     gain: f64,
 }
@@ -133,14 +136,17 @@ fn diagnose_one(
     data_path: &Path,
     options: &Options,
 ) -> Result<One, Report> {
-    let steps = diagnose_causes(description, data, options).map_err(fail)?;
-    let (Some(first), Some(d)) = (steps.first(), steps.last()) else {
-        return Err(fail("internal error: a diagnosis without a step"));
-    };
-    let localisation = localisation(d, data);
+    let answer = diagnose_causes(description, data, options).map_err(fail)?;
+    let steps = &answer.steps;
+    let (first, d) = (answer.first(), answer.last());
+    let localisation = localisation(d, data, &d.baseline_replay);
     let outputs = Outputs::new(out, data_path);
-    let toml = extended_toml(description, d)?;
-    let named = causes(&steps).join(" + ");
+    let named = if answer.unexplained() {
+        format!("unexplained; partial: {}", joined(&answer.partial(), " + "))
+    } else {
+        joined(&answer.names(), " + ")
+    };
+    let toml = extended_toml(description, d, &answer)?;
     let plots = plots(d, first, &named, data, &localisation, description)?;
     crate::atomic::write_all(&[
         (&outputs.extended, toml.as_bytes()),
@@ -150,24 +156,58 @@ fn diagnose_one(
     ])
     .map_err(fail)?;
     // every step's fitted values against the original description, a later
-    // step's refit (the resistance) replacing an earlier one's
+    // step's refit (the resistance, or every value after the joint fit)
+    // replacing an earlier one's
     let mut parameters: Vec<FittedParameter> = Vec::new();
-    for step in &steps {
+    for step in steps {
         for p in step.parameters(description, data) {
             parameters.retain(|q| q.path != p.path);
             parameters.push(p);
         }
     }
+    let left = answer
+        .unexplained()
+        .then(|| localisation_left(d, data).to_string());
+    let per_cause = per_cause(&answer, &parameters, data, description);
     let mut json = json_report(d, &outputs, &localisation, &parameters);
-    let overall = overall_gain(first, d);
+    let overall = answer.gain();
+    let names: Vec<&str> = answer.names().iter().map(|c| c.name()).collect();
     if let Some(map) = json.as_object_mut() {
-        map.insert("cause".into(), json!(first.cause.name()));
-        map.insert("causes".into(), json!(causes(&steps)));
+        map.insert("cause".into(), json!(names.first()));
+        map.insert("causes".into(), json!(names));
         map.insert("baseline_wnrmse".into(), json!(first.whole.baseline_wnrmse));
         map.insert("gain".into(), json!(overall));
         map.insert(
             "steps".into(),
             json!(steps.iter().map(step_json).collect::<Vec<_>>()),
+        );
+        map.insert(
+            "residual".into(),
+            json!({
+                "over_noise_floor": answer.residual.over_floor,
+                "correlation_samples": answer.residual.correlation,
+            }),
+        );
+        map.insert(
+            "unexplained".into(),
+            unexplained_json(&answer, left.as_deref()),
+        );
+        map.insert(
+            "per_cause".into(),
+            json!(per_cause
+                .iter()
+                .map(|c| json!({
+                    "cause": c.cause.name(),
+                    "named": !answer.unexplained(),
+                    "gain": c.gain,
+                    "identifiable": true,
+                    "why": c.why,
+                    "at_bound": c.at_bound,
+                    "values": c.values.iter().map(|p| (p.path.clone(), json!({
+                        "value": p.value, "std_error": p.std_error, "baseline": p.baseline,
+                    }))).collect::<serde_json::Map<_, _>>(),
+                }))
+                .collect::<Vec<_>>()),
         );
     }
     let mut text = text_report(
@@ -178,24 +218,220 @@ fn diagnose_one(
         &localisation,
         &outputs,
         &parameters,
+        &verdict(&answer, d),
     );
-    if steps.len() > 1 {
-        text = format!("{}{text}", steps_text(&steps, overall));
+    // the answer first, then per cause, then the last step in detail
+    let mut head = String::new();
+    if let Some(left) = &left {
+        head.push_str(&unexplained_text(&answer, left));
     }
+    if steps.len() > 1 {
+        head.push_str(&steps_text(steps, overall));
+    }
+    head.push_str(&per_cause_text(&per_cause, answer.unexplained()));
+    if !head.is_empty() {
+        head.push_str(&format!("\n{} in detail:\n", detail_title(&answer)));
+    }
+    text = format!("{head}{text}");
     Ok(One {
         json,
         text,
-        cause: first.cause,
+        cause: names_first(&answer),
         gain: overall,
     })
+}
+
+/// The cause line of the step `d`'s report.
+fn verdict(answer: &Causes, d: &Diagnosis) -> String {
+    if answer.unexplained() && d.cause != Cause::None {
+        format!(
+            "unexplained ({} explains part of it only: not named)",
+            d.cause
+        )
+    } else if answer.unexplained() {
+        "unexplained".to_owned()
+    } else {
+        d.cause.name().to_owned()
+    }
+}
+
+/// One cause the selection found, as the report gives it.
+struct CauseReport<'a> {
+    cause: Cause,
+    /// Its step's gain over the model before it.
+    gain: f64,
+    /// Why the record identifies it (`evidence::why_identified`).
+    why: String,
+    /// Its own fitted values (the resistance, refitted by every step, left out).
+    values: Vec<&'a FittedParameter>,
+    /// Those of its values the fit left on a bound of their search range.
+    at_bound: Vec<String>,
+}
+
+/// Every cause the selection found, strongest first.
+fn per_cause<'a>(
+    answer: &Causes,
+    parameters: &'a [FittedParameter],
+    data: &Measured,
+    description: &Description,
+) -> Vec<CauseReport<'a>> {
+    use reldesign_identify::diagnose::evidence::why_identified;
+    (answer.steps.iter())
+        .filter(|s| s.cause != Cause::None)
+        .map(|step| {
+            let own = |p: &&FittedParameter| {
+                p.path != "coil.resistance"
+                    && (step.named_candidate.as_ref())
+                        .is_some_and(|c| c.params.iter().any(|q| q.path == p.path))
+            };
+            let values: Vec<&FittedParameter> = parameters.iter().filter(own).collect();
+            let at_bound = (values.iter())
+                .filter(|p| on_bound(step, p))
+                .map(|p| p.path.clone())
+                .collect();
+            CauseReport {
+                cause: step.cause,
+                gain: step.whole.gain,
+                why: why_identified(step, parameters, data, description),
+                values,
+                at_bound,
+            }
+        })
+        .collect()
+}
+
+/// Whether `p` ended within 0.1 % of a bound of `step`'s search range: the
+/// data want it beyond what the fit allows, a sign the cause stands in for
+/// something else.
+fn on_bound(step: &Diagnosis, p: &FittedParameter) -> bool {
+    let Some(range) =
+        (step.named_candidate.as_ref()).and_then(|c| c.params.iter().find(|q| q.path == p.path))
+    else {
+        return false;
+    };
+    let near = |b: f64| (p.value - b).abs() <= 1e-3 * b.abs().max(f64::MIN_POSITIVE);
+    near(range.lower) || near(range.upper)
+}
+
+/// The report's section per cause: its gain, why the record identifies it,
+/// its values with their standard errors.
+fn per_cause_text(causes: &[CauseReport], unexplained: bool) -> String {
+    if causes.is_empty() {
+        return String::new();
+    }
+    let mut s = format!(
+        "\nper cause ({}):\n",
+        if unexplained {
+            "partial, not named"
+        } else {
+            "strongest first"
+        }
+    );
+    for c in causes {
+        let _ = writeln!(
+            s,
+            "  {}: gain {} over the model before it\n    identifiable: {}",
+            c.cause.name(),
+            percent(c.gain),
+            c.why
+        );
+        for p in &c.values {
+            let bound = if c.at_bound.contains(&p.path) {
+                " (on the bound of its range: the data want it further; the cause may stand in \
+                 for something else)"
+            } else {
+                ""
+            };
+            let _ = writeln!(
+                s,
+                "    {:<24} = {:.4e} ± {:.2e}{bound}",
+                p.path, p.value, p.std_error
+            );
+        }
+    }
+    s
+}
+
+/// The answer's first entry.
+fn names_first(answer: &Causes) -> Cause {
+    answer.names().first().copied().unwrap_or(Cause::None)
+}
+
+/// `causes`' names joined by `sep`.
+fn joined(causes: &[Cause], sep: &str) -> String {
+    causes
+        .iter()
+        .map(|c| c.name())
+        .collect::<Vec<_>>()
+        .join(sep)
+}
+
+/// `"unexplained"` of the JSON: null when the record is explained; else
+/// what is left, the partial causes and their gain, and where the residual
+/// left concentrates.
+fn unexplained_json(answer: &Causes, left: Option<&str>) -> Value {
+    let Some(left) = left else {
+        return Value::Null;
+    };
+    json!({
+        "over_noise_floor": answer.residual.over_floor,
+        "correlation_samples": answer.residual.correlation,
+        "partial_causes": answer.partial().iter().map(|c| c.name()).collect::<Vec<_>>(),
+        "partial_gain": answer.gain(),
+        "localisation": left,
+    })
+}
+
+/// What the detailed part of a report with a head covers.
+fn detail_title(answer: &Causes) -> String {
+    match answer.steps.len() {
+        1 => format!("the diagnosis ({})", answer.last().cause),
+        _ => format!("the last step ({})", answer.last().cause),
+    }
+}
+
+/// The report's verdict for an unexplained record.
+fn unexplained_text(answer: &Causes, left: &str) -> String {
+    let r = answer.residual;
+    let partial = answer.partial();
+    let mut s = format!(
+        "answer: unexplained. The model leaves {:.1}× the noise floor (its residual correlated \
+         over {:.0} samples); every cause of the vocabulary, alone or in pairs, leaves about 1× on \
+         records it explains. Something outside the vocabulary is at work: a measurement chain \
+         (probe gain or lag, driver delay), or parameters of the description (the spring, the \
+         mass) that no cause refits.\n",
+        r.over_floor, r.correlation
+    );
+    if partial.is_empty() {
+        s.push_str("no extension of the vocabulary improves the record.\n");
+    } else {
+        let _ = writeln!(
+            s,
+            "partial, not named: {} explains {} of the baseline's error (the extended model \
+             written holds it).",
+            joined(&partial, " + "),
+            percent(answer.gain())
+        );
+    }
+    let _ = writeln!(
+        s,
+        "where the residual left concentrates:\n{}",
+        left.trim_end()
+    );
+    s
 }
 
 /// The head of a report with several causes: the causes, each step's gain,
 /// the whole selection's; the last step's report follows in detail.
 fn steps_text(steps: &[Diagnosis], overall: f64) -> String {
     let mut s = format!(
-        "causes: {} (strongest first; each fitted on top of the ones before)\n",
-        causes(steps).join(", ")
+        "causes found: {} (strongest first; each fitted on top of the ones before, then all \
+         fitted together)\n",
+        steps
+            .iter()
+            .map(|s| s.cause.name())
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     for (k, step) in steps.iter().enumerate() {
         let _ = writeln!(
@@ -211,29 +447,13 @@ fn steps_text(steps: &[Diagnosis], overall: f64) -> String {
     if let (Some(first), Some(last)) = (steps.first(), steps.last()) {
         let _ = writeln!(
             s,
-            "  together: {} → {} (gain {}); the extended model holds every cause\n\nthe last step ({}), in detail:",
+            "  together: {} → {} (gain {}); the extended model holds every cause",
             percent(first.whole.baseline_wnrmse),
             percent(last.whole.extended_wnrmse),
             percent(overall),
-            last.cause.name()
         );
     }
     s
-}
-
-/// The named causes, strongest first (`["none"]` when there is none).
-fn causes(steps: &[Diagnosis]) -> Vec<&'static str> {
-    steps.iter().map(|s| s.cause.name()).collect()
-}
-
-/// 1 − (the last step's error)/(the original baseline's), on the whole record.
-fn overall_gain(first: &Diagnosis, last: &Diagnosis) -> f64 {
-    let base = first.whole.baseline_wnrmse;
-    if base > 0.0 {
-        1.0 - last.whole.extended_wnrmse / base
-    } else {
-        0.0
-    }
 }
 
 /// One step of the forward selection: its cause and its gain over the model
@@ -342,16 +562,28 @@ fn batch_summary(by_cause: &[(String, usize, f64)], failed: usize, total: usize)
 }
 
 /// The winner written over the original text, comments kept.
-fn extended_toml(description: &Description, d: &Diagnosis) -> Result<String, Report> {
+fn extended_toml(
+    description: &Description,
+    d: &Diagnosis,
+    answer: &Causes,
+) -> Result<String, Report> {
     let source = &description.source;
     let text = write_physics(&source.text, &source.file_name, &d.extended).map_err(fail)?;
+    let cause = if answer.unexplained() {
+        format!(
+            "unexplained (partial: {})",
+            joined(&answer.partial(), " + ")
+        )
+    } else {
+        joined(&answer.names(), " + ")
+    };
+    let first = answer.first();
     let header = format!(
-        "extended by reldesign diagnose: cause = {}, current wNRMSE {:.3} % -> {:.3} % \
+        "extended by reldesign diagnose: cause = {cause}, current wNRMSE {:.3} % -> {:.3} % \
          (gain {:.1} %)",
-        d.cause,
-        100.0 * d.whole.baseline_wnrmse,
+        100.0 * first.whole.baseline_wnrmse,
         100.0 * d.whole.extended_wnrmse,
-        100.0 * d.whole.gain
+        100.0 * answer.gain()
     );
     Ok(annotate(&text, &header))
 }
@@ -377,13 +609,17 @@ fn signals<'a>(
     }
 }
 
-/// Where the baseline's current error concentrates.
-fn localisation(d: &Diagnosis, data: &Measured) -> Localisation {
-    let replay = &d.baseline_replay;
+/// Where the current error of `replay` (the step's baseline's) concentrates.
+fn localisation(d: &Diagnosis, data: &Measured, replay: &SimOutputs) -> Localisation {
     let moving = reldesign_identify::diagnose::moving(replay);
     let m = &d.extended.mechanics;
     let impacts = reldesign_identify::diagnose::impacts(replay, m.z_min, m.z_max);
     localise(&signals(d, data, replay, &moving, &impacts))
+}
+
+/// Where the error the last model leaves concentrates.
+fn localisation_left(d: &Diagnosis, data: &Measured) -> Localisation {
+    localisation(d, data, &d.extended_replay)
 }
 
 /// The three plots: measured vs simulated, residual, λ–i loop.
@@ -463,6 +699,7 @@ fn text_report(
     loc: &Localisation,
     out: &Outputs,
     parameters: &[FittedParameter],
+    verdict: &str,
 ) -> String {
     let mut s = String::new();
     let n = data.t.len();
@@ -537,7 +774,7 @@ fn text_report(
     for r in &d.rejected {
         let _ = writeln!(s, "  {:<17} not named: {}", r.cause.name(), r.reason());
     }
-    let _ = writeln!(s, "cause: {}", d.cause);
+    let _ = writeln!(s, "cause: {verdict}");
     for p in parameters {
         let baseline = p
             .baseline

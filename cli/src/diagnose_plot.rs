@@ -243,7 +243,10 @@ fn time_panel(
         .margin(10)
         .x_label_area_size(35)
         .y_label_area_size(60)
-        .build_cartesian_2d(padded(&[t_ms[0], t_ms[t_ms.len() - 1]]), padded(&ys))
+        .build_cartesian_2d(
+            padded(&[t_ms[0], t_ms[t_ms.len() - 1]]),
+            legend_room(padded(&ys), lines.len() + distinct(shaded)),
+        )
         .map_err(err)?;
     chart
         .configure_mesh()
@@ -319,6 +322,21 @@ fn legend<'a>(chart: &mut Chart<'a>) -> Result<(), String> {
         .border_style(BLACK)
         .draw()
         .map_err(err)
+}
+
+/// `y` raised at the top by a band per legend entry (a tenth of the span
+/// each), so that the legend in the upper right covers no data.
+fn legend_room(y: std::ops::Range<f64>, entries: usize) -> std::ops::Range<f64> {
+    let span = y.end - y.start;
+    y.start..y.end + 0.1 * span * entries as f64
+}
+
+/// The number of distinct labels of `regions`.
+fn distinct(regions: &[(f64, f64, &str)]) -> usize {
+    let mut labels: Vec<&str> = regions.iter().map(|r| r.2).collect();
+    labels.sort_unstable();
+    labels.dedup();
+    labels.len()
 }
 
 /// The finite range of `v`, padded by 5 % (a unit-wide range around a constant).

@@ -509,6 +509,10 @@ fn several_causes_are_named_strongest_first() {
         }
         let overall = number(&m, "gain");
         assert!(overall >= steps[0]["gain"].as_f64().unwrap(), "{overall}");
+        // fitted together, the pair explains the record to the noise
+        assert!(m["unexplained"].is_null(), "{}", r.context());
+        let left = m["residual"]["over_noise_floor"].as_f64().unwrap();
+        assert!(left < 1.5, "{pair:?}: {left}× the floor left");
         let extended = checked_model(&PathBuf::from(m["extended_model"].as_str().unwrap()));
         for cause in pair {
             let has = match cause {
@@ -542,8 +546,8 @@ fn several_causes_are_named_strongest_first() {
     let (model, data) = write_case(dir.path(), &case);
     let text = rd!("diagnose", model, data, "--causes", QUICK_CAUSES).ok();
     assert!(
-        text.starts_with("causes: eddy-currents, resistance-drift")
-            || text.starts_with("causes: resistance-drift, eddy-currents"),
+        text.starts_with("causes found: eddy-currents, resistance-drift")
+            || text.starts_with("causes found: resistance-drift, eddy-currents"),
         "{text}"
     );
     assert!(
@@ -555,4 +559,78 @@ fn several_causes_are_named_strongest_first() {
     let (model, data) = write_case(dir.path(), &single);
     let m = one_object(&rd!("diagnose", model, data, "--json", "--causes", QUICK_CAUSES).ok());
     assert_eq!(m["causes"], serde_json::json!(["eddy-currents"]));
+}
+
+/// Effects outside the vocabulary (issue 17 §2; `reldesign_tests::outside`):
+/// a current probe reading 8 % high, a driver 120 µs late, a probe lagging by
+/// 100 µs, a spring 30 % stiffer or softer. Each is answered `unexplained`
+/// (no cause of the vocabulary named, whatever part of the error one of them
+/// absorbs: fringing takes 44–92 % of these), with the partial causes, their
+/// gain and where the residual left concentrates. Seeds apart from the ones
+/// the thresholds were read from.
+#[test]
+fn effects_outside_the_vocabulary_are_unexplained() {
+    use reldesign_tests::outside::{outside_case, Outside};
+    const TRACKING: &str = "perfect-tracking-valve.toml";
+    let cases = [
+        (EXAMPLE, Outside::ProbeGain(1.08), false, 81),
+        (TRACKING, Outside::DriverDelay(120e-6), true, 82),
+        (TRACKING, Outside::ProbeLag(100e-6), false, 83),
+        (EXAMPLE, Outside::Spring(1.3), true, 84),
+        (EXAMPLE, Outside::Spring(0.7), false, 85),
+    ];
+    for (k, (example, effect, with_z, seed)) in cases.into_iter().enumerate() {
+        let text = std::fs::read_to_string(example_path(example)).unwrap();
+        let desc = parse_str(&text, example).unwrap_or_else(|e| panic!("{e}"));
+        let excitation = Excitation::square_wave(&baseline(&desc));
+        let case = outside_case(example, effect, &excitation, with_z, seed);
+        let dir = TempDir::new("outside");
+        let (model, data) = write_case(dir.path(), &case);
+        // the whole vocabulary on the first (the hysteresis fit is the slow one)
+        let r = if k == 0 {
+            rd!("diagnose", model, data, "--json")
+        } else {
+            rd!("diagnose", model, data, "--json", "--causes", QUICK_CAUSES)
+        };
+        let m = one_object(&r.ok());
+        let what = format!("{example} {effect:?} (z: {with_z}): {}", r.context());
+        assert_eq!(m["cause"], "unexplained", "{what}");
+        assert_eq!(m["causes"], serde_json::json!(["unexplained"]), "{what}");
+        let u = &m["unexplained"];
+        let left = u["over_noise_floor"].as_f64().unwrap();
+        assert!(
+            left > reldesign_identify::diagnose::unexplained::OVER_FLOOR,
+            "{what}"
+        );
+        let partial_gain = u["partial_gain"].as_f64().unwrap();
+        assert!((partial_gain - number(&m, "gain")).abs() < 1e-12, "{what}");
+        let partial = u["partial_causes"].as_array().unwrap();
+        assert!(partial.len() <= 2, "{what}");
+        assert!(
+            partial.is_empty() == (partial_gain == 0.0),
+            "partial causes go with a partial gain: {what}"
+        );
+        assert!(!u["localisation"].as_str().unwrap().is_empty(), "{what}");
+        checked_model(&PathBuf::from(m["extended_model"].as_str().unwrap()));
+    }
+    // the text report says so, and names no cause
+    let text = std::fs::read_to_string(example_path(EXAMPLE)).unwrap();
+    let desc = parse_str(&text, EXAMPLE).unwrap_or_else(|e| panic!("{e}"));
+    let excitation = Excitation::square_wave(&baseline(&desc));
+    let case = outside_case(
+        EXAMPLE,
+        Outside::DriverDelay(120e-6),
+        &excitation,
+        false,
+        86,
+    );
+    let dir = TempDir::new("outside-text");
+    let (model, data) = write_case(dir.path(), &case);
+    let report = rd!("diagnose", model, data, "--causes", QUICK_CAUSES).ok();
+    assert!(report.starts_with("answer: unexplained."), "{report}");
+    assert!(
+        report.contains("where the residual left concentrates:"),
+        "{report}"
+    );
+    assert!(report.contains("cause: unexplained"), "{report}");
 }

@@ -424,7 +424,7 @@ pub fn with_effect(
 /// The baseline with the one extension `cause` added, its parameters drawn
 /// in realistic ranges scaled to the baseline's run of `excitation`, and the
 /// drawn values by their description keys (`coil.eddy`, …). `Cause::None`
-/// returns the baseline unchanged.
+/// and `Cause::Unexplained` return the baseline unchanged.
 pub fn with_effect_for(
     baseline: &Description,
     cause: Cause,
@@ -440,7 +440,8 @@ pub fn with_effect_for(
         Cause::Fringing => draw_fringing(&mut d, rng),
         Cause::ResistanceDrift => draw_drift(&mut d, &ctx, rng),
         Cause::Bouncing => draw_bounce(&mut d, &ctx, rng),
-        Cause::None => vec![],
+        // effects outside the vocabulary: `crate::outside`
+        Cause::None | Cause::Unexplained => vec![],
     };
     let drawn = drawn.into_iter().map(|(k, v)| (k.to_string(), v)).collect();
     (d, drawn)
@@ -604,26 +605,103 @@ pub fn experiment(
     with_z: bool,
     rng: &mut Rng,
 ) -> String {
-    let input = excitation.input(sampling.delay);
+    experiment_through(
+        truth,
+        excitation,
+        sampling,
+        noise,
+        with_z,
+        Chain::IDEAL,
+        rng,
+    )
+}
+
+/// The measurement chain between the plant and the record: what a bench
+/// adds that no actuator description holds (issue 17 §2 hides these).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Chain {
+    /// The current probe reads this times the coil current.
+    pub probe_gain: f64,
+    /// The current probe's first-order time constant [s] (0: ideal).
+    pub probe_tau: f64,
+    /// The driver applies the recorded voltage this late [s].
+    pub driver_delay: f64,
+}
+
+impl Chain {
+    /// An ideal probe and driver.
+    pub const IDEAL: Chain = Chain {
+        probe_gain: 1.0,
+        probe_tau: 0.0,
+        driver_delay: 0.0,
+    };
+}
+
+/// [`experiment`] through the measurement chain `chain`: the plant runs on
+/// the supply's steps `chain.driver_delay` later than the recorded voltage
+/// shows them, and the recorded current is the coil current through the
+/// probe's gain and first-order lag (exact for the piecewise-linear current
+/// between samples).
+pub fn experiment_through(
+    truth: &Description,
+    excitation: &Excitation,
+    sampling: Sampling,
+    noise: Noise,
+    with_z: bool,
+    chain: Chain,
+    rng: &mut Rng,
+) -> String {
+    let input = excitation.input(sampling.delay + chain.driver_delay);
     let n = ((excitation.duration() + sampling.delay) / sampling.period).floor() as usize + 1;
     let t: Vec<f64> = (0..n).map(|k| k as f64 * sampling.period).collect();
     let mut model = Model::build(truth);
     let run = replay(&mut model, &input, &t, &Options::default())
         .unwrap_or_else(|e| panic!("{}: simulation failed: {e}", truth.name));
+    let commanded = excitation.input(sampling.delay);
+    let probed = probe(&run.current, chain, sampling.period);
     let mut out = format!(
         "# simulated bench record of {}: {excitation:?}, sigma_v = {} V, sigma_i = {} A\n",
         truth.name, noise.voltage, noise.current
     );
     out.push_str(if with_z { "t,v,i,z\n" } else { "t,v,i\n" });
     for k in 0..t.len() {
-        let vm = run.voltage[k] + noise.voltage * gaussian(rng);
-        let im = run.current[k] + noise.current * gaussian(rng);
+        let v = if chain.driver_delay > 0.0 {
+            designer::sim::Input::value(&commanded, t[k])
+        } else {
+            run.voltage[k]
+        };
+        let vm = v + noise.voltage * gaussian(rng);
+        let im = probed[k] + noise.current * gaussian(rng);
         out.push_str(&format!("{:e},{vm:e},{im:e}", t[k]));
         if with_z {
             let zm = run.trajectory.x[k][0] + noise.position * gaussian(rng);
             out.push_str(&format!(",{zm:e}"));
         }
         out.push('\n');
+    }
+    out
+}
+
+/// The current as `chain`'s probe reads it, sampled every `period`: the gain,
+/// then the first-order lag y' = (i − y)/τ solved exactly for an input linear
+/// between samples.
+fn probe(current: &[f64], chain: Chain, period: f64) -> Vec<f64> {
+    let gained = current.iter().map(|i| chain.probe_gain * i);
+    if !(chain.probe_tau > 0.0) {
+        return gained.collect();
+    }
+    let a = (-period / chain.probe_tau).exp();
+    // the response to a unit ramp's share over one step
+    let b = 1.0 - chain.probe_tau / period * (1.0 - a);
+    let mut out = Vec::with_capacity(current.len());
+    let mut prev: Option<(f64, f64)> = None; // (input, output) at the last sample
+    for x in gained {
+        let y = match prev {
+            None => x,
+            Some((x0, y0)) => a * y0 + (1.0 - a) * x0 + b * (x - x0),
+        };
+        out.push(y);
+        prev = Some((x, y));
     }
     out
 }

@@ -3,6 +3,7 @@
 
 pub mod devices;
 pub mod hidden;
+pub mod outside;
 pub mod sensorless;
 
 use designer::description::{parse_file, parse_str, Description};

@@ -131,7 +131,7 @@ fn recovered_key(cause: Cause) -> Option<&'static str> {
         Cause::ResistanceDrift => Some("coil.resistance_drift"),
         Cause::Bouncing => Some("mechanics.restitution"),
         Cause::Fringing => Some("gap.area"),
-        Cause::Hysteresis | Cause::None => None,
+        Cause::Hysteresis | Cause::None | Cause::Unexplained => None,
     }
 }
 

@@ -54,6 +54,7 @@ pub fn candidate(
     };
     match cause {
         Cause::None => {}
+        Cause::Unexplained => return Err(not("`unexplained` is an answer, not an extension")),
         Cause::EddyCurrents => {
             if baseline.coil.eddy > 0.0 {
                 return Err(not("coil.eddy is already > 0"));

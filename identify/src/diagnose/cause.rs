@@ -21,6 +21,9 @@ pub enum Cause {
     Bouncing,
     /// The model already explains the data within its noise.
     None,
+    /// The residual stays well above the noise after the best extension(s):
+    /// something outside this vocabulary. An answer, never a candidate.
+    Unexplained,
 }
 
 impl Cause {
@@ -44,6 +47,7 @@ impl Cause {
             Cause::ResistanceDrift => "resistance-drift",
             Cause::Bouncing => "bouncing",
             Cause::None => "none",
+            Cause::Unexplained => "unexplained",
         }
     }
 }

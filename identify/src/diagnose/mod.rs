@@ -9,18 +9,24 @@
 //! voltage noise the replay passes on). The record's voltage edges are
 //! placed once by the baseline (`crate::edges`); the named cause is then
 //! polished on its own placement ([`polish`]). [`diagnose_causes`] names
-//! a second cause by forward selection on top of the first.
+//! a second cause by forward selection on top of the first, fits them
+//! together ([`joint`]), and answers `unexplained` where even that leaves
+//! the residual well above the noise ([`unexplained`]).
 //!
 //! Only the two inputs are read: the description and the recording.
 
 pub mod candidate;
 pub mod cause;
+pub mod evidence;
+mod joint;
 pub mod localise;
 mod polish;
 pub mod rank;
+pub mod unexplained;
 
 pub use candidate::{Candidate, NotApplicable, Scales};
 pub use cause::Cause;
+pub use unexplained::{Causes, Residual};
 
 use rayon::prelude::*;
 
@@ -174,6 +180,9 @@ pub struct Diagnosis {
     /// Variances of the named values from the voltage noise and the edge
     /// placement (`polish::propagated_variances`), in the fit's order.
     pub propagated: Option<Vec<f64>>,
+    /// The named cause's candidate: what its fit varied, within which bounds
+    /// (None for `none`).
+    pub named_candidate: Option<Candidate>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -264,18 +273,7 @@ pub fn diagnose(
         duration: data.t[n - 1] - data.t[0],
     };
     let (candidates, not_applicable) = candidates(baseline, &options.causes, scales);
-    let fit_options = FitOptions {
-        max_iterations: options.max_iterations,
-        // The ranking is by the current's error: fit that (and z when
-        // measured), not the flux integrated from v − R·i, which a drifting
-        // resistance would corrupt.
-        use_flux: false,
-        rtol: 1e-8,
-        fd_step: 1e-5,
-        ftol: 1e-5,
-        max_steps_per_sample: options.max_steps_per_sample,
-        ..FitOptions::default()
-    };
+    let fit_options = fit_options(options);
     // Jiles–Atherton fits cost most and are not convex: fit the rest first,
     // then the hysteresis candidate from two starts at once, one of them the
     // fitted saturating core.
@@ -324,8 +322,8 @@ pub fn diagnose(
         let Ok(fit) = scored.fit.as_ref() else {
             continue;
         };
-        let lacking = record_lacks(scored.cause, &baseline_replay, data, baseline);
-        if let Some(reason) = lacking.or_else(|| unidentified(scored.cause, fit)) {
+        let lacking = evidence::record_lacks(scored.cause, &baseline_replay, data, baseline);
+        if let Some(reason) = lacking.or_else(|| evidence::unidentified(scored.cause, fit)) {
             not_identifiable.push((scored.cause, reason));
             continue;
         }
@@ -369,21 +367,28 @@ pub fn diagnose(
                     &own.head(fitted_samples),
                     &fit_options,
                 );
-                chosen = Some((scored.cause, named, extended_replay, propagated));
+                chosen = Some((
+                    scored.cause,
+                    named,
+                    extended_replay,
+                    propagated,
+                    candidate.cloned(),
+                ));
                 break;
             }
         }
     }
-    let (winner, named_fit, extended, extended_replay, propagated) = match chosen {
-        Some((cause, fit, replay, propagated)) => {
+    let (winner, named_fit, extended, extended_replay, propagated, named_candidate) = match chosen {
+        Some((cause, fit, replay, propagated, candidate)) => {
             let extended = fit.description.clone();
-            (cause, Some(fit), extended, replay, propagated)
+            (cause, Some(fit), extended, replay, propagated, candidate)
         }
         None => (
             Cause::None,
             None,
             baseline.clone(),
             baseline_replay.clone(),
+            None,
             None,
         ),
     };
@@ -409,7 +414,23 @@ pub fn diagnose(
         edges,
         named_fit,
         propagated,
+        named_candidate,
     })
+}
+
+/// The fits' settings: the ranking is by the current's error, so the fits
+/// fit that (and z when measured), not the flux integrated from v − R·i,
+/// which a drifting resistance would corrupt.
+fn fit_options(options: &Options) -> FitOptions {
+    FitOptions {
+        max_iterations: options.max_iterations,
+        use_flux: false,
+        rtol: 1e-8,
+        fd_step: 1e-5,
+        ftol: 1e-5,
+        max_steps_per_sample: options.max_steps_per_sample,
+        ..FitOptions::default()
+    }
 }
 
 /// At most this many causes are named in one record. The hidden-effect
@@ -432,12 +453,15 @@ pub const MIN_STEP_GAIN: f64 = 0.2;
 /// named cause, strongest first; a single step when the first answer is
 /// `none` or its model already explains the record within the noise floor
 /// (no further fit is tried then). Causes that replace the same part of the
-/// model (a saturating and a Jiles–Atherton core) are not stacked.
+/// model (a saturating and a Jiles–Atherton core) are not stacked. With two
+/// causes or more, all of them are fitted again together ([`joint`]). The
+/// answer is `unexplained` where the last model leaves the residual well
+/// above the noise ([`unexplained`]).
 pub fn diagnose_causes(
     baseline: &Description,
     data: &Measured,
     options: &Options,
-) -> Result<Vec<Diagnosis>, DiagnoseError> {
+) -> Result<Causes, DiagnoseError> {
     let mut steps = vec![diagnose(baseline, data, options)?];
     while let Some(last) = steps.last() {
         let explained = last.whole.extended_wnrmse <= options.floor_factor * last.noise_floor;
@@ -461,7 +485,11 @@ pub fn diagnose_causes(
         }
         steps.push(next);
     }
-    Ok(steps)
+    if steps.len() > 1 {
+        joint::refit(&mut steps, data, &fit_options(options))?;
+    }
+    let residual = Residual::of(&steps[steps.len() - 1], data);
+    Ok(Causes { steps, residual })
 }
 
 /// Two causes that replace the same part of the model (the core).
@@ -540,141 +568,6 @@ fn hysteresis_starts(baseline: &Description, own: Candidate, ranking: &[Scored])
     std::iter::once(own).chain(seeded).collect()
 }
 
-/// How often the flux turns (φ̇ changes sign) while |φ| is above 10 % of its
-/// peak: a hysteresis loop shows only where the flux reverses at non-zero
-/// flux. Counted on the baseline's replay (noise-free), turns closer than 1 %
-/// of the peak to the last extremum ignored.
-fn flux_reversals(phi: &[f64]) -> usize {
-    let peak = peak_abs(phi);
-    let Some(&first) = phi.first() else {
-        return 0;
-    };
-    if !(peak > 0.0) {
-        return 0;
-    }
-    let tol = 0.01 * peak;
-    let (mut turns, mut direction, mut extreme) = (0, 0i8, first);
-    for &p in phi {
-        let turned = match direction {
-            0 => {
-                if (p - extreme).abs() >= tol {
-                    direction = if p > extreme { 1 } else { -1 };
-                    extreme = p;
-                }
-                false
-            }
-            1 if p > extreme => {
-                extreme = p;
-                false
-            }
-            -1 if p < extreme => {
-                extreme = p;
-                false
-            }
-            _ => (p - extreme).abs() >= tol,
-        };
-        if turned {
-            if extreme.abs() > 0.1 * peak {
-                turns += 1;
-            }
-            direction = -direction;
-            extreme = p;
-        }
-    }
-    turns
-}
-
-/// Fraction of the stroke the armature must cover for the gap to be seen at
-/// more than one length.
-const MOTION_FRACTION: f64 = 0.1;
-
-/// What the record must contain for `cause` to show, if it lacks it
-/// (decided from the data's own signals where it has them, else from the
-/// baseline's replay of them): a hysteresis needs flux reversals at non-zero
-/// flux (a λ–i loop), fringing a gap seen at several lengths (motion), a
-/// bounce an impact.
-fn record_lacks(
-    cause: Cause,
-    replay: &SimOutputs,
-    data: &Measured,
-    baseline: &Description,
-) -> Option<String> {
-    let m = &baseline.mechanics;
-    let stroke = m.z_max - m.z_min;
-    let z = data.z.as_deref().unwrap_or(&replay.z);
-    match cause {
-        Cause::Hysteresis if flux_reversals(&replay.phi) == 0 => Some(
-            "the record's flux never reverses at non-zero flux: there is no λ–i loop to tell a \
-             hysteretic core from a single-valued one"
-                .to_string(),
-        ),
-        Cause::Fringing if span(z) < MOTION_FRACTION * stroke => Some(format!(
-            "the armature moves over {:.1} % of the stroke only: the gap is seen at one length, \
-             where fringing is a change of the linear gap",
-            100.0 * span(z) / stroke
-        )),
-        Cause::Bouncing if impacts(replay, m.z_min, m.z_max).is_empty() => Some(
-            "the armature reaches no stop in the record: there is no impact to bounce".to_string(),
-        ),
-        _ => None,
-    }
-}
-
-/// max − min of the finite values.
-fn span(x: &[f64]) -> f64 {
-    let (lo, hi) = x
-        .iter()
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-            (a.min(v), b.max(v))
-        });
-    if hi >= lo {
-        hi - lo
-    } else {
-        0.0
-    }
-}
-
-/// The parameter whose null value means "no such effect", per cause: a loop
-/// width κ = 0 is no hysteresis, k_e = 0 no eddy currents, dR/dt = 0 no drift,
-/// γ = 0 no bounce, 1/φ_sat = 0 no saturation (same relative error as φ_sat).
-fn effect_parameter(cause: Cause) -> Option<&'static str> {
-    match cause {
-        Cause::Hysteresis => Some("core.kappa"),
-        Cause::EddyCurrents => Some("coil.eddy"),
-        Cause::ResistanceDrift => Some("coil.resistance_drift"),
-        Cause::Bouncing => Some("mechanics.restitution"),
-        Cause::Saturation => Some("core.phi_sat"),
-        Cause::Fringing | Cause::None => None,
-    }
-}
-
-/// Standard errors within which the effect parameter must stay clear of its
-/// null value (≈ a 95 % confidence interval).
-const IDENTIFIED_Z: f64 = 2.0;
-
-/// Why the record does not identify `cause`'s effect, if it does not: the
-/// effect parameter lies within `IDENTIFIED_Z` standard errors of its null
-/// value (linearised at the optimum, from the fit's Jacobian).
-fn unidentified(cause: Cause, fit: &FitReport) -> Option<String> {
-    let key = effect_parameter(cause)?;
-    let j = fit.values.iter().position(|(k, _)| k == key)?;
-    let value = fit.values[j].1;
-    let rel = fit.sensitivity.relative_std_errors.get(j).copied()?;
-    if rel.is_finite() && IDENTIFIED_Z * rel < 1.0 {
-        return None;
-    }
-    let null = if cause == Cause::Saturation {
-        "φ_sat = ∞ (no saturation)"
-    } else {
-        "0 (no such effect)"
-    };
-    Some(format!(
-        "{key} = {value:.4e} ± {:.2e}: its {IDENTIFIED_Z}-standard-error interval holds {null}",
-        value.abs() * rel
-    ))
-}
-
 /// The extensions that beat the baseline's own best (`none`) by BIC, best
 /// first, when the baseline's error stands clear of the noise floor.
 fn eligible(ranking: &[Scored], noise_floor: f64, floor_factor: f64) -> Vec<&Scored> {
@@ -745,11 +638,17 @@ impl Diagnosis {
     /// slightly are correlated over many samples, and carry τ_int times fewer
     /// independent samples than there are.
     fn residual_correlation_factor(&self, data: &Measured) -> f64 {
+        self.residual_correlation(data).sqrt()
+    }
+
+    /// τ_int of the |φ̇|-weighted current residual of the extended model over
+    /// the fitted samples [samples] (1: white).
+    pub fn residual_correlation(&self, data: &Measured) -> f64 {
         let k = self.fitted_samples.min(data.i.len());
         let r: Vec<f64> = (0..k)
             .map(|j| self.weights[j].sqrt() * (self.extended_replay.current[j] - data.i[j]))
             .collect();
-        integrated_autocorrelation(&r).sqrt()
+        integrated_autocorrelation(&r)
     }
 }
 
@@ -798,35 +697,4 @@ pub fn impacts(replay: &SimOutputs, z_min: f64, z_max: f64) -> Vec<f64> {
         .filter(|(w, _)| !near(w[0]) && near(w[1]))
         .map(|(_, t)| *t)
         .collect()
-}
-
-#[cfg(test)]
-mod reversal_tests {
-    use super::flux_reversals;
-
-    #[test]
-    fn reversals_count_turns_at_non_zero_flux_only() {
-        let step: Vec<f64> = (0..100).map(|k| 1.0 - (-(k as f64) / 10.0).exp()).collect();
-        assert_eq!(flux_reversals(&step), 0, "a step response never turns");
-        // a triangle wave between 0 and 1: turns at 1 count, turns at 0 do not
-        let triangle: Vec<f64> = (0..400)
-            .map(|k| {
-                let x = (k % 100) as f64 / 100.0;
-                if (k / 100) % 2 == 0 {
-                    x
-                } else {
-                    1.0 - x
-                }
-            })
-            .collect();
-        assert_eq!(
-            flux_reversals(&triangle),
-            2,
-            "two turns at the top, none at zero flux"
-        );
-        // a triangle between −1 and 1 turns at non-zero flux every time
-        let bipolar: Vec<f64> = triangle.iter().map(|x| 2.0 * x - 1.0).collect();
-        assert_eq!(flux_reversals(&bipolar), 3);
-        assert_eq!(flux_reversals(&[]), 0);
-    }
 }

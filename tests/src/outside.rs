@@ -1,0 +1,86 @@
+//! Data with an effect outside the measured-data vocabulary (issue 17 §2):
+//! what a bench or a valve does that no cause of `diagnose` represents, for
+//! tests that the answer is `unexplained` and not a vocabulary cause with a
+//! high gain. The measurement chain's effects go through
+//! [`hidden::experiment_through`]; a wrong spring changes the plant itself.
+
+use designer::description::parse_str;
+use reldesign_identify::diagnose::Cause;
+
+use crate::hidden::{
+    self, baseline, experiment_through, Chain, Excitation, HiddenCase, Noise, Sampling,
+};
+use crate::{example_path, Rng};
+
+/// An effect no extension of the vocabulary holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Outside {
+    /// The current probe reads this times the coil current.
+    ProbeGain(f64),
+    /// The driver applies the recorded voltage this late [s].
+    DriverDelay(f64),
+    /// The current probe lags by a first-order time constant [s].
+    ProbeLag(f64),
+    /// The spring (stiffness and preload) is this times the description's.
+    Spring(f64),
+}
+
+impl Outside {
+    /// The measurement chain the effect puts between plant and record.
+    fn chain(self) -> Chain {
+        match self {
+            Outside::ProbeGain(g) => Chain {
+                probe_gain: g,
+                ..Chain::IDEAL
+            },
+            Outside::DriverDelay(d) => Chain {
+                driver_delay: d,
+                ..Chain::IDEAL
+            },
+            Outside::ProbeLag(tau) => Chain {
+                probe_tau: tau,
+                ..Chain::IDEAL
+            },
+            Outside::Spring(_) => Chain::IDEAL,
+        }
+    }
+}
+
+/// The record of `examples/<example_file>`'s baseline with `effect` under
+/// `excitation` (sampled as [`hidden::hidden_case`] samples), reproducible
+/// from `seed`. Its `cause` is [`Cause::Unexplained`]; `drawn` is empty.
+pub fn outside_case(
+    example_file: &str,
+    effect: Outside,
+    excitation: &Excitation,
+    with_z: bool,
+    seed: u64,
+) -> HiddenCase {
+    let path = example_path(example_file);
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: cannot read: {e}", path.display()));
+    let mut case =
+        hidden::hidden_case_of(&text, example_file, Cause::None, excitation, with_z, seed);
+    let base = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
+    let mut truth = baseline(&base);
+    if let Outside::Spring(factor) = effect {
+        truth.mechanics.stiffness *= factor;
+        truth.mechanics.preload *= factor;
+    }
+    let mut rng = Rng::new(seed ^ 0x0075_1DE);
+    let sampling = Sampling::daq(&mut rng);
+    let noise = Noise::for_device(&base, excitation);
+    case.data_csv = experiment_through(
+        &truth,
+        excitation,
+        sampling,
+        noise,
+        with_z,
+        effect.chain(),
+        &mut rng,
+    );
+    case.truth = truth;
+    case.sampling = sampling;
+    case.cause = Cause::Unexplained;
+    case
+}
