@@ -192,6 +192,7 @@ fn diagnose_one(
             "unexplained".into(),
             unexplained_json(&answer, left.as_deref()),
         );
+        map.insert("recalibration".into(), recalibration_json(&answer));
         map.insert(
             "per_cause".into(),
             json!(per_cause
@@ -378,6 +379,7 @@ fn unexplained_json(answer: &Causes, left: Option<&str>) -> Value {
         "correlation_samples": answer.residual.correlation,
         "partial_causes": answer.partial().iter().map(|c| c.name()).collect::<Vec<_>>(),
         "partial_gain": answer.gain(),
+        "recalibrated": answer.recalibrated(),
         "localisation": left,
     })
 }
@@ -390,6 +392,25 @@ fn detail_title(answer: &Causes) -> String {
     }
 }
 
+/// `"recalibration"` of the JSON: the description refitted against the
+/// causes found (null where it was not tried).
+fn recalibration_json(answer: &Causes) -> Value {
+    let Some(r) = &answer.recalibration else {
+        return Value::Null;
+    };
+    let values: serde_json::Map<String, Value> = (r.values.iter())
+        .map(|(k, v)| (k.clone(), json!(v)))
+        .collect();
+    json!({
+        "values": values,
+        "wnrmse": r.wnrmse,
+        "bic": r.bic,
+        "causes_wnrmse": r.causes_wnrmse,
+        "causes_bic": r.causes_bic,
+        "explains": r.explains(),
+    })
+}
+
 /// The report's verdict for an unexplained record.
 fn unexplained_text(answer: &Causes, left: &str) -> String {
     let r = answer.residual;
@@ -399,9 +420,25 @@ fn unexplained_text(answer: &Causes, left: &str) -> String {
          over {:.0} samples); every cause of the vocabulary, alone or in pairs, leaves about 1× on \
          records it explains. Something outside the vocabulary is at work: a measurement chain \
          (probe gain or lag, driver delay), or parameters of the description (the spring, the \
-         mass) that no cause refits.\n",
+         mass, the reluctances) that no cause refits.\n",
         r.over_floor, r.correlation
     );
+    if let Some(r) = answer.recalibration.as_ref().filter(|r| r.explains()) {
+        let values: Vec<String> = (r.values.iter())
+            .map(|(k, v)| format!("{k} = {v:.4e}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "the description recalibrated ({}) explains it as well as the causes found \
+             (wNRMSE {} against {} on the fitted part, BIC {:.1} against {:.1}): a current probe's \
+             gain, or reluctances other than the description's, not an effect of the vocabulary.",
+            values.join(", "),
+            percent(r.wnrmse),
+            percent(r.causes_wnrmse),
+            r.bic,
+            r.causes_bic
+        );
+    }
     if partial.is_empty() {
         s.push_str("no extension of the vocabulary improves the record.\n");
     } else {

@@ -82,7 +82,7 @@ pub(super) fn refit(
 
 /// Every named cause's fitted parameters, a later step's bounds replacing
 /// an earlier one's for a key they share (the resistance).
-fn every_parameter(steps: &[Diagnosis]) -> Vec<FitParam> {
+pub(super) fn every_parameter(steps: &[Diagnosis]) -> Vec<FitParam> {
     let mut params: Vec<FitParam> = Vec::new();
     for c in steps.iter().filter_map(|s| s.named_candidate.as_ref()) {
         for p in &c.params {

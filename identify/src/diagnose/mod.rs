@@ -22,6 +22,7 @@ mod joint;
 pub mod localise;
 mod polish;
 pub mod rank;
+pub mod recalibration;
 pub mod unexplained;
 
 pub use candidate::{Candidate, NotApplicable, Scales};
@@ -489,7 +490,15 @@ pub fn diagnose_causes(
         joint::refit(&mut steps, data, &fit_options(options))?;
     }
     let residual = Residual::of(&steps[steps.len() - 1], data);
-    Ok(Causes { steps, residual })
+    // the causes found against a recalibration of the description
+    let recalibration = (steps[0].cause != Cause::None && !residual.unexplained())
+        .then(|| recalibration::check(baseline, &steps, data, &fit_options(options)))
+        .flatten();
+    Ok(Causes {
+        steps,
+        residual,
+        recalibration,
+    })
 }
 
 /// Two causes that replace the same part of the model (the core).

@@ -2,7 +2,9 @@
 //! above the noise after the best extension(s), so the discrepancy is
 //! something outside the vocabulary (a current probe's gain, a driver's
 //! delay, a wrong spring), and the causes the selection found explain part
-//! of it only: they are reported as partial, never named.
+//! of it only: they are reported as partial, never named. The same answer
+//! where the description recalibrated does as well as the causes found
+//! ([`super::recalibration`]).
 //!
 //! The test is the error left after the selection against the noise floor.
 //! Every vocabulary cause but hysteresis, alone or in pairs (fitted
@@ -14,6 +16,7 @@
 //! records of the description itself reach 71 samples at 1.2× the floor.
 //! Figures in `docs/validation/diagnose.md`.
 
+use super::recalibration::Recalibration;
 use super::{Cause, Diagnosis};
 use crate::Measured;
 
@@ -73,12 +76,23 @@ pub struct Causes {
     pub steps: Vec<Diagnosis>,
     /// What the last step's model leaves.
     pub residual: Residual,
+    /// The description recalibrated, against the causes found (None: no
+    /// cause found, the record already unexplained, or nothing to refit).
+    pub recalibration: Option<Recalibration>,
 }
 
 impl Causes {
-    /// Whether the record is `unexplained`.
+    /// Whether the record is `unexplained`: the residual left is well above
+    /// the noise, or a recalibration of the description does as well as the
+    /// causes found.
     pub fn unexplained(&self) -> bool {
-        self.residual.unexplained()
+        self.residual.unexplained() || self.recalibrated()
+    }
+
+    /// Whether a recalibration of the description explains the record as
+    /// well as the causes found.
+    pub fn recalibrated(&self) -> bool {
+        self.recalibration.as_ref().is_some_and(|r| r.explains())
     }
 
     /// The answer, strongest first: the named causes, `["none"]`, or
