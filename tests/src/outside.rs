@@ -10,7 +10,7 @@ use reldesign_identify::diagnose::Cause;
 use crate::hidden::{
     self, baseline, experiment_through, Chain, Excitation, HiddenCase, Noise, Sampling,
 };
-use crate::{example_path, Rng};
+use crate::Rng;
 
 /// An effect no extension of the vocabulary holds.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,11 +56,7 @@ pub fn outside_case(
     with_z: bool,
     seed: u64,
 ) -> HiddenCase {
-    let path = example_path(example_file);
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: cannot read: {e}", path.display()));
-    let mut case =
-        hidden::hidden_case_of(&text, example_file, Cause::None, excitation, with_z, seed);
+    let mut case = hidden::hidden_case(example_file, Cause::None, excitation, with_z, seed);
     let base = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
     let mut truth = baseline(&base);
     if let Outside::Spring(factor) = effect {

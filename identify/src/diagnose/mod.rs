@@ -453,7 +453,8 @@ pub const MIN_STEP_GAIN: f64 = 0.2;
 /// of the remaining error, and so on up to [`MOST_CAUSES`]. One step per
 /// named cause, strongest first; a single step when the first answer is
 /// `none` or its model already explains the record within the noise floor
-/// (no further fit is tried then). Causes that replace the same part of the
+/// (no further fit is tried then; with a Jiles–Atherton core, within the
+/// hysteretic threshold of [`unexplained`]). Causes that replace the same part of the
 /// model (a saturating and a Jiles–Atherton core) are not stacked. With two
 /// causes or more, all of them are fitted again together ([`joint`]). The
 /// answer is `unexplained` where the last model leaves the residual well
@@ -465,7 +466,12 @@ pub fn diagnose_causes(
 ) -> Result<Causes, DiagnoseError> {
     let mut steps = vec![diagnose(baseline, data, options)?];
     while let Some(last) = steps.last() {
-        let explained = last.whole.extended_wnrmse <= options.floor_factor * last.noise_floor;
+        // (a Jiles–Atherton fit stops at 4–5× the floor on records it
+        // explains: within the hysteretic threshold it counts as explained,
+        // else the selection stacks a cause that mops up its fit's error)
+        let left = Residual::of(last, data);
+        let explained = last.whole.extended_wnrmse <= options.floor_factor * last.noise_floor
+            || (left.hysteretic && !left.unexplained());
         if last.cause == Cause::None || explained || steps.len() >= MOST_CAUSES {
             break;
         }
