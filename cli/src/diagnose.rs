@@ -142,7 +142,7 @@ fn diagnose_one(
     let localisation = localisation(d, data, &d.baseline_replay);
     let outputs = Outputs::new(out, data_path);
     let named = if answer.unexplained() {
-        format!("unexplained; partial: {}", joined(&answer.partial(), " + "))
+        unexplained_label(&answer)
     } else {
         joined(&answer.names(), " + ")
     };
@@ -201,7 +201,7 @@ fn diagnose_one(
                     "cause": c.cause.name(),
                     "named": !answer.unexplained(),
                     "gain": c.gain,
-                    "identifiable": true,
+                    "identifiable": c.identifiable,
                     "why": c.why,
                     "at_bound": c.at_bound,
                     "values": c.values.iter().map(|p| (p.path.clone(), json!({
@@ -227,7 +227,7 @@ fn diagnose_one(
         head.push_str(&unexplained_text(&answer, left));
     }
     if steps.len() > 1 {
-        head.push_str(&steps_text(steps, overall));
+        head.push_str(&steps_text(&answer));
     }
     head.push_str(&per_cause_text(&per_cause, answer.unexplained()));
     if !head.is_empty() {
@@ -244,10 +244,11 @@ fn diagnose_one(
 
 /// The cause line of the step `d`'s report.
 fn verdict(answer: &Causes, d: &Diagnosis) -> String {
-    if answer.unexplained() && d.cause != Cause::None {
+    let partial = answer.partial();
+    if answer.unexplained() && !partial.is_empty() {
         format!(
-            "unexplained ({} explains part of it only: not named)",
-            d.cause
+            "unexplained ({} explain part of it only: not named)",
+            joined(&partial, " + ")
         )
     } else if answer.unexplained() {
         "unexplained".to_owned()
@@ -261,6 +262,9 @@ struct CauseReport<'a> {
     cause: Cause,
     /// Its step's gain over the model before it.
     gain: f64,
+    /// Whether its reported values still identify it (None: it has no effect
+    /// parameter, as fringing; it was identified by the record's motion).
+    identifiable: Option<bool>,
     /// Why the record identifies it (`evidence::why_identified`).
     why: String,
     /// Its own fitted values (the resistance, refitted by every step, left out).
@@ -276,7 +280,7 @@ fn per_cause<'a>(
     data: &Measured,
     description: &Description,
 ) -> Vec<CauseReport<'a>> {
-    use reldesign_identify::diagnose::evidence::why_identified;
+    use reldesign_identify::diagnose::evidence::{identified, why_identified};
     (answer.steps.iter())
         .filter(|s| s.cause != Cause::None)
         .map(|step| {
@@ -293,6 +297,7 @@ fn per_cause<'a>(
             CauseReport {
                 cause: step.cause,
                 gain: step.whole.gain,
+                identifiable: identified(step.cause, parameters),
                 why: why_identified(step, parameters, data, description),
                 values,
                 at_bound,
@@ -301,7 +306,7 @@ fn per_cause<'a>(
         .collect()
 }
 
-/// Whether `p` ended within 0.1 % of a bound of `step`'s search range: the
+/// Whether `p` ended within 0.1 % of `step`'s search range from a bound: the
 /// data want it beyond what the fit allows, a sign the cause stands in for
 /// something else.
 fn on_bound(step: &Diagnosis, p: &FittedParameter) -> bool {
@@ -310,7 +315,7 @@ fn on_bound(step: &Diagnosis, p: &FittedParameter) -> bool {
     else {
         return false;
     };
-    let near = |b: f64| (p.value - b).abs() <= 1e-3 * b.abs().max(f64::MIN_POSITIVE);
+    let near = |b: f64| (p.value - b).abs() <= 1e-3 * (range.upper - range.lower);
     near(range.lower) || near(range.upper)
 }
 
@@ -331,9 +336,13 @@ fn per_cause_text(causes: &[CauseReport], unexplained: bool) -> String {
     for c in causes {
         let _ = writeln!(
             s,
-            "  {}: gain {} over the model before it\n    identifiable: {}",
+            "  {}: gain {} over the model before it\n    {}: {}",
             c.cause.name(),
             percent(c.gain),
+            match c.identifiable {
+                Some(false) => "NOT identifiable by its reported values",
+                _ => "identifiable",
+            },
             c.why
         );
         for p in &c.values {
@@ -351,6 +360,14 @@ fn per_cause_text(causes: &[CauseReport], unexplained: bool) -> String {
         }
     }
     s
+}
+
+/// "unexplained", with the partial causes where there are any.
+fn unexplained_label(answer: &Causes) -> String {
+    match answer.partial() {
+        partial if partial.is_empty() => "unexplained".to_owned(),
+        partial => format!("unexplained; partial: {}", joined(&partial, " + ")),
+    }
 }
 
 /// The answer's first entry.
@@ -417,8 +434,9 @@ fn unexplained_text(answer: &Causes, left: &str) -> String {
     let partial = answer.partial();
     let mut s = format!(
         "answer: unexplained. The model leaves {:.1}× the noise floor (its residual correlated \
-         over {:.0} samples); every cause of the vocabulary, alone or in pairs, leaves about 1× on \
-         records it explains. Something outside the vocabulary is at work: a measurement chain \
+         over {:.0} samples), or a recalibration of the description does as well as the causes \
+         found; the causes of the vocabulary leave about 1× on the records they explain (a \
+         Jiles–Atherton fit 4–5×). Something outside the vocabulary is at work: a measurement chain \
          (probe gain or lag, driver delay), or parameters of the description (the spring, the \
          mass, the reluctances) that no cause refits.\n",
         r.over_floor, r.correlation
@@ -460,10 +478,15 @@ fn unexplained_text(answer: &Causes, left: &str) -> String {
 
 /// The head of a report with several causes: the causes, each step's gain,
 /// the whole selection's; the last step's report follows in detail.
-fn steps_text(steps: &[Diagnosis], overall: f64) -> String {
+fn steps_text(answer: &Causes) -> String {
+    let (steps, overall) = (&answer.steps, answer.gain());
+    let together = if answer.fitted_together {
+        ", then all fitted together; the last step's figures are the joint fit's"
+    } else {
+        ""
+    };
     let mut s = format!(
-        "causes found: {} (strongest first; each fitted on top of the ones before, then all \
-         fitted together)\n",
+        "causes found: {} (strongest first; each fitted on top of the ones before{together})\n",
         steps
             .iter()
             .map(|s| s.cause.name())
@@ -607,10 +630,7 @@ fn extended_toml(
     let source = &description.source;
     let text = write_physics(&source.text, &source.file_name, &d.extended).map_err(fail)?;
     let cause = if answer.unexplained() {
-        format!(
-            "unexplained (partial: {})",
-            joined(&answer.partial(), " + ")
-        )
+        unexplained_label(answer)
     } else {
         joined(&answer.names(), " + ")
     };

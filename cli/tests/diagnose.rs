@@ -565,7 +565,7 @@ fn several_causes_are_named_strongest_first() {
 /// a current probe reading 8 % high or low, a driver 120 µs late, a probe
 /// lagging by 100 µs, a spring 30 % stiffer or softer. Each is answered
 /// `unexplained` (no cause of the vocabulary named, whatever part of the
-/// error one of them absorbs: fringing takes 44–95 % of these), with the
+/// error one of them absorbs: fringing takes 37–96 % of these), with the
 /// partial causes, their gain and where the residual left concentrates.
 /// Seeds apart from the ones the thresholds were read from.
 #[test]
@@ -599,16 +599,20 @@ fn effects_outside_the_vocabulary_are_unexplained() {
         assert_eq!(m["cause"], "unexplained", "{what}");
         assert_eq!(m["causes"], serde_json::json!(["unexplained"]), "{what}");
         let u = &m["unexplained"];
+        // which test decides it: the probe 8 % low leaves less than the
+        // threshold and is caught by the recalibration alone
         let left = u["over_noise_floor"].as_f64().unwrap();
         let recalibrated = u["recalibrated"].as_bool().unwrap();
-        assert!(
-            left > reldesign_identify::diagnose::unexplained::OVER_FLOOR || recalibrated,
-            "{what}"
-        );
+        let over = left > reldesign_identify::diagnose::unexplained::OVER_FLOOR;
+        assert_eq!((over, recalibrated), (seed != 87, seed == 87), "{what}");
         if recalibrated {
             let r = &m["recalibration"];
-            assert!(r["explains"].as_bool().unwrap(), "{what}");
-            assert!(r["bic"].as_f64() <= r["causes_bic"].as_f64(), "{what}");
+            let bic = |k: &str| r[k].as_f64().unwrap();
+            assert!(bic("bic") <= bic("causes_bic"), "{what}");
+            assert!(
+                r["values"]["coil.resistance"].as_f64().unwrap() > 0.0,
+                "{what}"
+            );
         }
         let partial_gain = u["partial_gain"].as_f64().unwrap();
         assert!((partial_gain - number(&m, "gain")).abs() < 1e-12, "{what}");

@@ -63,7 +63,7 @@ fn run(subject: &Subject, period: f64, edges: Edges, seed: u64) -> (Diagnosis, R
     let record = Record::parse(&csv, "data.csv").unwrap_or_else(|e| panic!("{e}"));
     let data = Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
     let d = diagnose(&desc, &data, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
-    let left = Residual::of(&d, &data);
+    let left = Residual::of(std::slice::from_ref(&d), &data);
     let summary = format!(
         "{} Δ={:.0} µs {edges:?} seed={seed}: {} (gain {:.1} %, baseline {:.3} %, floor {:.3} %, \
          left {:.2}× the floor correlated over {:.1} samples; ranking {})",

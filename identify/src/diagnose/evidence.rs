@@ -118,7 +118,7 @@ pub fn effect_parameter(cause: Cause) -> Option<&'static str> {
 
 /// Standard errors within which the effect parameter must stay clear of its
 /// null value (≈ a 95 % confidence interval).
-const IDENTIFIED_Z: f64 = 2.0;
+pub const IDENTIFIED_Z: f64 = 2.0;
 
 /// Why the record does not identify `cause`'s effect, if it does not: the
 /// effect parameter lies within `IDENTIFIED_Z` standard errors of its null
@@ -158,6 +158,17 @@ pub fn why_identified(
     }
 }
 
+/// Whether the reported values still identify `cause`: its effect parameter
+/// more than [`IDENTIFIED_Z`] standard errors from "no effect" (None: the
+/// cause has no such parameter, e.g. fringing, or it is not reported). The
+/// ranking checked the same on its fit; the values reported come after the
+/// polish and the joint fit, with widened standard errors.
+pub fn identified(cause: Cause, parameters: &[FittedParameter]) -> Option<bool> {
+    let key = effect_parameter(cause)?;
+    let p = parameters.iter().find(|p| p.path == key)?;
+    Some(p.value.abs() > IDENTIFIED_Z * p.std_error)
+}
+
 /// What the record shows of `step.cause`'s effect.
 fn record_shows(step: &Diagnosis, data: &Measured, baseline: &Description) -> String {
     let replay = &step.baseline_replay;
@@ -179,7 +190,11 @@ fn record_shows(step: &Diagnosis, data: &Measured, baseline: &Description) -> St
         ),
         Cause::EddyCurrents => format!(
             "{} voltage steps, each followed by the current's transient",
-            step.edges.len().max(voltage_steps(&data.v))
+            if step.edges.is_empty() {
+                voltage_steps(&data.v)
+            } else {
+                step.edges.len()
+            }
         ),
         Cause::Saturation => match step.extended.core {
             Core::Saturating { phi_sat, .. } => format!(
@@ -189,9 +204,9 @@ fn record_shows(step: &Diagnosis, data: &Measured, baseline: &Description) -> St
             _ => "the flux reaches the core's saturation".to_owned(),
         },
         Cause::ResistanceDrift => format!(
-            "the record lasts {:.3} s with {} steady intervals of the current to compare",
+            "the record lasts {:.3} s over {} voltage steps (the current's level from step to step)",
             data.t.last().copied().unwrap_or(0.0) - data.t.first().copied().unwrap_or(0.0),
-            voltage_steps(&data.v) + 1
+            voltage_steps(&data.v)
         ),
         Cause::None | Cause::Unexplained => String::new(),
     }

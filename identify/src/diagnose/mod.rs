@@ -469,9 +469,10 @@ pub fn diagnose_causes(
         // (a Jiles–Atherton fit stops at 4–5× the floor on records it
         // explains: within the hysteretic threshold it counts as explained,
         // else the selection stacks a cause that mops up its fit's error)
-        let left = Residual::of(last, data);
         let explained = last.whole.extended_wnrmse <= options.floor_factor * last.noise_floor
-            || (left.hysteretic && !left.unexplained());
+            || (unexplained::hysteresis_fitted(&steps)
+                && last.whole.extended_wnrmse
+                    <= unexplained::OVER_FLOOR_HYSTERESIS * last.noise_floor);
         if last.cause == Cause::None || explained || steps.len() >= MOST_CAUSES {
             break;
         }
@@ -492,16 +493,15 @@ pub fn diagnose_causes(
         }
         steps.push(next);
     }
-    if steps.len() > 1 {
-        joint::refit(&mut steps, data, &fit_options(options))?;
-    }
-    let residual = Residual::of(&steps[steps.len() - 1], data);
+    let fitted_together = steps.len() > 1 && joint::refit(&mut steps, data, &fit_options(options));
+    let residual = Residual::of(&steps, data);
     // the causes found against a recalibration of the description
     let recalibration = (steps[0].cause != Cause::None && !residual.unexplained())
         .then(|| recalibration::check(baseline, &steps, data, &fit_options(options)))
         .flatten();
     Ok(Causes {
         steps,
+        fitted_together,
         residual,
         recalibration,
     })

@@ -2,11 +2,13 @@
 //! and resistance refitted. A current probe reading 8 % low, or reluctances
 //! other than the description's, look to the replay like a change of the
 //! magnetic circuit's scale: v = (R/g)·i_m + N·φ̇ with φ = N·i_m/(g·ℛ(z)),
-//! for a probe gain g. A McLyman gap, free in its area, its winding length
-//! and the core's reluctance, absorbs that with a gain of 95 % and leaves
-//! 2.6× the noise floor, under the `unexplained` threshold. So once causes
-//! are found, the baseline with its gap's and core's reluctances and R
-//! refitted is fitted too; where it does as well by BIC as the causes
+//! for a probe gain g, and the force ½φ²ℛ′ scales with ℛ (so the spring
+//! and the mass do too, for the same motion). A McLyman gap, free in its
+//! area, its winding length and the core's reluctance, absorbs that with a
+//! gain of 95 % and leaves 2.2–2.9× the noise floor, under the
+//! `unexplained` threshold. So once causes are found, the description with
+//! R, its gap's and core's reluctances, the mass, the stiffness and the
+//! preload free is fitted too; where it does as well by BIC as the causes
 //! found, the causes are not needed beyond a recalibration, and the record
 //! is `unexplained`. A true cause changes the shape of ℛ(z) or of the
 //! response (saturation, eddy currents, a bounce), which no rescaling
@@ -69,17 +71,31 @@ pub(super) fn check(
     };
     let placed = fit(baseline, &on_edges(first.edges.clone()))?;
     let own = crate::edges::located(&placed.description, data);
-    let recalibrated = fit(&placed.description, &on_edges(own))?;
+    let recalibrated = fit(&placed.description, &on_edges(own))?.description;
+    // both measured alike: each model on the edges it places itself, the
+    // diagnosis's |φ̇| weights (a fit weighs by its own start's R)
+    let replay = crate::simulate_outputs(
+        &recalibrated,
+        &on_edges(crate::edges::located(&recalibrated, data)),
+    )
+    .ok()?;
     let weights = &first.weights[..k];
     let n_eff = rank::effective_samples(weights);
-    let causes_wnrmse = crate::wnrmse(&last.extended_replay.current[..k], &data.i[..k], weights);
-    let causes_parameters = joint::every_parameter(steps).len();
+    let error = |current: &[f64]| crate::wnrmse(&current[..k], &data.i[..k], weights);
+    let (wnrmse, causes_wnrmse) = (error(&replay.current), error(&last.extended_replay.current));
     Some(Recalibration {
-        values: recalibrated.values.clone(),
-        wnrmse: recalibrated.wnrmse_current,
-        bic: rank::bic(recalibrated.wnrmse_current, params.len(), n_eff),
+        values: (params.iter())
+            .filter_map(|p| {
+                Some((
+                    p.path.clone(),
+                    crate::params::get(&recalibrated, &p.path).ok()?,
+                ))
+            })
+            .collect(),
+        wnrmse,
+        bic: rank::bic(wnrmse, params.len(), n_eff),
         causes_wnrmse,
-        causes_bic: rank::bic(causes_wnrmse, causes_parameters, n_eff),
+        causes_bic: rank::bic(causes_wnrmse, joint::every_parameter(steps).len(), n_eff),
     })
 }
 
