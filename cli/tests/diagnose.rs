@@ -39,11 +39,14 @@ const RECOVERY_TOLERANCE: f64 = 0.1;
 /// The SEMERA valve's case for `cause`: three square-wave cycles, 40 µs
 /// sampling, σ_v = 15 mV, σ_i = 1 mA, no `z` column.
 fn semera_case(cause: Cause, seed: u64) -> HiddenCase {
-    let path = example_path(EXAMPLE);
-    let text = std::fs::read_to_string(&path).unwrap();
-    let desc = parse_str(&text, EXAMPLE).unwrap_or_else(|e| panic!("{e}"));
-    let excitation = Excitation::square_wave(&baseline(&desc));
-    hidden_case(EXAMPLE, cause, &excitation, false, seed)
+    hidden_case(EXAMPLE, cause, &square_wave(EXAMPLE), false, seed)
+}
+
+/// The square wave the generator makes of `example`'s baseline.
+fn square_wave(example: &str) -> Excitation {
+    let text = std::fs::read_to_string(example_path(example)).unwrap();
+    let desc = parse_str(&text, example).unwrap_or_else(|e| panic!("{e}"));
+    Excitation::square_wave(&baseline(&desc))
 }
 
 /// The drawn value of `key` in a case.
@@ -477,9 +480,7 @@ fn several_causes_are_named_strongest_first() {
         ),
     ];
     for (example, with_z, pair, seed) in cases {
-        let text = std::fs::read_to_string(example_path(example)).unwrap();
-        let desc = parse_str(&text, example).unwrap_or_else(|e| panic!("{e}"));
-        let excitation = Excitation::square_wave(&baseline(&desc));
+        let excitation = square_wave(example);
         let case = hidden_pair(example, pair, &excitation, with_z, seed);
         let dir = TempDir::new("pair");
         let (model, data) = write_case(dir.path(), &case);
@@ -532,13 +533,7 @@ fn several_causes_are_named_strongest_first() {
     let case = hidden_pair(
         EXAMPLE,
         [Cause::EddyCurrents, Cause::ResistanceDrift],
-        &Excitation::square_wave(&baseline(
-            &parse_str(
-                &std::fs::read_to_string(example_path(EXAMPLE)).unwrap(),
-                EXAMPLE,
-            )
-            .unwrap(),
-        )),
+        &square_wave(EXAMPLE),
         false,
         71,
     );
@@ -582,9 +577,7 @@ fn effects_outside_the_vocabulary_are_unexplained() {
         (TRACKING, Outside::ProbeGain(0.92), false, 87),
     ];
     for (k, (example, effect, with_z, seed)) in cases.into_iter().enumerate() {
-        let text = std::fs::read_to_string(example_path(example)).unwrap();
-        let desc = parse_str(&text, example).unwrap_or_else(|e| panic!("{e}"));
-        let excitation = Excitation::square_wave(&baseline(&desc));
+        let excitation = square_wave(example);
         let case = outside_case(example, effect, &excitation, with_z, seed);
         let dir = TempDir::new("outside");
         let (model, data) = write_case(dir.path(), &case);
@@ -626,9 +619,7 @@ fn effects_outside_the_vocabulary_are_unexplained() {
         checked_model(&PathBuf::from(m["extended_model"].as_str().unwrap()));
     }
     // the text report says so, and names no cause
-    let text = std::fs::read_to_string(example_path(EXAMPLE)).unwrap();
-    let desc = parse_str(&text, EXAMPLE).unwrap_or_else(|e| panic!("{e}"));
-    let excitation = Excitation::square_wave(&baseline(&desc));
+    let excitation = square_wave(EXAMPLE);
     let case = outside_case(
         EXAMPLE,
         Outside::DriverDelay(120e-6),

@@ -499,7 +499,13 @@ pub fn diagnose_causes(
     let recalibration = (steps[0].cause != Cause::None && !residual.unexplained())
         .then(|| recalibration::check(baseline, &steps, data, &fit_options(options)))
         .flatten();
+    let (first, last) = (&steps[0], &steps[steps.len() - 1]);
+    let whole = Gain::new(
+        first.whole.baseline_wnrmse,
+        wnrmse(&last.extended_replay.current, &data.i, &first.weights),
+    );
     Ok(Causes {
+        whole,
         steps,
         fitted_together,
         residual,

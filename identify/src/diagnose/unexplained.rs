@@ -19,7 +19,7 @@
 //! `docs/validation/diagnose.md`.
 
 use super::recalibration::Recalibration;
-use super::{Cause, Diagnosis};
+use super::{Cause, Diagnosis, Gain};
 use crate::Measured;
 
 /// The error left after the selection, against the noise.
@@ -99,6 +99,10 @@ pub struct Causes {
     /// Whether the causes were fitted together ([`super::joint`]: not with a
     /// Jiles–Atherton core, nor where it did not lower the error).
     pub fitted_together: bool,
+    /// The original baseline against the model with every cause, on the
+    /// whole record, both weighted as the first step weighs (by the
+    /// description's R: a later step weighs by its own baseline's refitted R).
+    pub whole: Gain,
     /// What the last step's model leaves.
     pub residual: Residual,
     /// The description recalibrated, against the causes found (None: no
@@ -153,11 +157,6 @@ impl Causes {
     /// 1 − (the last model's error)/(the original baseline's), on the whole
     /// record.
     pub fn gain(&self) -> f64 {
-        let base = self.first().whole.baseline_wnrmse;
-        if base > 0.0 {
-            1.0 - self.last().whole.extended_wnrmse / base
-        } else {
-            0.0
-        }
+        self.whole.gain
     }
 }
