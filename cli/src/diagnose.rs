@@ -435,8 +435,8 @@ fn unexplained_text(answer: &Causes, left: &str) -> String {
     let mut s = format!(
         "answer: unexplained. The model leaves {:.1}× the noise floor (its residual correlated \
          over {:.0} samples), or a recalibration of the description does as well as the causes \
-         found; the causes of the vocabulary leave about 1× on the records they explain (a \
-         Jiles–Atherton fit 4–5×). Something outside the vocabulary is at work: a measurement chain \
+         found; the causes of the vocabulary leave 1–4× on the records they explain. Something \
+         outside the vocabulary is at work: a measurement chain \
          (probe gain or lag, driver delay), or parameters of the description (the spring, the \
          mass, the reluctances) that no cause refits.\n",
         r.over_floor, r.correlation

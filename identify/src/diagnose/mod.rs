@@ -466,9 +466,10 @@ pub fn diagnose_causes(
 ) -> Result<Causes, DiagnoseError> {
     let mut steps = vec![diagnose(baseline, data, options)?];
     while let Some(last) = steps.last() {
-        // (a Jiles–Atherton fit stops at 4–5× the floor on records it
+        // (a Jiles–Atherton fit stops at up to 3.9× the floor on records it
         // explains: within the hysteretic threshold it counts as explained,
-        // else the selection stacks a cause that mops up its fit's error)
+        // else the selection stacks a cause that mops up its fit's error;
+        // the long hysteresis benchmark record came out hysteresis + fringing)
         let explained = last.whole.extended_wnrmse <= options.floor_factor * last.noise_floor
             || (unexplained::hysteresis_fitted(&steps)
                 && last.whole.extended_wnrmse

@@ -9,6 +9,7 @@
 //! The test is the error left after the selection against the noise floor.
 //! A vocabulary cause other than hysteresis, alone or in pairs (fitted
 //! jointly), leaves 0.9–1.1× the floor where its fit reaches the truth
+//! (hysteresis 0.95–3.9×: [`OVER_FLOOR_HYSTERESIS`])
 //! (5 of 105 generated-device records, whose fit stops far from it, leave
 //! 7–44× and are answered `unexplained`); records of the description itself
 //! leave up to 3.07× (a saturated relay sampled at 7 µs); effects outside
@@ -38,10 +39,11 @@ pub struct Residual {
 
 /// Left above this many floors, the record is unexplained.
 pub const OVER_FLOOR: f64 = 3.5;
-/// Where a step fitted a Jiles–Atherton core, the threshold instead:
-/// its fit is not polished (a finite-difference Jacobian) and stops at
-/// 4.4–5.4× the floor on hidden-hysteresis records it explains (98 % gain).
-pub const OVER_FLOOR_HYSTERESIS: f64 = 10.0;
+/// Where a step fitted a Jiles–Atherton core, the threshold instead: its
+/// fit, polished at the ranking's integration only (a finite-difference
+/// Jacobian), leaves 0.95–3.9× the floor on the 25 hidden-hysteresis
+/// records it names in the validation matrices.
+pub const OVER_FLOOR_HYSTERESIS: f64 = 6.0;
 
 impl Residual {
     /// The residual the last of `steps` leaves on `data`. Its ratio to the
@@ -77,7 +79,7 @@ impl Residual {
     }
 }
 
-/// Whether a step fitted a Jiles–Atherton core (its fit is not polished).
+/// Whether a step fitted a Jiles–Atherton core (its fit is polished less).
 pub fn hysteresis_fitted(steps: &[Diagnosis]) -> bool {
     steps.iter().any(|s| s.cause == Cause::Hysteresis)
 }
