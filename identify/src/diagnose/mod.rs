@@ -29,8 +29,6 @@ pub use candidate::{Candidate, NotApplicable, Scales};
 pub use cause::Cause;
 pub use unexplained::{Causes, Residual};
 
-use rayon::prelude::*;
-
 use crate::description::Description;
 use crate::edges::Edge;
 use crate::{flux_rate_weights, wnrmse, FitError, FitOptions, FitReport, Measured, SimOutputs};
@@ -275,25 +273,16 @@ pub fn diagnose(
     };
     let (candidates, not_applicable) = candidates(baseline, &options.causes, scales);
     let fit_options = fit_options(options);
-    // Jiles–Atherton fits cost most and are not convex: fit the rest first,
-    // then the hysteresis candidate from two starts at once, one of them the
-    // fitted saturating core.
+    // Jiles–Atherton fits cost most and are not convex: the hysteresis
+    // candidate is fitted from two starts, its own and the fitted saturating
+    // core, the second as soon as the saturation fit ends (not after every
+    // other fit: the cores stay busy).
     let all_candidates = candidates.clone();
     let (hysteresis, others): (Vec<Candidate>, Vec<Candidate>) = candidates
         .into_iter()
         .partition(|c| c.cause == Cause::Hysteresis);
-    let mut ranking: Vec<Scored> = others
-        .par_iter()
-        .map(|c| score(c, &fit_data, &fit_options, n_eff))
-        .collect();
-    if let Some(first) = hysteresis.into_iter().next() {
-        let starts = hysteresis_starts(baseline, first, &ranking);
-        let best = starts
-            .par_iter()
-            .map(|c| score(c, &fit_data, &fit_options, n_eff))
-            .min_by(|a, b| a.bic.total_cmp(&b.bic));
-        ranking.extend(best);
-    }
+    let fit_one = |c: &Candidate| score(c, &fit_data, &fit_options, n_eff);
+    let mut ranking = fit_all(baseline, &others, hysteresis.first(), &fit_one);
     ranking.sort_by(|a, b| a.bic.total_cmp(&b.bic).then(a.cause.cmp(&b.cause)));
 
     // The best candidate that beats `none` and does not lose on the
@@ -578,16 +567,60 @@ fn score(c: &Candidate, data: &Measured, options: &FitOptions, n_eff: f64) -> Sc
     }
 }
 
-/// The hysteresis candidate's starts: its own, and one from the fitted
-/// saturating core when there is one (the saturation fit finds the flux
-/// scale reliably; the Jiles–Atherton objective has local minima).
-fn hysteresis_starts(baseline: &Description, own: Candidate, ranking: &[Scored]) -> Vec<Candidate> {
-    let seeded = ranking
-        .iter()
-        .find(|s| s.cause == Cause::Saturation)
-        .and_then(|s| s.fit.as_ref().ok())
-        .and_then(|f| candidate::hysteresis_from_saturation(baseline, &f.description));
-    std::iter::once(own).chain(seeded).collect()
+/// Every candidate of `others` fitted and scored by `fit`, in parallel,
+/// and the hysteresis candidate (`hysteresis`) from two starts: its own,
+/// and one from the fitted saturating core, spawned as soon as that fit ends
+/// (the saturation fit finds the flux scale reliably; the Jiles–Atherton
+/// objective has local minima). The better hysteresis start is kept (the
+/// own one on a tie). The order of the result is not meaningful.
+fn fit_all(
+    baseline: &Description,
+    others: &[Candidate],
+    hysteresis: Option<&Candidate>,
+    fit: &(dyn Fn(&Candidate) -> Scored + Sync),
+) -> Vec<Scored> {
+    use std::sync::Mutex;
+    let push = |to: &Mutex<Vec<(usize, Scored)>>, item: (usize, Scored)| {
+        if let Ok(mut v) = to.lock() {
+            v.push(item);
+        }
+    };
+    let scored = Mutex::new(Vec::new());
+    let starts = Mutex::new(Vec::new());
+    rayon::scope(|s| {
+        if let Some(own) = hysteresis {
+            s.spawn(|_| push(&starts, (0, fit(own))));
+        }
+        for (k, c) in others.iter().enumerate() {
+            let (scored, starts, push) = (&scored, &starts, &push);
+            s.spawn(move |s| {
+                let result = fit(c);
+                let seeded = (hysteresis.is_some() && c.cause == Cause::Saturation)
+                    .then(|| result.fit.as_ref().ok())
+                    .flatten()
+                    .and_then(|f| candidate::hysteresis_from_saturation(baseline, &f.description));
+                if let Some(seeded) = seeded {
+                    s.spawn(move |_| push(starts, (1, fit(&seeded))));
+                }
+                push(scored, (k, result));
+            });
+        }
+    });
+    let mut ranking: Vec<Scored> = (scored.into_inner().unwrap_or_default())
+        .into_iter()
+        .map(|(_, s)| s)
+        .collect();
+    let mut starts = starts.into_inner().unwrap_or_default();
+    starts.sort_by_key(|(k, _)| *k);
+    let best = (starts.into_iter().map(|(_, s)| s)).reduce(|best, s| {
+        if s.bic.total_cmp(&best.bic).is_lt() {
+            s
+        } else {
+            best
+        }
+    });
+    ranking.extend(best);
+    ranking
 }
 
 /// The extensions that beat the baseline's own best (`none`) by BIC, best
