@@ -754,9 +754,7 @@ pub fn hidden_case(
     with_z: bool,
     seed: u64,
 ) -> HiddenCase {
-    let path = example_path(example_file);
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: cannot read: {e}", path.display()));
+    let text = example_text(example_file);
     hidden_case_of(&text, example_file, cause, excitation, with_z, seed)
 }
 
@@ -783,13 +781,7 @@ fn case_of(
     with_z: bool,
     seed: u64,
 ) -> HiddenCase {
-    // a bench recording needs no controller; the truth (a Jiles–Atherton core,
-    // say) may not admit the design's [trajectory]
-    let text = &support::without_design_sections(text);
-    let desc = parse_str(text, file_name).unwrap_or_else(|e| panic!("{e}"));
-    let base = baseline(&desc);
-    let baseline_toml = write_physics(text, file_name, &base)
-        .unwrap_or_else(|e| panic!("writing the baseline: {e}"));
+    let (base, baseline_toml) = baseline_of(text, file_name);
     let mut rng = Rng::new(seed);
     let mut truth = base.clone();
     let mut drawn = Vec::new();
@@ -812,6 +804,19 @@ fn case_of(
     }
 }
 
+/// The description `text`'s [`baseline`], and as TOML: the text rewritten
+/// (comments kept), its design sections left out (a bench recording needs
+/// no controller; a truth such as a Jiles–Atherton core may not admit the
+/// design's [trajectory]).
+pub fn baseline_of(text: &str, file_name: &str) -> (Description, String) {
+    let text = &support::without_design_sections(text);
+    let desc = parse_str(text, file_name).unwrap_or_else(|e| panic!("{e}"));
+    let base = baseline(&desc);
+    let toml = write_physics(text, file_name, &base)
+        .unwrap_or_else(|e| panic!("writing the baseline: {e}"));
+    (base, toml)
+}
+
 /// [`hidden_case`] with two effects at once (issue 17 §1): `causes[0]`'s
 /// extension drawn on the baseline, then `causes[1]`'s on top of it; the
 /// case's `cause` is the first, `drawn` holds both draws.
@@ -822,10 +827,15 @@ pub fn hidden_pair(
     with_z: bool,
     seed: u64,
 ) -> HiddenCase {
-    let path = example_path(example_file);
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: cannot read: {e}", path.display()));
+    let text = example_text(example_file);
     case_of(&text, example_file, &causes, excitation, with_z, seed)
+}
+
+/// The text of `examples/<example_file>`.
+pub fn example_text(example_file: &str) -> String {
+    let path = example_path(example_file);
+    std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: cannot read: {e}", path.display()))
 }
 
 /// Writes `baseline.toml` and `data.csv` into `dir` (created if needed).

@@ -4,12 +4,9 @@
 //! high gain. The measurement chain's effects go through
 //! [`hidden::experiment_through`]; a wrong spring changes the plant itself.
 
-use designer::description::parse_str;
 use reldesign_identify::diagnose::Cause;
 
-use crate::hidden::{
-    self, baseline, experiment_through, Chain, Excitation, HiddenCase, Noise, Sampling,
-};
+use crate::hidden::{self, experiment_through, Chain, Excitation, HiddenCase, Noise, Sampling};
 use crate::Rng;
 
 /// An effect no extension of the vocabulary holds.
@@ -56,9 +53,9 @@ pub fn outside_case(
     with_z: bool,
     seed: u64,
 ) -> HiddenCase {
-    let mut case = hidden::hidden_case(example_file, Cause::None, excitation, with_z, seed);
-    let base = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
-    let mut truth = baseline(&base);
+    let (base, baseline_toml) =
+        hidden::baseline_of(&hidden::example_text(example_file), example_file);
+    let mut truth = base.clone();
     if let Outside::Spring(factor) = effect {
         truth.mechanics.stiffness *= factor;
         truth.mechanics.preload *= factor;
@@ -66,7 +63,7 @@ pub fn outside_case(
     let mut rng = Rng::new(seed ^ 0x0075_1DE);
     let sampling = Sampling::daq(&mut rng);
     let noise = Noise::for_device(&base, excitation);
-    case.data_csv = experiment_through(
+    let data_csv = experiment_through(
         &truth,
         excitation,
         sampling,
@@ -75,8 +72,13 @@ pub fn outside_case(
         effect.chain(),
         &mut rng,
     );
-    case.truth = truth;
-    case.sampling = sampling;
-    case.cause = Cause::Unexplained;
-    case
+    HiddenCase {
+        baseline_toml,
+        data_csv,
+        cause: Cause::Unexplained,
+        drawn: Vec::new(),
+        truth,
+        sampling,
+        excitation: *excitation,
+    }
 }
