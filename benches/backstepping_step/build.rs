@@ -14,7 +14,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use designer::backstepping_loop::{run_backstepping, Mode};
+use designer::backstepping_loop::run_backstepping;
 use designer::closed_loop::Noise;
 use designer::description::{parse_file, SetPoint};
 use designer::design::Design;
@@ -22,15 +22,6 @@ use designer::sim::Options;
 
 const TS: f64 = 1e-5;
 const RECORD: usize = 1001;
-
-fn mode_index(m: Mode) -> u8 {
-    match m {
-        Mode::Start => 0,
-        Mode::Approaching => 1,
-        Mode::Waiting => 2,
-        Mode::Inside => 3,
-    }
-}
 
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
@@ -93,13 +84,7 @@ fn main() {
             row[0], row[1], row[2], row[3], row[4]
         )
         .unwrap();
-        writeln!(
-            loop_text,
-            "    ({:?}, {}),",
-            tr.u[k],
-            mode_index(run.modes[k])
-        )
-        .unwrap();
+        writeln!(loop_text, "    ({:?}, {}),", tr.u[k], run.modes[k] as u8).unwrap();
     }
     text.push_str("];\n");
     loop_text.push_str("];\n");

@@ -85,17 +85,18 @@ pub trait Backstepping<T> {
 }
 
 /// The switching state: the token M of [SB 31–33] and where the state was
-/// first seen.
+/// first seen. Numbered (`mode as u8`) as recordings give it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
 pub enum Mode {
     /// No sample since the reference last changed.
-    Start,
+    Start = 0,
     /// Outside D with F_d > 0 (hybrid, M = 1): the law.
-    Approaching,
+    Approaching = 1,
     /// Outside D, u = 0: the spring carries the state towards X₀ ∈ D.
-    Waiting,
+    Waiting = 2,
     /// In D (once): the law.
-    Inside,
+    Inside = 3,
 }
 
 /// `u` clamped to [u_min, u_max] (NaN → the bound nearest 0).

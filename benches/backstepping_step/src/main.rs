@@ -103,15 +103,6 @@ record_loop!(law32, f32, (), law_call32, CYCLE32);
 record_loop!(base64, f64, (), nothing64, CYCLE64);
 record_loop!(base32, f32, (), nothing32, CYCLE32);
 
-fn mode_index(m: Mode) -> u8 {
-    match m {
-        Mode::Start => 0,
-        Mode::Approaching => 1,
-        Mode::Waiting => 2,
-        Mode::Inside => 3,
-    }
-}
-
 fn dump(rec64: &[[f64; 5]], rec32: &[[f32; 5]]) {
     println!(
         "k,t,phi,step64_u,step32_u,step64_mode,step32_mode,loop_u,loop_mode,\
@@ -133,8 +124,8 @@ fn dump(rec64: &[[f64; 5]], rec32: &[[f32; 5]]) {
             "{k},{:e},{:e},{u:e},{w:e},{},{},{loop_u:e},{loop_mode},{l:e},{m:e},{}",
             r[0],
             r[3],
-            mode_index(c64.mode()),
-            mode_index(c32.mode()),
+            c64.mode() as u8,
+            c32.mode() as u8,
             u8::from(law_runs)
         );
     }
