@@ -194,9 +194,10 @@ where
     Ok(report)
 }
 
-/// Minimises with the caller's Jacobian ∂r/∂θ (original units).
+/// Minimises with the caller's Jacobian ∂r/∂θ (original units); where it
+/// has none (`None`, or not finite) with forward differences of `residual`.
 pub fn minimize_with_jacobian<F, J>(
-    mut residual: F,
+    residual: F,
     mut jacobian: J,
     x0: &[f64],
     bounds: &[(f64, f64)],
@@ -208,20 +209,29 @@ where
     J: FnMut(&[f64]) -> Option<DMatrix<f64>>,
 {
     let count = std::cell::Cell::new(0);
+    let f = std::cell::RefCell::new(residual);
+    let call = |x: &[f64]| {
+        count.set(count.get() + 1);
+        (f.borrow_mut())(x)
+    };
     let map = Map::new(x0, bounds)?;
     let mut problem = Problem {
         map: &map,
-        residual: |y: &[f64]| {
-            count.set(count.get() + 1);
-            residual(&map.theta(y))
-        },
-        jacobian: |y: &[f64], _r: &[f64]| {
-            let mut jac = jacobian(&map.theta(y))?;
-            for j in 0..y.len() {
-                let d = map.dtheta_dy(y, j);
-                jac.column_mut(j).scale_mut(d);
+        residual: |y: &[f64]| call(&map.theta(y)),
+        jacobian: |y: &[f64], r: &[f64]| match jacobian(&map.theta(y)) {
+            Some(mut jac) if finite(jac.as_slice()) => {
+                for j in 0..y.len() {
+                    let d = map.dtheta_dy(y, j);
+                    jac.column_mut(j).scale_mut(d);
+                }
+                Some(jac)
             }
-            Some(jac)
+            _ => {
+                let columns = (0..y.len())
+                    .map(|j| fd_column(&map, &call, y, r, j, options.fd_step))
+                    .collect();
+                assemble(columns, r.len())
+            }
         },
     };
     let mut report = solve(&mut problem, options, monitor)?;
@@ -369,6 +379,15 @@ struct Point {
     jac: DMatrix<f64>,
 }
 
+/// The Jacobian at `y` when it is finite (the SVD of a matrix with a NaN
+/// never ends).
+fn jacobian_at<R, J>(p: &mut Problem<R, J>, y: &[f64], r: &[f64]) -> Option<DMatrix<f64>>
+where
+    J: FnMut(&[f64], &[f64]) -> Option<DMatrix<f64>>,
+{
+    (p.jacobian)(y, r).filter(|jac| finite(jac.as_slice()))
+}
+
 fn solve<R, J>(
     p: &mut Problem<R, J>,
     options: &Options,
@@ -382,7 +401,7 @@ where
     let r = (p.residual)(&y)
         .filter(|r| finite(r))
         .ok_or(LmError::Start)?;
-    let jac = (p.jacobian)(&y, &r).ok_or(LmError::StartJacobian)?;
+    let jac = jacobian_at(p, &y, &r).ok_or(LmError::StartJacobian)?;
     let r = DVector::from_vec(r);
     let mut pt = Point {
         cost: 0.5 * r.norm_squared(),
@@ -415,7 +434,7 @@ where
                     theta: &theta,
                     damping: mu,
                 });
-                match (p.jacobian)(&pt.y, pt.r.as_slice()) {
+                match jacobian_at(p, &pt.y, pt.r.as_slice()) {
                     Some(jac) => pt.jac = jac,
                     None => break Status::JacobianFailed,
                 }

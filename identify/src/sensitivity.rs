@@ -15,76 +15,93 @@
 //!   A lift-off leaves S unchanged: at the crossing v = 0 and the free
 //!   acceleration (the guard) is 0, so f⁺ = f⁻ and the saltation term is
 //!   zero.
-//! - **Integration.** The simulator is reused as is: the sensitivity ODE is
-//!   integrated by fixed-step RK4 together with x over each sample interval,
-//!   x re-anchored at every sample on the simulator's (tight-tolerance)
-//!   state, the interval cut at the simulator's event times and at the
-//!   input's breakpoints (a voltage edge between samples), each piece with
-//!   the replayed input's own affine u. A second Dopri pass on
-//!   the augmented system would not fit `MAX_DIM` (d·(1 + p) states).
+//! - **Integration.** The simulator is reused as is: its samples give x.
+//!   A sample interval with no event and no input breakpoint inside (most
+//!   of them) takes one step of Radau IIA (2 stages, order 3, L-stable) of
+//!   the linear Ṡ = f_x·S + f_θ, the stages' x interpolated from the
+//!   samples (cubic Hermite): three tape evaluations, and stable however
+//!   stiff the field. Where the interpolant does not follow the field (a
+//!   transient within the interval), and across events and breakpoints (a
+//!   voltage edge between samples), RK4 integrates x and S together, x
+//!   re-anchored at every sample, the interval cut at the events and
+//!   breakpoints, each piece with the replayed input's own affine u, in 4
+//!   substeps or more where f_x is stiff. Beyond [`MAX_SUBSTEPS`] the pass
+//!   gives up ([`Unsupported::Stiff`]) and the fit differences replays for
+//!   that Jacobian. A second Dopri pass on the augmented system would not
+//!   fit `MAX_DIM` (d·(1 + p) states).
+//! - **Restitution.** γ enters only the bounce's reset v⁺ = −γ·v⁻, so its
+//!   column has f_θ = 0 and gains R_θ = ∂x⁺/∂γ = (0, −v⁻, 0, …) at each
+//!   bounce (not at an impact that sticks: v⁺ = 0 whatever γ).
+//! - **Jiles–Atherton core.** Its field switches with δ = sign φ̇ [JA 26],
+//!   but it is continuous there: Ḣ_c = dH_c/dB_c(δ)·φ̇/A_c [JA 33] is 0 on
+//!   both sides of φ̇ = 0, so the saltation term (f⁺ − f⁻)·τ vanishes and S
+//!   is continuous across a switch, as at a lift-off (only f_x jumps; the
+//!   symbolic ∂ sign/∂x is 0).
 //!
 //! Not supported (the fit falls back to finite differences): parameters
 //! that change the model's structure (the resistance drift when the model
-//! has none), those entering only the resets or the mode logic
-//! (`mechanics.restitution`, `mechanics.bounce_threshold`), and the
-//! Jiles–Atherton core, whose switching functions (sign φ̇) would need a
-//! saltation update at every switch.
+//! has none) and those entering only the mode logic
+//! (`mechanics.bounce_threshold`).
 
 use std::cell::RefCell;
 
 use nalgebra::DMatrix;
 
-use crate::description::{Core, Description};
+use crate::description::{schema, Description};
 use crate::model::Model;
-use crate::sim::{EventKind, Input, Limit, Mode, Trajectory, MAX_DIM};
+use crate::sim::{Affine, EventKind, Input, Limit, Mode, Trajectory, MAX_DIM};
 use crate::sym::{Id, Tape};
 
 /// RK4 substeps per sample interval (and per piece of one cut at events):
 /// on the saturating valve at 20 µs samples, 4 keep the Jacobian within
 /// 3e-6 of central differences (as 32 do); 2 lose accuracy at voltage edges.
+/// More where the field is stiff there (see [`STABLE_REACH`]).
 pub const SUBSTEPS: usize = 4;
+
+/// The largest defect of the replay's cubic interpolant at a Radau stage,
+/// relative to the field's magnitudes there (see [`Field::radau`]).
+pub const HERMITE_DEFECT: f64 = 1e-4;
+
+/// The largest h·|λ| of an RK4 substep, |λ| bounded at its start
+/// ([`spectral_bound`] of f_x): explicit RK4 is stable to 2.78 on the
+/// negative real axis, and the field can stiffen within the substep.
+pub const STABLE_REACH: f64 = 1.0;
+
+/// The most substeps one piece may take: beyond, the field is too stiff for
+/// an explicit method (a Jiles–Atherton core far in saturation, where
+/// ∂Ḣ_c/∂H_c reaches −1e10/s) and [`forward`] gives up ([`Unsupported::Stiff`]);
+/// the fit then differences whole replays, which the adaptive simulator makes.
+pub const MAX_SUBSTEPS: usize = 256;
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Unsupported {
     #[error("parameter `{path}` has no analytic sensitivity: {reason}")]
     Parameter { path: String, reason: &'static str },
-    #[error("the Jiles–Atherton core has no analytic sensitivities (its switching functions need a saltation update per switch)")]
-    Hysteresis,
+    #[error("the field is too stiff at t = {t:e} s (|λ| up to {rate:.1e}/s) for the sensitivities' explicit RK4")]
+    Stiff { t: f64, rate: f64 },
 }
 
-/// The model parameter behind a fit path, or why there is none.
+/// How a fitted parameter enters the replay.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Theta {
+    /// A symbol of the model's field.
+    Field(Id),
+    /// The restitution γ: only the bounce's reset v⁺ = −γ·v⁻.
+    Restitution,
+}
+
+/// The model symbol behind a fit path (the schema's), or why there is none.
 fn symbol_name(path: &str) -> Result<&'static str, &'static str> {
-    Ok(match path {
-        "coil.turns" => "N",
-        "coil.resistance" => "R",
-        "coil.eddy" => "k_e",
-        "coil.resistance_drift" => "R_drift",
-        "mechanics.mass" => "m",
-        "mechanics.stiffness" => "k_s",
-        "mechanics.damping" => "c",
-        "mechanics.preload" => "F0",
-        "gap.slope" => "k_gap",
-        "gap.offset" => "R_gap0",
-        "gap.area" => "A_gap",
-        "gap.winding_length" => "l_w",
-        "gap.r0" => "R_g0",
-        "gap.r0_prime" => "R_g0_prime",
-        "gap.k1" => "k1",
-        "gap.k2" => "k2",
-        "core.r0" => "R_core0",
-        "core.phi_sat" => "phi_sat",
-        "mechanics.restitution" | "mechanics.bounce_threshold" => {
-            return Err("it only enters the impact reset")
-        }
-        _ => return Err("it is not a parameter of the model's field"),
-    })
+    match path {
+        "mechanics.bounce_threshold" => Err("it only decides between a bounce and sticking"),
+        _ => schema::lookup(path)
+            .and_then(|key| key.symbol.filter(|_| key.fittable))
+            .ok_or("it is not a parameter of the model's field"),
+    }
 }
 
-/// The symbols of `paths` in `model`, when all have analytic sensitivities.
-pub fn symbols(model: &Model, paths: &[&str]) -> Result<Vec<Id>, Unsupported> {
-    if matches!(model.description.core, Core::JilesAtherton(_)) {
-        return Err(Unsupported::Hysteresis);
-    }
+/// How each of `paths` enters `model`, when all have analytic sensitivities.
+pub fn symbols(model: &Model, paths: &[&str]) -> Result<Vec<Theta>, Unsupported> {
     paths
         .iter()
         .map(|&path| {
@@ -92,10 +109,14 @@ pub fn symbols(model: &Model, paths: &[&str]) -> Result<Vec<Id>, Unsupported> {
                 path: path.to_owned(),
                 reason,
             };
+            if path == "mechanics.restitution" {
+                return Ok(Theta::Restitution);
+            }
             let name = symbol_name(path).map_err(unsupported)?;
             model
                 .params
                 .symbol(name)
+                .map(Theta::Field)
                 .ok_or_else(|| unsupported("the model does not contain it at this value"))
         })
         .collect()
@@ -122,19 +143,41 @@ struct Field {
     out: RefCell<Vec<f64>>,
     d: usize,
     p: usize,
+    /// The column of the restitution γ, if fitted.
+    restitution: Option<usize>,
     z_min: f64,
     z_max: f64,
 }
 
+/// f_x and f_θ at the two stages of [`Field::radau`] (allocated once a pass).
+struct Work {
+    a: [Vec<f64>; 2],
+    b: [Vec<f64>; 2],
+}
+
+impl Work {
+    fn new(d: usize, p: usize) -> Work {
+        Work {
+            a: [vec![0.0; d * d], vec![0.0; d * d]],
+            b: [vec![0.0; d * p], vec![0.0; d * p]],
+        }
+    }
+}
+
 impl Field {
-    fn new(model: &mut Model, theta: &[Id]) -> Field {
+    fn new(model: &mut Model, theta: &[Theta]) -> Field {
         let (d, p) = (model.dim(), theta.len());
         let f = model.f.clone();
         let mut exprs = f.clone();
         exprs.extend(model.jacobian().into_iter().flatten());
+        let zero = model.graph.constant(0.0);
+        let diff = |model: &mut Model, e: Id, th: &Theta| match *th {
+            Theta::Field(th) => model.graph.diff(e, th),
+            Theta::Restitution => zero,
+        };
         for &fi in &f {
-            for &th in theta {
-                exprs.push(model.graph.diff(fi, th));
+            for th in theta {
+                exprs.push(diff(model, fi, th));
             }
         }
         let i = model.current;
@@ -143,8 +186,8 @@ impl Field {
             let xk = model.states[k];
             exprs.push(model.graph.diff(i, xk));
         }
-        for &th in theta {
-            exprs.push(model.graph.diff(i, th));
+        for th in theta {
+            exprs.push(diff(model, i, th));
         }
         let tape = model.compile(&exprs);
         let m = &model.description.mechanics;
@@ -154,6 +197,7 @@ impl Field {
             tape,
             d,
             p,
+            restitution: theta.iter().position(|th| *th == Theta::Restitution),
             z_min: m.z_min,
             z_max: m.z_max,
         }
@@ -227,7 +271,22 @@ impl Field {
         }
     }
 
-    /// Classical RK4 of (x, S) over [a, b] in `SUBSTEPS` steps; u linear.
+    /// A bound on |λ|max of f_x at the last evaluation, rows of z and v
+    /// zero when `stuck` (∞ when f_x is not finite).
+    fn rate_bound(&self, stuck: bool) -> f64 {
+        let d = self.d;
+        let out = self.out.borrow();
+        let mut fx = [0.0; MAX_DIM * MAX_DIM];
+        for (i, row) in out[d..d + d * d].chunks(d).enumerate() {
+            if !(stuck && i < 2) {
+                fx[i * d..(i + 1) * d].copy_from_slice(row);
+            }
+        }
+        spectral_bound(&fx[..d * d], d)
+    }
+
+    /// Classical RK4 of (x, S) over [a, b] in `SUBSTEPS` steps, finer from
+    /// any substep on whose f_x asks for it ([`STABLE_REACH`]); u linear.
     fn integrate(
         &self,
         a: f64,
@@ -236,14 +295,16 @@ impl Field {
         s: &mut [f64],
         u: &dyn Fn(f64) -> f64,
         stuck: bool,
-    ) {
+    ) -> Result<(), Unsupported> {
         let (d, n) = (self.d, self.d * self.p);
-        let h = (b - a) / SUBSTEPS as f64;
         let mut k = [[0.0; MAX_DIM]; 4];
         let mut ks = vec![vec![0.0; n]; 4];
         let (mut xt, mut st) = ([0.0; MAX_DIM], vec![0.0; n]);
-        for step in 0..SUBSTEPS {
-            let t = a + step as f64 * h;
+        // Substeps of length h from `start`: `step` done of `steps`.
+        let (mut start, mut steps, mut step) = (a, SUBSTEPS, 0);
+        let mut h = (b - a) / SUBSTEPS as f64;
+        while step < steps {
+            let t = start + step as f64 * h;
             for stage in 0..4 {
                 let c = [0.0, 0.5, 0.5, 1.0][stage];
                 for i in 0..d {
@@ -265,6 +326,18 @@ impl Field {
                 let tc = t + c * h;
                 let (kx, kss) = (&mut k[stage], &mut ks[stage]);
                 self.rhs(tc, &xt, &st, u(tc), stuck, kx, kss);
+                if stage == 0 {
+                    let rate = self.rate_bound(stuck);
+                    let needed = ((b - t) * rate / STABLE_REACH).ceil();
+                    if needed > (steps - step) as f64 {
+                        // Stiffer than the substeps left can follow: from t on, finer.
+                        if !(needed <= MAX_SUBSTEPS as f64) {
+                            return Err(Unsupported::Stiff { t, rate });
+                        }
+                        steps = needed as usize;
+                        (start, step, h) = (t, 0, (b - t) / steps as f64);
+                    }
+                }
             }
             // (RK4) y += h/6·(k1 + 2k2 + 2k3 + k4)
             for i in 0..d {
@@ -273,7 +346,118 @@ impl Field {
             for i in 0..n {
                 s[i] += h / 6.0 * (ks[0][i] + 2.0 * ks[1][i] + 2.0 * ks[2][i] + ks[3][i]);
             }
+            step += 1;
         }
+        Ok(())
+    }
+
+    /// f_x and f_θ at the last evaluation into `a` (d×d) and `b` (d×p),
+    /// rows of z and v zero when `stuck`; f itself is returned.
+    fn linearisation(&self, stuck: bool, a: &mut [f64], b: &mut [f64]) -> [f64; MAX_DIM] {
+        let (d, p) = (self.d, self.p);
+        let out = self.out.borrow();
+        let (f, rest) = out.split_at(d);
+        let (fx, rest) = rest.split_at(d * d);
+        let frozen = |i: usize| stuck && i < 2;
+        for i in 0..d {
+            let keep = if frozen(i) { 0.0 } else { 1.0 };
+            for k in 0..d {
+                a[i * d + k] = keep * fx[i * d + k];
+            }
+            for j in 0..p {
+                b[i * p + j] = keep * rest[i * p + j];
+            }
+        }
+        std::array::from_fn(|i| match i < d && !frozen(i) {
+            true => f[i],
+            false => 0.0,
+        })
+    }
+
+    /// One step of Radau IIA (2 stages, order 3, L-stable) of the linear
+    /// Ṡ = f_x·S + f_θ over a sample interval [t0, t1] with neither an event
+    /// nor an input breakpoint inside. x is not integrated: at t1 it is the
+    /// replay's sample, at the stage t0 + h/3 the cubic Hermite interpolant
+    /// of the samples and their derivatives. Three tape evaluations instead
+    /// of RK4's sixteen, and stable however stiff the field (a saturated
+    /// Jiles–Atherton core). `false` (S untouched) if the stage system is
+    /// singular.
+    #[allow(clippy::too_many_arguments)]
+    fn radau(
+        &self,
+        (t0, t1): (f64, f64),
+        x0: &[f64],
+        x1: &[f64],
+        s: &mut [f64],
+        piece: Affine,
+        stuck: bool,
+        work: &mut Work,
+    ) -> bool {
+        let (d, p, h) = (self.d, self.p, t1 - t0);
+        // (Radau IIA) c = (1/3, 1), A = [[5/12, −1/12], [3/4, 1/4]]
+        const C1: f64 = 1.0 / 3.0;
+        const RADAU: [[f64; 2]; 2] = [[5.0 / 12.0, -1.0 / 12.0], [0.75, 0.25]];
+        self.eval(t0, x0, piece.value(t0));
+        let f0 = self.linearisation(stuck, &mut work.a[0], &mut work.b[0]);
+        self.eval(t1, x1, piece.value(t1));
+        let f1 = self.linearisation(stuck, &mut work.a[1], &mut work.b[1]);
+        // cubic Hermite at σ = 1/3: h00 = 20/27, h10 = 4/27, h01 = 7/27, h11 = −2/27
+        let xm: [f64; MAX_DIM] = std::array::from_fn(|i| match i < d {
+            true => {
+                (20.0 * x0[i] + 7.0 * x1[i] + h * (4.0 * f0[i] - 2.0 * f1[i])) / 27.0
+            }
+            false => 0.0,
+        });
+        let tm = t0 + C1 * h;
+        self.eval(tm, &xm, piece.value(tm));
+        let [a1, a2] = &mut work.a;
+        let [b1, b2] = &mut work.b;
+        let fm = self.linearisation(stuck, a1, b1);
+        // The interpolant's slope at σ = 1/3, (4/3)(x1 − x0)/h − f1/3, must
+        // be the field's there: else x moves faster than a cubic follows (a
+        // transient within the interval) and RK4 integrates x instead.
+        let follows = (0..d).all(|i| {
+            let slope = 4.0 / 3.0 * (x1[i] - x0[i]) / h - f1[i] / 3.0;
+            (fm[i] - slope).abs() <= HERMITE_DEFECT * (f0[i].abs() + fm[i].abs() + f1[i].abs())
+        });
+        if !follows {
+            return false;
+        }
+        // [Z1; Z2] = S + h·RADAU·[A1·Z1 + B1; A2·Z2 + B2]: unused rows of the
+        // padded system are identity.
+        let stage = [&*a1, &*a2];
+        let m = nalgebra::SMatrix::<f64, { 2 * MAX_DIM }, { 2 * MAX_DIM }>::from_fn(|r, c| {
+            let (bi, i, bk, k) = (r / MAX_DIM, r % MAX_DIM, c / MAX_DIM, c % MAX_DIM);
+            let identity = if r == c { 1.0 } else { 0.0 };
+            match i < d && k < d {
+                true => identity - h * RADAU[bi][bk] * stage[bk][i * d + k],
+                false => identity,
+            }
+        });
+        let Some(lu) = Some(m.lu()).filter(|lu| lu.is_invertible()) else {
+            return false;
+        };
+        let forcing = [&*b1, &*b2];
+        for j in 0..p {
+            let rhs = nalgebra::SVector::<f64, { 2 * MAX_DIM }>::from_fn(|r, _| {
+                let (bi, i) = (r / MAX_DIM, r % MAX_DIM);
+                match i < d {
+                    true => {
+                        s[i * p + j]
+                            + h * (RADAU[bi][0] * forcing[0][i * p + j]
+                                + RADAU[bi][1] * forcing[1][i * p + j])
+                    }
+                    false => 0.0,
+                }
+            });
+            let Some(z) = lu.solve(&rhs) else {
+                return false;
+            };
+            for i in 0..d {
+                s[i * p + j] = z[MAX_DIM + i];
+            }
+        }
+        true
     }
 
     /// The saltation update at an impact, a stick or a lift-off.
@@ -313,6 +497,10 @@ impl Field {
                         s[i * p + j] = r[i] * s[i * p + j] + jump * ratio;
                     }
                 }
+                // R_θ of a bounce v⁺ = −γ·v⁻: ∂v⁺/∂γ = −v⁻.
+                if let (Some(j), false) = (self.restitution, stuck) {
+                    s[p + j] -= v_before;
+                }
             }
             EventKind::Stick { limit } => {
                 (x[0], x[1]) = (stop(limit), 0.0);
@@ -322,6 +510,37 @@ impl Field {
             EventKind::LiftOff { .. } => {}
         }
     }
+}
+
+/// An upper bound on the spectral radius of the d×d matrix `a` (row-major,
+/// d ≤ [`MAX_DIM`]): Fujiwara's bound on the roots of its characteristic
+/// polynomial zᵈ + c₁zᵈ⁻¹ + … + c_d (coefficients by Faddeev–LeVerrier),
+/// 2·max(|c₁|, |c₂|^½, …, |c_d/2|^(1/d)). Unlike a matrix norm it does not
+/// depend on the states' units; ∞ when `a` is not finite.
+fn spectral_bound(a: &[f64], d: usize) -> f64 {
+    if !a.iter().all(|v| v.is_finite()) {
+        return f64::INFINITY;
+    }
+    // M_k = A·M_{k−1} + c_{k−1}·I, c_k = −tr(A·M_k)/k (M_0 = 0, c_0 = 1).
+    let mut m = [0.0; MAX_DIM * MAX_DIM];
+    let (mut c_prev, mut bound) = (1.0, 0.0f64);
+    for k in 1..=d {
+        let mut next = [0.0; MAX_DIM * MAX_DIM];
+        for i in 0..d {
+            for j in 0..d {
+                next[i * d + j] = (0..d).map(|l| a[i * d + l] * m[l * d + j]).sum::<f64>()
+                    + if i == j { c_prev } else { 0.0 };
+            }
+        }
+        let trace: f64 = (0..d)
+            .map(|i| (0..d).map(|l| a[i * d + l] * next[l * d + i]).sum::<f64>())
+            .sum();
+        let c = -trace / k as f64;
+        let term = if k == d { c.abs() / 2.0 } else { c.abs() };
+        bound = bound.max(term.powf(1.0 / k as f64));
+        (m, c_prev) = (next, c);
+    }
+    2.0 * bound
 }
 
 /// The sensitivities of `paths` along `trajectory`, a replay of `model`
@@ -358,11 +577,18 @@ pub fn forward<I: Input + ?Sized>(
     record(0, &s, &mut out);
     let events = &tr.events;
     let mut next = events.iter().take_while(|e| e.t <= tr.t[0]).count();
+    let mut work = Work::new(d, p);
     for k in 0..n - 1 {
         let t1 = tr.t[k + 1];
         let mut x = tr.x[k];
         let mut mode = tr.mode[k];
         let mut a = tr.t[k];
+        let smooth = events.get(next).is_none_or(|e| e.t > t1) && input.next_breakpoint(a) >= t1;
+        let stuck = mode != Mode::Free;
+        if smooth && field.radau((a, t1), &x, &tr.x[k + 1], &mut s, input.piece(a), stuck, &mut work) {
+            record(k + 1, &s, &mut out);
+            continue;
+        }
         // Pieces of the interval between the input's breakpoints and the
         // events, each integrated with its own affine piece of u.
         loop {
@@ -380,7 +606,7 @@ pub fn forward<I: Input + ?Sized>(
                     &mut s,
                     &|t| piece.value(t),
                     mode != Mode::Free,
-                );
+                )?;
                 a = b;
             }
             match event {
