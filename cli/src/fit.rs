@@ -219,7 +219,7 @@ fn fit_text(
         r.simulations,
         r.best_start,
         r.status,
-        jacobian_name(r.sensitivities)
+        jacobian_name(r)
     );
     s += &r.sensitivity.to_string();
     if let Some(p) = written {
@@ -267,7 +267,8 @@ fn fit_json(d: &Description, r: &FitReport, before: f64, written: Option<&str>) 
         "cost": finite(r.cost),
         "iterations": r.iterations,
         "simulations": r.simulations,
-        "jacobian": jacobian_name(r.sensitivities),
+        "jacobian": jacobian_name(r),
+        "jacobians_differenced": r.differenced_jacobians,
         "status": format!("{:?}", r.status),
         "singular_values": sens.singular_values.iter().map(|s| finite(*s)).collect::<Vec<_>>(),
         "condition": finite(sens.condition),
@@ -327,9 +328,13 @@ fn gap_json(r: &GapFit, written: Option<&str>) -> Value {
 }
 
 /// How the fit's Jacobian was obtained.
-fn jacobian_name(s: Sensitivities) -> &'static str {
-    match s {
-        Sensitivities::Analytic => "analytic forward sensitivities",
-        Sensitivities::FiniteDifference => "finite differences of whole replays",
+fn jacobian_name(r: &FitReport) -> String {
+    match (r.sensitivities, r.differenced_jacobians) {
+        (Sensitivities::Analytic, 0) => "analytic forward sensitivities".into(),
+        (Sensitivities::Analytic, n) => format!(
+            "analytic forward sensitivities ({n} of them by finite differences of whole \
+             replays, where the sensitivities gave up: a field too stiff for them)"
+        ),
+        (Sensitivities::FiniteDifference, _) => "finite differences of whole replays".into(),
     }
 }

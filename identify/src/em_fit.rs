@@ -18,10 +18,12 @@
 //!
 //! Sensitivities are analytic where the symbolic core gives them
 //! ([`sensitivity`](super::sensitivity): forward sensitivity equations along
-//! the replay, [`Sensitivities::Analytic`]); otherwise (a parameter of the
-//! resets, the Jiles–Atherton core, or when asked) forward differences of
-//! whole replays: the replays run at a tight tolerance ([`FitOptions::rtol`])
-//! so that a relative step of [`FitOptions::fd_step`] sees a smooth function.
+//! the replay, [`Sensitivities::Analytic`]); otherwise (the bounce
+//! threshold, a term the model lacks, or when asked), and for any one
+//! Jacobian the sensitivities cannot give (a field too stiff for them),
+//! forward differences of whole replays: the replays run at a tight
+//! tolerance ([`FitOptions::rtol`]) so that a relative step of
+//! [`FitOptions::fd_step`] sees a smooth function.
 //! Several starts ([`FitOptions::starts`]) are drawn deterministically from
 //! the bounds (log-uniform for positive parameters spanning a decade or more);
 //! the best fit is kept.
@@ -138,6 +140,9 @@ pub struct FitReport {
     /// The Jacobian actually used (analytic only when every fitted
     /// parameter has an analytic sensitivity).
     pub sensitivities: Sensitivities,
+    /// Of an analytic fit's Jacobians, those made by finite differences
+    /// instead (the sensitivities gave up: a stiff field, a failed replay).
+    pub differenced_jacobians: usize,
     /// Why the best start stopped.
     pub status: Status,
     /// Which start gave the best fit (0 = the description's values).
@@ -493,6 +498,7 @@ pub fn fit(
     // θ (the solver asks for J at the point it just evaluated and accepted).
     let last: RefCell<Option<(Vec<f64>, Trajectory)>> = RefCell::new(None);
     let jacobian_replays = Cell::new(0);
+    let differenced = Cell::new(0);
     let keeping = |theta: &[f64]| {
         let d = with_values(description, params, theta).ok()?;
         let replay = replay(&d, data, &setup.objective.budget).ok()?;
@@ -510,7 +516,15 @@ pub fn fit(
                 replay(&d, data, &setup.objective.budget).ok()?.trajectory
             }
         };
-        setup.objective.jacobian(&d, &paths, &trajectory)
+        let jac = setup
+            .objective
+            .jacobian(&d, &paths, &trajectory)
+            .filter(|j| j.iter().all(|x| x.is_finite()));
+        if jac.is_none() {
+            // `lm` differences the residual instead.
+            differenced.set(differenced.get() + 1);
+        }
+        jac
     };
     let lm_options = lm::Options {
         max_iterations: options.max_iterations,
@@ -583,6 +597,7 @@ pub fn fit(
         },
         status: report.status,
         best_start,
+        differenced_jacobians: differenced.get(),
     })
 }
 

@@ -348,7 +348,7 @@ where
         if dh == 0.0 {
             continue;
         }
-        if let Some(rj) = f(&map.theta(&yj)).filter(|rj| rj.len() == r.len()) {
+        if let Some(rj) = f(&map.theta(&yj)).filter(|rj| rj.len() == r.len() && finite(rj)) {
             return Some(rj.iter().zip(r).map(|(a, b)| (a - b) / dh).collect());
         }
     }
@@ -677,6 +677,37 @@ mod tests {
             seq.theta, rep.theta,
             "parallel and sequential columns agree bit for bit"
         );
+    }
+
+    #[test]
+    fn a_jacobian_the_caller_cannot_give_is_differenced() {
+        // None at every other call, NaN at the rest: the solver must neither
+        // stop nor hand a NaN to its SVD (which would never return).
+        let calls = std::cell::Cell::new(0);
+        let jac = |x: &[f64]| {
+            calls.set(calls.get() + 1);
+            match calls.get() % 2 {
+                0 => None,
+                _ => Some(DMatrix::from_row_slice(
+                    2,
+                    2,
+                    &[f64::NAN, 10.0, -1.0, 0.0 * x[0]],
+                )),
+            }
+        };
+        let bounds = [(-5.0, 5.0), (-5.0, 5.0)];
+        let rep = minimize_with_jacobian(
+            rosenbrock,
+            jac,
+            &[-1.2, 1.0],
+            &bounds,
+            &Options::default(),
+            &mut quiet,
+        )
+        .unwrap();
+        assert!(rep.status.converged(), "{:?}", rep.status);
+        assert!((rep.theta[0] - 1.0).abs() < 1e-8, "{:?}", rep.theta);
+        assert!(calls.get() > 2 && rep.evaluations > calls.get());
     }
 
     #[test]

@@ -133,6 +133,10 @@ pub struct OutputSensitivities {
     pub current: DMatrix<f64>,
     pub z: DMatrix<f64>,
     pub phi: DMatrix<f64>,
+    /// Sample intervals taken by one Radau step, and by RK4 (events, input
+    /// breakpoints, or an interpolant that did not follow the field).
+    pub radau_intervals: usize,
+    pub rk4_intervals: usize,
 }
 
 /// f, f_x, f_θ, i, i_x, i_θ of (x, u, t) on one tape, outputs in that
@@ -149,10 +153,13 @@ struct Field {
     z_max: f64,
 }
 
-/// f_x and f_θ at the two stages of [`Field::radau`] (allocated once a pass).
+/// f_x and f_θ at the two stages of [`Field::radau`], and the right-hand
+/// sides of its stage system, one column per parameter (allocated once a
+/// pass).
 struct Work {
     a: [Vec<f64>; 2],
     b: [Vec<f64>; 2],
+    rhs: nalgebra::OMatrix<f64, nalgebra::Const<{ 2 * MAX_DIM }>, nalgebra::Dyn>,
 }
 
 impl Work {
@@ -160,6 +167,7 @@ impl Work {
         Work {
             a: [vec![0.0; d * d], vec![0.0; d * d]],
             b: [vec![0.0; d * p], vec![0.0; d * p]],
+            rhs: nalgebra::OMatrix::zeros_generic(nalgebra::Const, nalgebra::Dyn(p)),
         }
     }
 }
@@ -300,8 +308,9 @@ impl Field {
         let mut k = [[0.0; MAX_DIM]; 4];
         let mut ks = vec![vec![0.0; n]; 4];
         let (mut xt, mut st) = ([0.0; MAX_DIM], vec![0.0; n]);
-        // Substeps of length h from `start`: `step` done of `steps`.
-        let (mut start, mut steps, mut step) = (a, SUBSTEPS, 0);
+        // Substeps of length h from `start`: `step` done of `steps`; `taken`
+        // before `start`.
+        let (mut start, mut steps, mut step, mut taken) = (a, SUBSTEPS, 0, 0);
         let mut h = (b - a) / SUBSTEPS as f64;
         while step < steps {
             let t = start + step as f64 * h;
@@ -331,7 +340,8 @@ impl Field {
                     let needed = ((b - t) * rate / STABLE_REACH).ceil();
                     if needed > (steps - step) as f64 {
                         // Stiffer than the substeps left can follow: from t on, finer.
-                        if !(needed <= MAX_SUBSTEPS as f64) {
+                        taken += step;
+                        if !(needed <= (MAX_SUBSTEPS - taken) as f64) {
                             return Err(Unsupported::Stiff { t, rate });
                         }
                         steps = needed as usize;
@@ -434,27 +444,34 @@ impl Field {
                 false => identity,
             }
         });
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        if !(finite(a1) && finite(a2) && finite(b1) && finite(b2)) {
+            return false;
+        }
         let Some(lu) = Some(m.lu()).filter(|lu| lu.is_invertible()) else {
             return false;
         };
         let forcing = [&*b1, &*b2];
+        let rhs = &mut work.rhs;
         for j in 0..p {
-            let rhs = nalgebra::SVector::<f64, { 2 * MAX_DIM }>::from_fn(|r, _| {
+            for r in 0..2 * MAX_DIM {
                 let (bi, i) = (r / MAX_DIM, r % MAX_DIM);
-                match i < d {
+                rhs[(r, j)] = match i < d {
                     true => {
                         s[i * p + j]
                             + h * (RADAU[bi][0] * forcing[0][i * p + j]
                                 + RADAU[bi][1] * forcing[1][i * p + j])
                     }
                     false => 0.0,
-                }
-            });
-            let Some(z) = lu.solve(&rhs) else {
-                return false;
-            };
+                };
+            }
+        }
+        if !lu.solve_mut(rhs) {
+            return false;
+        }
+        for j in 0..p {
             for i in 0..d {
-                s[i * p + j] = z[MAX_DIM + i];
+                s[i * p + j] = rhs[(MAX_DIM + i, j)];
             }
         }
         true
@@ -536,6 +553,9 @@ fn spectral_bound(a: &[f64], d: usize) -> f64 {
             .map(|i| (0..d).map(|l| a[i * d + l] * next[l * d + i]).sum::<f64>())
             .sum();
         let c = -trace / k as f64;
+        if !c.is_finite() {
+            return f64::INFINITY;
+        }
         let term = if k == d { c.abs() / 2.0 } else { c.abs() };
         bound = bound.max(term.powf(1.0 / k as f64));
         (m, c_prev) = (next, c);
@@ -560,6 +580,8 @@ pub fn forward<I: Input + ?Sized>(
         current: DMatrix::zeros(n, p),
         z: DMatrix::zeros(n, p),
         phi: DMatrix::zeros(n, p),
+        radau_intervals: 0,
+        rk4_intervals: 0,
     };
     let mut s = vec![0.0; d * p];
     let mut row = vec![0.0; p];
@@ -586,9 +608,11 @@ pub fn forward<I: Input + ?Sized>(
         let smooth = events.get(next).is_none_or(|e| e.t > t1) && input.next_breakpoint(a) >= t1;
         let stuck = mode != Mode::Free;
         if smooth && field.radau((a, t1), &x, &tr.x[k + 1], &mut s, input.piece(a), stuck, &mut work) {
+            out.radau_intervals += 1;
             record(k + 1, &s, &mut out);
             continue;
         }
+        out.rk4_intervals += 1;
         // Pieces of the interval between the input's breakpoints and the
         // events, each integrated with its own affine piece of u.
         loop {
@@ -622,4 +646,34 @@ pub fn forward<I: Input + ?Sized>(
         record(k + 1, &s, &mut out);
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::spectral_bound;
+
+    /// At least the spectral radius (within 2× of it for these), the same
+    /// for the matrix in other units (D·A·D⁻¹), ∞ when not finite.
+    #[test]
+    fn the_spectral_bound_holds_and_ignores_units() {
+        // eigenvalues −1, −1e4 (a stiff pair), with a coupling
+        let a = [-1.0, 3.0, 0.0, -1e4];
+        let b = spectral_bound(&a, 2);
+        assert!((1e4..=2.0 * 1e4 * 1.01).contains(&b), "{b}");
+        // the same matrix in other units: D·A·D⁻¹, D = diag(1, 1e-9)
+        let scaled = [-1.0, 3.0e9, 0.0, -1e4];
+        assert_eq!(spectral_bound(&scaled, 2), b);
+        // a rotation: eigenvalues ±5i
+        let rot = [0.0, 5.0, -5.0, 0.0];
+        let r = spectral_bound(&rot, 2);
+        assert!((5.0..=10.0).contains(&r), "{r}");
+        // 4×4 triangular: eigenvalues on the diagonal, the largest 7
+        let t = [
+            -2.0, 1.0, 0.0, 5.0, 0.0, -7.0, 2.0, 0.0, 0.0, 0.0, 3.0, 1.0, 0.0, 0.0, 0.0, -1.0,
+        ];
+        let tb = spectral_bound(&t, 4);
+        assert!((7.0..=14.0 * 1.5).contains(&tb), "{tb}");
+        assert_eq!(spectral_bound(&[f64::NAN, 0.0, 0.0, 0.0], 2), f64::INFINITY);
+        assert_eq!(spectral_bound(&[1e300, 1e300, 1e300, 1e300], 2), f64::INFINITY);
+    }
 }

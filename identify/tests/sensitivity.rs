@@ -7,7 +7,7 @@ use designer::description::{parse_file, Description, Gap};
 use designer::model::Model;
 use designer::replay::{replay, Replay};
 use designer::sim::{EventKind, Options, PiecewiseLinear};
-use reldesign_identify::edges::replay_input;
+use reldesign_identify::edges::{replay_input, Edge};
 use reldesign_identify::sensitivity::{check, forward, OutputSensitivities};
 use reldesign_identify::{params, Measured};
 use support::example_path;
@@ -64,7 +64,8 @@ fn record_of(n: usize, v: impl Fn(usize) -> f64) -> Measured {
 }
 
 /// The replay of `d` at relative tolerance `rtol`, driven as the fit
-/// drives it (the voltage edge a step between samples), and its input.
+/// drives it (the samples joined linearly, a step at each placed edge),
+/// and its input.
 fn replayed(d: &Description, data: &Measured, rtol: f64) -> (Model, Replay, PiecewiseLinear) {
     let mut model = Model::build(d);
     let input = replay_input(data).unwrap();
@@ -115,9 +116,11 @@ fn central(d: &Description, data: &Measured, path: &str, h: f64) -> [Vec<f64>; 3
 }
 
 /// Largest |analytic − fd| relative to the largest |fd|, per signal.
-fn compare(d: &Description, data: &Measured, paths: &[&str], tol: f64) -> Vec<EventKind> {
+fn compare(d: &Description, data: &Measured, paths: &[&str], tol: f64) -> Compared {
     check(d, paths).unwrap();
     let (s, events) = analytic(d, data, paths);
+    let intervals = (s.radau_intervals, s.rk4_intervals);
+    assert_eq!(intervals.0 + intervals.1, data.len() - 1, "one step per interval");
     for (j, path) in paths.iter().enumerate() {
         let fd = central(d, data, path, 1e-4);
         for (name, m, f) in [
@@ -147,32 +150,59 @@ fn compare(d: &Description, data: &Measured, paths: &[&str], tol: f64) -> Vec<Ev
             );
         }
     }
-    events
+    eprintln!("intervals: {} by Radau, {} by RK4", intervals.0, intervals.1);
+    Compared {
+        events,
+        radau: intervals.0,
+        rk4: intervals.1,
+    }
+}
+
+/// The events of the replay and how its sample intervals were integrated.
+struct Compared {
+    events: Vec<EventKind>,
+    radau: usize,
+    rk4: usize,
 }
 
 #[test]
 fn the_analytic_jacobian_matches_central_differences_on_a_stuck_armature() {
     let d = valve();
     let data = record(3.0, 400, 500);
-    let events = compare(&d, &data, &PATHS, 1e-5);
+    let c = compare(&d, &data, &PATHS, 1e-5);
     assert!(
-        !events.iter().any(|e| matches!(e, EventKind::Impact { .. })),
-        "the armature must not move: {events:?}"
+        !c.events.iter().any(|e| matches!(e, EventKind::Impact { .. })),
+        "the armature must not move: {:?}",
+        c.events
     );
+    // No event, no breakpoint inside an interval: Radau throughout, but
+    // where the cubic does not follow x (the voltage ramp down at 400).
+    assert!(c.rk4 <= 5, "{} intervals by RK4", c.rk4);
 }
 
 #[test]
 fn the_analytic_jacobian_matches_central_differences_through_impacts() {
     let d = valve();
-    let data = record(30.0, 500, 1500);
+    let mut data = record(30.0, 500, 1500);
+    // The switch-off placed as a step 7 µs into its interval, as the
+    // diagnosis places edges: a breakpoint inside an interval.
+    data.edges = Some(vec![Edge {
+        k: 499,
+        tau: data.t[499] + 7e-6,
+        located: true,
+    }]);
     // In motion the Radau steps (order 3, one per 20 µs sample) follow the
     // differences to 2e-5; stuck, to 1e-6.
-    let events = compare(&d, &data, &PATHS, 1e-4);
-    let bounces = events
+    let c = compare(&d, &data, &PATHS, 1e-4);
+    let bounces = c
+        .events
         .iter()
         .filter(|e| matches!(e, EventKind::Impact { v_after, .. } if *v_after != 0.0))
         .count();
-    assert!(bounces >= 2, "the record must have bounces: {events:?}");
+    assert!(bounces >= 2, "the record must have bounces: {:?}", c.events);
+    // RK4 across the events and the edge, and where the motion is too fast
+    // for the cubic (890 by Radau, 609 by RK4 when written).
+    assert!(c.rk4 > c.events.len() && c.radau > c.rk4, "{} / {}", c.radau, c.rk4);
 }
 
 /// ±`volts`, reversed every 4 ms (200 samples): the flux, and with it
@@ -187,8 +217,9 @@ fn reversals(volts: f64) -> Measured {
 #[test]
 fn the_analytic_jacobian_matches_central_differences_on_the_hysteretic_core() {
     let d = parse_file(&example_path("jiles-atherton-valve.toml")).unwrap();
-    let events = compare(&d, &reversals(4.0), &JA_PATHS, 5e-4);
-    assert!(events.is_empty(), "the armature must not move: {events:?}");
+    let c = compare(&d, &reversals(4.0), &JA_PATHS, 5e-4);
+    assert!(c.events.is_empty(), "the armature must not move: {:?}", c.events);
+    assert!(c.radau > 10 * c.rk4, "{} / {}", c.radau, c.rk4);
 }
 
 /// With motion, on a linear gap: the example's McLyman fit has a curvature
@@ -201,12 +232,13 @@ fn the_analytic_jacobian_matches_central_differences_on_a_moving_hysteretic_valv
         slope: 2.0e10,
         offset: 2.41e6,
     };
-    let events = compare(&d, &reversals(24.0), &JA_PATHS, 2e-3);
-    let bounces = events
+    let c = compare(&d, &reversals(24.0), &JA_PATHS, 2e-3);
+    let bounces = c
+        .events
         .iter()
         .filter(|e| matches!(e, EventKind::Impact { v_after, .. } if *v_after != 0.0))
         .count();
-    assert!(bounces >= 5, "the armature must bounce: {events:?}");
+    assert!(bounces >= 5, "the armature must bounce: {:?}", c.events);
 }
 
 #[test]
