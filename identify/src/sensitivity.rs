@@ -413,9 +413,7 @@ impl Field {
         let f1 = self.linearisation(stuck, &mut work.a[1], &mut work.b[1]);
         // cubic Hermite at σ = 1/3: h00 = 20/27, h10 = 4/27, h01 = 7/27, h11 = −2/27
         let xm: [f64; MAX_DIM] = std::array::from_fn(|i| match i < d {
-            true => {
-                (20.0 * x0[i] + 7.0 * x1[i] + h * (4.0 * f0[i] - 2.0 * f1[i])) / 27.0
-            }
+            true => (20.0 * x0[i] + 7.0 * x1[i] + h * (4.0 * f0[i] - 2.0 * f1[i])) / 27.0,
             false => 0.0,
         });
         let tm = t0 + C1 * h;
@@ -607,7 +605,17 @@ pub fn forward<I: Input + ?Sized>(
         let mut a = tr.t[k];
         let smooth = events.get(next).is_none_or(|e| e.t > t1) && input.next_breakpoint(a) >= t1;
         let stuck = mode != Mode::Free;
-        if smooth && field.radau((a, t1), &x, &tr.x[k + 1], &mut s, input.piece(a), stuck, &mut work) {
+        if smooth
+            && field.radau(
+                (a, t1),
+                &x,
+                &tr.x[k + 1],
+                &mut s,
+                input.piece(a),
+                stuck,
+                &mut work,
+            )
+        {
             out.radau_intervals += 1;
             record(k + 1, &s, &mut out);
             continue;
@@ -674,6 +682,9 @@ mod tests {
         let tb = spectral_bound(&t, 4);
         assert!((7.0..=14.0 * 1.5).contains(&tb), "{tb}");
         assert_eq!(spectral_bound(&[f64::NAN, 0.0, 0.0, 0.0], 2), f64::INFINITY);
-        assert_eq!(spectral_bound(&[1e300, 1e300, 1e300, 1e300], 2), f64::INFINITY);
+        assert_eq!(
+            spectral_bound(&[1e300, 1e300, 1e300, 1e300], 2),
+            f64::INFINITY
+        );
     }
 }

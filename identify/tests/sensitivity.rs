@@ -120,7 +120,11 @@ fn compare(d: &Description, data: &Measured, paths: &[&str], tol: f64) -> Compar
     check(d, paths).unwrap();
     let (s, events) = analytic(d, data, paths);
     let intervals = (s.radau_intervals, s.rk4_intervals);
-    assert_eq!(intervals.0 + intervals.1, data.len() - 1, "one step per interval");
+    assert_eq!(
+        intervals.0 + intervals.1,
+        data.len() - 1,
+        "one step per interval"
+    );
     for (j, path) in paths.iter().enumerate() {
         let fd = central(d, data, path, 1e-4);
         for (name, m, f) in [
@@ -150,7 +154,10 @@ fn compare(d: &Description, data: &Measured, paths: &[&str], tol: f64) -> Compar
             );
         }
     }
-    eprintln!("intervals: {} by Radau, {} by RK4", intervals.0, intervals.1);
+    eprintln!(
+        "intervals: {} by Radau, {} by RK4",
+        intervals.0, intervals.1
+    );
     Compared {
         events,
         radau: intervals.0,
@@ -171,7 +178,9 @@ fn the_analytic_jacobian_matches_central_differences_on_a_stuck_armature() {
     let data = record(3.0, 400, 500);
     let c = compare(&d, &data, &PATHS, 1e-5);
     assert!(
-        !c.events.iter().any(|e| matches!(e, EventKind::Impact { .. })),
+        !c.events
+            .iter()
+            .any(|e| matches!(e, EventKind::Impact { .. })),
         "the armature must not move: {:?}",
         c.events
     );
@@ -202,7 +211,12 @@ fn the_analytic_jacobian_matches_central_differences_through_impacts() {
     assert!(bounces >= 2, "the record must have bounces: {:?}", c.events);
     // RK4 across the events and the edge, and where the motion is too fast
     // for the cubic (890 by Radau, 609 by RK4 when written).
-    assert!(c.rk4 > c.events.len() && c.radau > c.rk4, "{} / {}", c.radau, c.rk4);
+    assert!(
+        c.rk4 > c.events.len() && c.radau > c.rk4,
+        "{} / {}",
+        c.radau,
+        c.rk4
+    );
 }
 
 /// ±`volts`, reversed every 4 ms (200 samples): the flux, and with it
@@ -218,7 +232,11 @@ fn reversals(volts: f64) -> Measured {
 fn the_analytic_jacobian_matches_central_differences_on_the_hysteretic_core() {
     let d = parse_file(&example_path("jiles-atherton-valve.toml")).unwrap();
     let c = compare(&d, &reversals(4.0), &JA_PATHS, 5e-4);
-    assert!(c.events.is_empty(), "the armature must not move: {:?}", c.events);
+    assert!(
+        c.events.is_empty(),
+        "the armature must not move: {:?}",
+        c.events
+    );
     assert!(c.radau > 10 * c.rk4, "{} / {}", c.radau, c.rk4);
 }
 

@@ -27,6 +27,7 @@ use reldesign_identify::edges::{located, replay_input};
 use reldesign_identify::edit::write_physics;
 use reldesign_identify::wnrmse;
 
+use crate::friction::replay_with_friction;
 use crate::{example_path, Rng};
 
 /// Sample period of the records [s] (the semera paper samples at 50 µs).
@@ -626,6 +627,10 @@ pub struct Chain {
     pub probe_tau: f64,
     /// The driver applies the recorded voltage this late [s].
     pub driver_delay: f64,
+    /// A Coulomb friction force on the armature [N] (of the bench's valve,
+    /// not of its instruments, but no description holds it either:
+    /// [`friction`](crate::friction)).
+    pub coulomb: f64,
 }
 
 impl Chain {
@@ -634,6 +639,7 @@ impl Chain {
         probe_gain: 1.0,
         probe_tau: 0.0,
         driver_delay: 0.0,
+        coulomb: 0.0,
     };
 }
 
@@ -655,8 +661,12 @@ pub fn experiment_through(
     let n = ((excitation.duration() + sampling.delay) / sampling.period).floor() as usize + 1;
     let t: Vec<f64> = (0..n).map(|k| k as f64 * sampling.period).collect();
     let mut model = Model::build(truth);
-    let run = replay(&mut model, &input, &t, &Options::default())
-        .unwrap_or_else(|e| panic!("{}: simulation failed: {e}", truth.name));
+    let run = if chain.coulomb > 0.0 {
+        replay_with_friction(&mut model, chain.coulomb, &input, &t, &Options::default())
+    } else {
+        replay(&mut model, &input, &t, &Options::default())
+    }
+    .unwrap_or_else(|e| panic!("{}: simulation failed: {e}", truth.name));
     let commanded = excitation.input(sampling.delay);
     let probed = probe(&run.current, chain, sampling.period);
     let mut out = format!(

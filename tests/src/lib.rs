@@ -2,6 +2,7 @@
 //! loading models, deterministic pseudo-random states.
 
 pub mod devices;
+pub mod friction;
 pub mod hidden;
 pub mod outside;
 pub mod sensorless;

@@ -2,8 +2,11 @@
 //! what a bench or a valve does that no cause of `diagnose` represents, for
 //! tests that the answer is `unexplained` and not a vocabulary cause with a
 //! high gain. The measurement chain's effects go through
-//! [`hidden::experiment_through`]; a wrong spring changes the plant itself.
+//! [`hidden::experiment_through`], and so does Coulomb friction (a plant
+//! of its own, [`friction`](crate::friction)); a wrong spring changes the
+//! description's plant itself.
 
+use designer::description::Description;
 use reldesign_identify::diagnose::Cause;
 
 use crate::hidden::{self, experiment_through, Chain, Excitation, HiddenCase, Noise, Sampling};
@@ -20,11 +23,15 @@ pub enum Outside {
     ProbeLag(f64),
     /// The spring (stiffness and preload) is this times the description's.
     Spring(f64),
+    /// Coulomb friction on the armature, this times the spring's force
+    /// over the stroke, k_s·(z_max − z_min) ([`friction`](crate::friction)).
+    Friction(f64),
 }
 
 impl Outside {
-    /// The measurement chain the effect puts between plant and record.
-    fn chain(self) -> Chain {
+    /// The measurement chain the effect puts between plant and record (and
+    /// the friction the plant meets), for the description `d`.
+    fn chain(self, d: &Description) -> Chain {
         match self {
             Outside::ProbeGain(g) => Chain {
                 probe_gain: g,
@@ -36,6 +43,10 @@ impl Outside {
             },
             Outside::ProbeLag(tau) => Chain {
                 probe_tau: tau,
+                ..Chain::IDEAL
+            },
+            Outside::Friction(f) => Chain {
+                coulomb: f * d.mechanics.stiffness * (d.mechanics.z_max - d.mechanics.z_min),
                 ..Chain::IDEAL
             },
             Outside::Spring(_) => Chain::IDEAL,
@@ -69,7 +80,7 @@ pub fn outside_case(
         sampling,
         noise,
         with_z,
-        effect.chain(),
+        effect.chain(&base),
         &mut rng,
     );
     HiddenCase {

@@ -464,57 +464,72 @@ fn run_causes(case: &HiddenCase) -> (Causes, Vec<FittedParameter>) {
 /// Effects outside the vocabulary (issue 17 §2, `reldesign_tests::outside`)
 /// on four actuators, with and without `z`, every candidate tried: how often
 /// the answer is `unexplained`, and what else is named (the table of
-/// docs/validation/diagnose.md).
+/// docs/validation/diagnose.md). Coulomb friction of 10 % of the spring's
+/// force over the stroke may leave no trace above the noise: there `none`
+/// is right (the baseline leaving at most 1.2× the floor).
 #[test]
-#[ignore = "slow: 48 records, every candidate"]
+#[ignore = "slow: 64 records, every candidate"]
 fn outside_matrix() {
     use reldesign_tests::outside::{outside_case, Outside};
-    let effects = [
-        Outside::ProbeGain(1.08),
-        Outside::ProbeGain(0.92),
-        Outside::DriverDelay(120e-6),
-        Outside::ProbeLag(100e-6),
-        Outside::Spring(1.3),
-        Outside::Spring(0.7),
+    // (effects, the first seed): the measurement chain's and the spring's
+    // first, their seeds as when the matrix had only them
+    let effects: [(&[Outside], u64); 2] = [
+        (
+            &[
+                Outside::ProbeGain(1.08),
+                Outside::ProbeGain(0.92),
+                Outside::DriverDelay(120e-6),
+                Outside::ProbeLag(100e-6),
+                Outside::Spring(1.3),
+                Outside::Spring(0.7),
+            ],
+            500,
+        ),
+        (&[Outside::Friction(0.1), Outside::Friction(0.3)], 600),
     ];
-    let (mut unexplained, mut total, mut named_high) = (0, 0, Vec::new());
-    let mut seed = 500;
-    for example in [SEMERA, TRACKING, SLIDING, TABLE] {
-        for effect in effects {
-            for with_z in [false, true] {
-                seed += 1;
-                let e = excitation(example, Square);
-                let case = outside_case(example, effect, &e, with_z, seed);
-                let (answer, _) = run_causes(&case);
-                total += 1;
-                let names = answer.names();
-                let line = format!(
-                    "{example} {effect:?} z={with_z} seed={seed}: {} (gain {:.1} %, left {:.2}× the floor, correlated over {:.1} samples; partial {:?})",
-                    names.iter().map(|c| c.name()).collect::<Vec<_>>().join(" + "),
-                    100.0 * answer.gain(),
-                    answer.residual.over_floor,
-                    answer.residual.correlation,
-                    answer.partial(),
-                );
-                eprintln!("{line}");
-                if answer.unexplained() {
-                    unexplained += 1;
-                } else if names != [Cause::None] && answer.gain() >= 0.5 {
-                    named_high.push(line);
+    let (mut unexplained, mut invisible, mut total) = (0, 0, 0);
+    let mut wrong = Vec::new();
+    for (effects, first_seed) in effects {
+        let mut seed = first_seed;
+        for example in [SEMERA, TRACKING, SLIDING, TABLE] {
+            for &effect in effects {
+                for with_z in [false, true] {
+                    seed += 1;
+                    let e = excitation(example, Square);
+                    let case = outside_case(example, effect, &e, with_z, seed);
+                    let (answer, _) = run_causes(&case);
+                    total += 1;
+                    let names = answer.names();
+                    let line = format!(
+                        "{example} {effect:?} z={with_z} seed={seed}: {} (gain {:.1} %, left {:.2}× the floor, correlated over {:.1} samples; partial {:?})",
+                        names.iter().map(|c| c.name()).collect::<Vec<_>>().join(" + "),
+                        100.0 * answer.gain(),
+                        answer.residual.over_floor,
+                        answer.residual.correlation,
+                        answer.partial(),
+                    );
+                    eprintln!("{line}");
+                    if answer.unexplained() {
+                        unexplained += 1;
+                    } else if names == [Cause::None] && answer.residual.over_floor <= 1.2 {
+                        invisible += 1;
+                    } else {
+                        wrong.push(line);
+                    }
                 }
             }
         }
     }
     eprintln!(
-        "{unexplained} of {total} unexplained; a cause named with a gain ≥ 50 %: {}",
-        named_high.len()
+        "{unexplained} of {total} unexplained, {invisible} `none` with no trace above the noise, {} otherwise",
+        wrong.len()
     );
     assert!(
-        named_high.is_empty(),
-        "a vocabulary cause named with a high gain:\n{}",
-        named_high.join("\n")
+        wrong.is_empty(),
+        "neither unexplained nor an invisible effect:\n{}",
+        wrong.join("\n")
     );
-    assert_eq!(unexplained, total, "every record is unexplained");
+    assert!(invisible <= 4, "{invisible} effects left no trace");
 }
 
 #[test]

@@ -382,3 +382,47 @@ fn measurement_chain_effects_do_what_they_say() {
     let rel = (lagged.2[before_fall] - i[before_fall]).abs() / i[before_fall];
     assert!(rel < 1e-3, "the steady current is kept: {rel:e}");
 }
+
+/// Coulomb friction (`reldesign_tests::friction`) brakes the armature and
+/// nothing else: with no force the replay is the plain one bit for bit; with
+/// a force of 10 % of the spring's over the stroke, the armature closes
+/// later and hits the stop slower, and the current at rest is unchanged.
+#[test]
+fn coulomb_friction_brakes_the_armature() {
+    use designer::model::Model;
+    use designer::replay::replay;
+    use designer::sim::{EventKind, Options, PiecewiseLinear};
+    use reldesign_tests::friction::replay_with_friction;
+
+    let base = baseline(&example("semera-valve.toml"));
+    let t: Vec<f64> = (0..2000).map(|k| k as f64 * 10e-6).collect();
+    let on = PiecewiseLinear::new(vec![0.0, 1e-6, 1.0], vec![0.0, 24.0, 24.0]).unwrap();
+    let opts = Options::default();
+    let plain = replay(&mut Model::build(&base), &on, &t, &opts).unwrap();
+    let none = replay_with_friction(&mut Model::build(&base), 0.0, &on, &t, &opts).unwrap();
+    assert_eq!(none.current, plain.current);
+    let m = &base.mechanics;
+    let force = 0.1 * m.stiffness * (m.z_max - m.z_min);
+    let braked = replay_with_friction(&mut Model::build(&base), force, &on, &t, &opts).unwrap();
+    let first_impact = |r: &designer::replay::Replay| {
+        r.trajectory
+            .events
+            .iter()
+            .find_map(|e| match e.kind {
+                EventKind::Impact { v_before, .. } => Some((e.t, v_before.abs())),
+                _ => None,
+            })
+            .unwrap_or_else(|| panic!("the armature must close"))
+    };
+    let ((t0, v0), (t1, v1)) = (first_impact(&plain), first_impact(&braked));
+    assert!(
+        t1 > t0 && v1 < v0,
+        "closed at {t1} with {v1} m/s, without friction {t0} with {v0}"
+    );
+    // Before lift-off the armature rests: the same current.
+    let k = t
+        .iter()
+        .position(|&x| x >= 0.9 * plain.trajectory.events[0].t)
+        .unwrap_or(0);
+    assert_eq!(braked.current[..k], plain.current[..k]);
+}
