@@ -64,8 +64,21 @@ pub fn outside_case(
     with_z: bool,
     seed: u64,
 ) -> HiddenCase {
-    let (base, baseline_toml) =
-        hidden::baseline_of(&hidden::example_text(example_file), example_file);
+    let text = hidden::example_text(example_file);
+    outside_case_of(&text, example_file, effect, excitation, with_z, seed)
+}
+
+/// [`outside_case`] for the description `text` (an example's or a generated
+/// device's) named `file_name`.
+pub fn outside_case_of(
+    text: &str,
+    file_name: &str,
+    effect: Outside,
+    excitation: &Excitation,
+    with_z: bool,
+    seed: u64,
+) -> HiddenCase {
+    let (base, baseline_toml) = hidden::baseline_of(text, file_name);
     let mut truth = base.clone();
     if let Outside::Spring(factor) = effect {
         truth.mechanics.stiffness *= factor;
