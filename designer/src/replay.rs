@@ -7,7 +7,7 @@
 //! ([`ModelPlant::currents_and_voltages`]).
 
 use crate::model::{Model, ModelPlant};
-use crate::sim::{simulate, Input, Mode, Options, SimError, State, Trajectory};
+use crate::sim::{simulate, Input, Mode, Options, Plant, SimError, State, Trajectory};
 
 /// A simulated experiment with the coil's electrical outputs.
 #[derive(Debug, Clone)]
@@ -45,6 +45,19 @@ pub fn replay_plant<I: Input + ?Sized>(
     output_times: &[f64],
     options: &Options,
 ) -> Result<Replay, SimError> {
+    replay_through(plant, plant, model, input, output_times, options)
+}
+
+/// [`replay`] of `plant`, a variant of `model`'s own plant `coil` (e.g.
+/// with a force no description holds) whose coil outputs are `coil`'s.
+pub fn replay_through<P: Plant, I: Input + ?Sized>(
+    plant: &P,
+    coil: &ModelPlant,
+    model: &Model,
+    input: &I,
+    output_times: &[f64],
+    options: &Options,
+) -> Result<Replay, SimError> {
     let trajectory = simulate(
         plant,
         input,
@@ -54,7 +67,7 @@ pub fn replay_plant<I: Input + ?Sized>(
         options,
     )?;
     let tr = &trajectory;
-    let (current, voltage) = plant.currents_and_voltages(&tr.t, &tr.x, &tr.u);
+    let (current, voltage) = coil.currents_and_voltages(&tr.t, &tr.x, &tr.u);
     Ok(Replay {
         trajectory,
         current,

@@ -629,6 +629,20 @@ mod tests {
         Some(vec![10.0 * (x[1] - x[0] * x[0]), 1.0 - x[0]])
     }
 
+    /// Rosenbrock from (−1.2, 1) in [−5, 5]² with the Jacobian `jac`.
+    fn rosenbrock_with_jacobian(jac: impl FnMut(&[f64]) -> Option<DMatrix<f64>>) -> Report {
+        let bounds = [(-5.0, 5.0), (-5.0, 5.0)];
+        minimize_with_jacobian(
+            rosenbrock,
+            jac,
+            &[-1.2, 1.0],
+            &bounds,
+            &Options::default(),
+            &mut quiet,
+        )
+        .unwrap()
+    }
+
     #[test]
     fn rosenbrock_as_least_squares() {
         let bounds = [(-5.0, 5.0), (-5.0, 5.0)];
@@ -655,15 +669,7 @@ mod tests {
                 &[-20.0 * x[0], 10.0, -1.0, 0.0],
             ))
         };
-        let exact = minimize_with_jacobian(
-            rosenbrock,
-            jac,
-            &[-1.2, 1.0],
-            &bounds,
-            &Options::default(),
-            &mut quiet,
-        )
-        .unwrap();
+        let exact = rosenbrock_with_jacobian(jac);
         assert!((exact.theta[0] - 1.0).abs() < 1e-10, "{:?}", exact.theta);
         let seq = minimize_mut(
             rosenbrock,
@@ -695,16 +701,7 @@ mod tests {
                 )),
             }
         };
-        let bounds = [(-5.0, 5.0), (-5.0, 5.0)];
-        let rep = minimize_with_jacobian(
-            rosenbrock,
-            jac,
-            &[-1.2, 1.0],
-            &bounds,
-            &Options::default(),
-            &mut quiet,
-        )
-        .unwrap();
+        let rep = rosenbrock_with_jacobian(jac);
         assert!(rep.status.converged(), "{:?}", rep.status);
         assert!((rep.theta[0] - 1.0).abs() < 1e-8, "{:?}", rep.theta);
         assert!(calls.get() > 2 && rep.evaluations > calls.get());

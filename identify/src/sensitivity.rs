@@ -43,6 +43,9 @@
 //! has none) and those entering only the mode logic
 //! (`mechanics.bounce_threshold`).
 
+// `!(a <= b)` comparisons are deliberate: they also catch NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use std::cell::RefCell;
 
 use nalgebra::DMatrix;

@@ -7,8 +7,8 @@
 //! one at about F_c/m.
 
 use designer::model::{Model, ModelPlant};
-use designer::replay::{rest_state, Replay};
-use designer::sim::{simulate, Branches, Input, Limits, Mode, Options, Plant, SimError, State};
+use designer::replay::{replay_through, Replay};
+use designer::sim::{Branches, Input, Limits, Options, Plant, SimError, State};
 
 /// The speed over which the friction force reaches 76 % of F_c (tanh 1) [m/s]:
 /// far below a valve's 0.1–2 m/s, so the force is nearly constant in motion.
@@ -85,19 +85,5 @@ pub fn replay_with_friction<I: Input + ?Sized>(
         force,
         mass,
     };
-    let trajectory = simulate(
-        &plant,
-        input,
-        rest_state(model),
-        Mode::StuckMax,
-        output_times,
-        options,
-    )?;
-    let tr = &trajectory;
-    let (current, voltage) = inner.currents_and_voltages(&tr.t, &tr.x, &tr.u);
-    Ok(Replay {
-        trajectory,
-        current,
-        voltage,
-    })
+    replay_through(&plant, &inner, model, input, output_times, options)
 }

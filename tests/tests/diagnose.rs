@@ -18,6 +18,7 @@ use reldesign_identify::diagnose::{
 };
 use reldesign_identify::Measured;
 use reldesign_tests::hidden::{hidden_case, Excitation, HiddenCase};
+use reldesign_tests::outside::Outside;
 
 #[derive(Debug, Clone, Copy)]
 enum Drive {
@@ -461,6 +462,74 @@ fn run_causes(case: &HiddenCase) -> (Causes, Vec<FittedParameter>) {
     (answer, parameters)
 }
 
+/// The measurement chain's effects and a wrong spring, outside the
+/// vocabulary (`reldesign_tests::outside`).
+const CHAIN_AND_SPRING: [Outside; 6] = [
+    Outside::ProbeGain(1.08),
+    Outside::ProbeGain(0.92),
+    Outside::DriverDelay(120e-6),
+    Outside::ProbeLag(100e-6),
+    Outside::Spring(1.3),
+    Outside::Spring(0.7),
+];
+
+/// Coulomb friction of 10 % and 30 % of the spring's force over the stroke.
+const FRICTIONS: [Outside; 2] = [Outside::Friction(0.1), Outside::Friction(0.3)];
+
+/// Answers to records of effects outside the vocabulary, counted.
+#[derive(Default)]
+struct Tally {
+    total: usize,
+    unexplained: usize,
+    none: usize,
+    /// The lines of the other answers.
+    other: Vec<String>,
+}
+
+impl Tally {
+    /// Counts `answer`, reported by `line`; `none` as such where allowed.
+    fn add(&mut self, answer: &Causes, line: String, none_allowed: bool) {
+        self.total += 1;
+        if answer.unexplained() {
+            self.unexplained += 1;
+        } else if none_allowed && answer.names() == [Cause::None] {
+            self.none += 1;
+        } else {
+            self.other.push(line);
+        }
+    }
+}
+
+impl std::fmt::Display for Tally {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(
+            f,
+            "{} of {} unexplained, {} none, {} otherwise",
+            self.unexplained,
+            self.total,
+            self.none,
+            self.other.len()
+        )
+    }
+}
+
+/// The answer for a record of an effect outside the vocabulary, and the
+/// line that reports it (printed).
+fn outside_answer(label: &str, case: &HiddenCase) -> (Causes, String) {
+    let (answer, _) = run_causes(case);
+    let names: Vec<_> = answer.names().iter().map(|c| c.name()).collect();
+    let line = format!(
+        "{label}: {} (gain {:.1} %, left {:.2}× the floor, correlated over {:.1} samples; partial {:?})",
+        names.join(" + "),
+        100.0 * answer.gain(),
+        answer.residual.over_floor,
+        answer.residual.correlation,
+        answer.partial(),
+    );
+    eprintln!("{line}");
+    (answer, line)
+}
+
 /// Effects outside the vocabulary (issue 17 §2, `reldesign_tests::outside`)
 /// on four actuators, with and without `z`, every candidate tried: how often
 /// the answer is `unexplained`, and what else is named (the table of
@@ -472,25 +541,11 @@ fn run_causes(case: &HiddenCase) -> (Causes, Vec<FittedParameter>) {
 #[test]
 #[ignore = "slow: 64 records, every candidate"]
 fn outside_matrix() {
-    use reldesign_tests::outside::{outside_case, Outside};
+    use reldesign_tests::outside::outside_case;
     // (effects, the first seed): the measurement chain's and the spring's
     // first, their seeds as when the matrix had only them
-    let effects: [(&[Outside], u64); 2] = [
-        (
-            &[
-                Outside::ProbeGain(1.08),
-                Outside::ProbeGain(0.92),
-                Outside::DriverDelay(120e-6),
-                Outside::ProbeLag(100e-6),
-                Outside::Spring(1.3),
-                Outside::Spring(0.7),
-            ],
-            500,
-        ),
-        (&[Outside::Friction(0.1), Outside::Friction(0.3)], 600),
-    ];
-    let (mut unexplained, mut total) = (0, 0);
-    let (mut friction_none, mut wrong) = (0, Vec::new());
+    let effects: [(&[Outside], u64); 2] = [(&CHAIN_AND_SPRING, 500), (&FRICTIONS, 600)];
+    let mut tally = Tally::default();
     for (effects, first_seed) in effects {
         let mut seed = first_seed;
         for example in [SEMERA, TRACKING, SLIDING, TABLE] {
@@ -499,43 +554,20 @@ fn outside_matrix() {
                     seed += 1;
                     let e = excitation(example, Square);
                     let case = outside_case(example, effect, &e, with_z, seed);
-                    let (answer, _) = run_causes(&case);
-                    total += 1;
-                    let names = answer.names();
-                    let line = format!(
-                        "{example} {effect:?} z={with_z} seed={seed}: {} (gain {:.1} %, left {:.2}× the floor, correlated over {:.1} samples; partial {:?})",
-                        names.iter().map(|c| c.name()).collect::<Vec<_>>().join(" + "),
-                        100.0 * answer.gain(),
-                        answer.residual.over_floor,
-                        answer.residual.correlation,
-                        answer.partial(),
-                    );
-                    eprintln!("{line}");
-                    let friction = matches!(effect, Outside::Friction(_));
-                    if answer.unexplained() {
-                        unexplained += 1;
-                    } else if friction && names == [Cause::None] {
-                        friction_none += 1;
-                    } else {
-                        wrong.push(line);
-                    }
+                    let label = format!("{example} {effect:?} z={with_z} seed={seed}");
+                    let (answer, line) = outside_answer(&label, &case);
+                    tally.add(&answer, line, matches!(effect, Outside::Friction(_)));
                 }
             }
         }
     }
-    eprintln!(
-        "{unexplained} of {total} unexplained, {friction_none} frictions `none`, {} otherwise",
-        wrong.len()
-    );
+    eprintln!("{tally} (`none`: frictions only)");
     assert!(
-        wrong.is_empty(),
+        tally.other.is_empty(),
         "a cause named, or `none` for an effect of the chain or the spring:\n{}",
-        wrong.join("\n")
+        tally.other.join("\n")
     );
-    assert!(
-        friction_none <= 6,
-        "{friction_none} frictions answered `none`"
-    );
+    assert!(tally.none <= 6, "{} frictions answered `none`", tally.none);
 }
 
 /// The effects outside the vocabulary on devices nobody tuned the diagnosis
@@ -547,19 +579,9 @@ fn outside_matrix() {
 #[test]
 #[ignore = "slow: 60 records, every candidate (450 s)"]
 fn outside_on_generated_devices() {
-    use reldesign_tests::outside::{outside_case_of, Outside};
-    let effects = [
-        Outside::ProbeGain(1.08),
-        Outside::ProbeGain(0.92),
-        Outside::DriverDelay(120e-6),
-        Outside::ProbeLag(100e-6),
-        Outside::Spring(1.3),
-        Outside::Spring(0.7),
-        Outside::Friction(0.1),
-        Outside::Friction(0.3),
-    ];
-    let (mut unexplained, mut none, mut total) = (0, 0, 0);
-    let mut named = Vec::new();
+    use reldesign_tests::outside::outside_case_of;
+    let effects = [CHAIN_AND_SPRING.as_slice(), &FRICTIONS].concat();
+    let mut tally = Tally::default();
     let mut seed = 700;
     for index in 0..15u64 {
         let device = reldesign_tests::devices::device(DEVICE_SEED, index, false);
@@ -570,36 +592,17 @@ fn outside_on_generated_devices() {
             seed += 1;
             let effect = effects[(4 * index as usize + k) % effects.len()];
             let case = outside_case_of(&device.toml, &file, effect, &excitation, false, seed);
-            let (answer, _) = run_causes(&case);
-            total += 1;
-            let names = answer.names();
-            let line = format!(
-                "{file} {effect:?} seed={seed}: {} (gain {:.1} %, left {:.2}× the floor; partial {:?})",
-                names.iter().map(|c| c.name()).collect::<Vec<_>>().join(" + "),
-                100.0 * answer.gain(),
-                answer.residual.over_floor,
-                answer.partial(),
-            );
-            eprintln!("{line}");
-            if answer.unexplained() {
-                unexplained += 1;
-            } else if names == [Cause::None] {
-                none += 1;
-            } else {
-                named.push(line);
-            }
+            let (answer, line) = outside_answer(&format!("{file} {effect:?} seed={seed}"), &case);
+            tally.add(&answer, line, true);
         }
     }
-    eprintln!(
-        "{unexplained} of {total} unexplained, {none} none, a cause named: {}",
-        named.len()
-    );
+    eprintln!("{tally}");
     assert!(
-        named.is_empty(),
+        tally.other.is_empty(),
         "a vocabulary cause named:\n{}",
-        named.join("\n")
+        tally.other.join("\n")
     );
-    assert!(none <= 1, "{none} answered `none`");
+    assert!(tally.none <= 1, "{} answered `none`", tally.none);
 }
 
 #[test]
