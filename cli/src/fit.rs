@@ -333,7 +333,8 @@ fn jacobian_name(r: &FitReport) -> String {
         (Sensitivities::Analytic, 0) => "analytic forward sensitivities".into(),
         (Sensitivities::Analytic, n) => format!(
             "analytic forward sensitivities ({n} of them by finite differences of whole \
-             replays, where the sensitivities gave up: a field too stiff for them)"
+             replays, where the sensitivities gave up: a field too stiff for them, or a \
+             failed replay)"
         ),
         (Sensitivities::FiniteDifference, _) => "finite differences of whole replays".into(),
     }

@@ -498,7 +498,6 @@ pub fn fit(
     // θ (the solver asks for J at the point it just evaluated and accepted).
     let last: RefCell<Option<(Vec<f64>, Trajectory)>> = RefCell::new(None);
     let jacobian_replays = Cell::new(0);
-    let differenced = Cell::new(0);
     let keeping = |theta: &[f64]| {
         let d = with_values(description, params, theta).ok()?;
         let replay = replay(&d, data, &setup.objective.budget).ok()?;
@@ -516,15 +515,8 @@ pub fn fit(
                 replay(&d, data, &setup.objective.budget).ok()?.trajectory
             }
         };
-        let jac = setup
-            .objective
-            .jacobian(&d, &paths, &trajectory)
-            .filter(|j| j.iter().all(|x| x.is_finite()));
-        if jac.is_none() {
-            // `lm` differences the residual instead.
-            differenced.set(differenced.get() + 1);
-        }
-        jac
+        // none (or not finite): `lm` differences the residual instead
+        setup.objective.jacobian(&d, &paths, &trajectory)
     };
     let lm_options = lm::Options {
         max_iterations: options.max_iterations,
@@ -534,7 +526,7 @@ pub fn fit(
     };
     let starts = options.starts.max(1);
     let mut best: Option<(usize, lm::Report)> = None;
-    let (mut iterations, mut simulations) = (0, 0);
+    let (mut iterations, mut simulations, mut differenced) = (0, 0, 0);
     let mut last_error = None;
     for (k, x0) in start_points(start0, params, starts, options.seed)
         .iter()
@@ -558,6 +550,7 @@ pub fn fit(
             Ok(report) => {
                 iterations += report.iterations;
                 simulations += report.evaluations;
+                differenced += report.differenced_jacobians;
                 if best.as_ref().is_none_or(|(_, b)| report.cost < b.cost) {
                     best = Some((k, report));
                 }
@@ -597,7 +590,7 @@ pub fn fit(
         },
         status: report.status,
         best_start,
-        differenced_jacobians: differenced.get(),
+        differenced_jacobians: differenced,
     })
 }
 

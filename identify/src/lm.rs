@@ -99,6 +99,9 @@ pub struct Report {
     pub iterations: usize,
     /// Residual evaluations, finite differences included.
     pub evaluations: usize,
+    /// Of [`minimize_with_jacobian`]'s Jacobians, those the caller could not
+    /// give and the solver differenced instead.
+    pub differenced_jacobians: usize,
     pub status: Status,
 }
 
@@ -182,12 +185,7 @@ where
     let mut problem = Problem {
         map: &map,
         residual: |y: &[f64]| call(&map.theta(y)),
-        jacobian: |y: &[f64], r: &[f64]| {
-            let columns = (0..y.len())
-                .map(|j| fd_column(&map, &call, y, r, j, options.fd_step))
-                .collect();
-            assemble(columns, r.len())
-        },
+        jacobian: |y: &[f64], r: &[f64]| fd_jacobian(&map, &call, y, r, options.fd_step),
     };
     let mut report = solve(&mut problem, options, monitor)?;
     report.evaluations = count.get();
@@ -208,7 +206,7 @@ where
     F: FnMut(&[f64]) -> Option<Vec<f64>>,
     J: FnMut(&[f64]) -> Option<DMatrix<f64>>,
 {
-    let count = std::cell::Cell::new(0);
+    let (count, differenced) = (std::cell::Cell::new(0), std::cell::Cell::new(0));
     let f = std::cell::RefCell::new(residual);
     let call = |x: &[f64]| {
         count.set(count.get() + 1);
@@ -227,15 +225,14 @@ where
                 Some(jac)
             }
             _ => {
-                let columns = (0..y.len())
-                    .map(|j| fd_column(&map, &call, y, r, j, options.fd_step))
-                    .collect();
-                assemble(columns, r.len())
+                differenced.set(differenced.get() + 1);
+                fd_jacobian(&map, &call, y, r, options.fd_step)
             }
         },
     };
     let mut report = solve(&mut problem, options, monitor)?;
     report.evaluations = count.get();
+    report.differenced_jacobians = differenced.get();
     Ok(report)
 }
 
@@ -353,6 +350,17 @@ where
         }
     }
     None
+}
+
+/// The forward-difference Jacobian at `y`, one column after the other.
+fn fd_jacobian<F>(map: &Map, f: &F, y: &[f64], r: &[f64], step: f64) -> Option<DMatrix<f64>>
+where
+    F: Fn(&[f64]) -> Option<Vec<f64>>,
+{
+    let columns = (0..y.len())
+        .map(|j| fd_column(map, f, y, r, j, step))
+        .collect();
+    assemble(columns, r.len())
 }
 
 fn assemble(columns: Vec<Option<Vec<f64>>>, rows: usize) -> Option<DMatrix<f64>> {
@@ -615,6 +623,7 @@ fn report(map: &Map, pt: Point, iterations: usize, status: Status) -> Report {
         jacobian,
         iterations,
         evaluations: 0,
+        differenced_jacobians: 0,
         status,
     }
 }
@@ -705,6 +714,8 @@ mod tests {
         assert!(rep.status.converged(), "{:?}", rep.status);
         assert!((rep.theta[0] - 1.0).abs() < 1e-8, "{:?}", rep.theta);
         assert!(calls.get() > 2 && rep.evaluations > calls.get());
+        // every one of them differenced, and counted
+        assert_eq!(rep.differenced_jacobians, calls.get());
     }
 
     #[test]

@@ -286,14 +286,23 @@ impl Field {
     /// zero when `stuck` (∞ when f_x is not finite).
     fn rate_bound(&self, stuck: bool) -> f64 {
         let d = self.d;
-        let out = self.out.borrow();
         let mut fx = [0.0; MAX_DIM * MAX_DIM];
-        for (i, row) in out[d..d + d * d].chunks(d).enumerate() {
-            if !(stuck && i < 2) {
-                fx[i * d..(i + 1) * d].copy_from_slice(row);
+        self.frozen_rows(stuck, d, d, &mut fx[..d * d]);
+        spectral_bound(&fx[..d * d], d)
+    }
+
+    /// The `cols`-wide block of the last evaluation's outputs from `from`
+    /// on (f_x: from d, d wide; f_θ: from d + d², p wide) into `block`,
+    /// rows of z and v zero when `stuck`.
+    fn frozen_rows(&self, stuck: bool, from: usize, cols: usize, block: &mut [f64]) {
+        let out = self.out.borrow();
+        let rows = out[from..from + self.d * cols].chunks(cols);
+        for (i, (row, into)) in rows.zip(block.chunks_mut(cols)).enumerate() {
+            match stuck && i < 2 {
+                true => into.fill(0.0),
+                false => into.copy_from_slice(row),
             }
         }
-        spectral_bound(&fx[..d * d], d)
     }
 
     /// Classical RK4 of (x, S) over [a, b] in `SUBSTEPS` steps, finer from
@@ -368,21 +377,11 @@ impl Field {
     /// rows of z and v zero when `stuck`; f itself is returned.
     fn linearisation(&self, stuck: bool, a: &mut [f64], b: &mut [f64]) -> [f64; MAX_DIM] {
         let (d, p) = (self.d, self.p);
+        self.frozen_rows(stuck, d, d, a);
+        self.frozen_rows(stuck, d + d * d, p, b);
         let out = self.out.borrow();
-        let (f, rest) = out.split_at(d);
-        let (fx, rest) = rest.split_at(d * d);
-        let frozen = |i: usize| stuck && i < 2;
-        for i in 0..d {
-            let keep = if frozen(i) { 0.0 } else { 1.0 };
-            for k in 0..d {
-                a[i * d + k] = keep * fx[i * d + k];
-            }
-            for j in 0..p {
-                b[i * p + j] = keep * rest[i * p + j];
-            }
-        }
-        std::array::from_fn(|i| match i < d && !frozen(i) {
-            true => f[i],
+        std::array::from_fn(|i| match i < d && !(stuck && i < 2) {
+            true => out[i],
             false => 0.0,
         })
     }
@@ -434,6 +433,10 @@ impl Field {
         if !follows {
             return false;
         }
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        if !(finite(a1) && finite(a2) && finite(b1) && finite(b2)) {
+            return false;
+        }
         // [Z1; Z2] = S + h·RADAU·[A1·Z1 + B1; A2·Z2 + B2]: unused rows of the
         // padded system are identity.
         let stage = [&*a1, &*a2];
@@ -445,10 +448,6 @@ impl Field {
                 false => identity,
             }
         });
-        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-        if !(finite(a1) && finite(a2) && finite(b1) && finite(b2)) {
-            return false;
-        }
         let Some(lu) = Some(m.lu()).filter(|lu| lu.is_invertible()) else {
             return false;
         };
