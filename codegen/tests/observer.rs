@@ -16,7 +16,9 @@ use std::fmt::Write as _;
 
 use designer::description::{parse_file, parse_str, Core, Description};
 use designer::model::Model;
-use designer::observe::discrete::{DiscreteModel, Estimate, KalmanSettings, ResistanceSettings};
+use designer::observe::discrete::{
+    DiscreteModel, Estimate, FluxStep, KalmanSettings, ResistanceSettings,
+};
 use designer::observe::ekf::Ekf;
 use designer::observe::ukf::Ukf;
 use designer::replay::replay;
@@ -58,6 +60,7 @@ fn settings(d: &Description) -> KalmanSettings {
         ukf_alpha: 1.0,
         ukf_beta: 2.0,
         ukf_kappa: 0.0,
+        flux_step: FluxStep::Euler,
     }
 }
 
@@ -67,15 +70,22 @@ const RESISTANCE: ResistanceSettings = ResistanceSettings {
     initial_std: 5.0,
 };
 
-fn discrete(d: &Description, resistance: bool) -> DiscreteModel {
+fn discrete(d: &Description, resistance: bool, flux_step: FluxStep) -> DiscreteModel {
     let r = resistance.then_some(RESISTANCE);
-    DiscreteModel::with_resistance(&Model::build(d), &settings(d), r).unwrap()
+    let settings = KalmanSettings {
+        flux_step,
+        ..settings(d)
+    };
+    DiscreteModel::with_resistance(&Model::build(d), &settings, r).unwrap()
 }
+
+/// The exponential flux step of the cases that use it.
+const EXPONENTIAL: FluxStep = FluxStep::Exponential { substeps: 2 };
 
 /// The emitted observer part of a file: `params!`, `kalman!`, then
 /// `pub mod ekf` and `pub mod ukf` as the build wraps them.
-fn emit(d: &Description, resistance: bool, floats: &[Float]) -> String {
-    let dm = discrete(d, resistance);
+fn emit(d: &Description, resistance: bool, flux_step: FluxStep, floats: &[Float]) -> String {
+    let dm = discrete(d, resistance, flux_step);
     let input = ObserverInput {
         name: &d.name,
         discrete: &dm,
@@ -175,11 +185,11 @@ fn record(d: &Description, t_end: f64, holes: bool) -> Vec<(f64, f64)> {
 /// check binary's `end skipped repairs` line.
 fn reference(
     d: &Description,
-    resistance: bool,
+    (resistance, flux_step): (bool, FluxStep),
     ukf: bool,
     rec: &[(f64, f64)],
 ) -> (Vec<Estimate>, String) {
-    let dm = discrete(d, resistance);
+    let dm = discrete(d, resistance, flux_step);
     macro_rules! run {
         ($f:expr) => {{
             let mut f = $f;
@@ -194,18 +204,45 @@ fn reference(
     }
 }
 
-/// The cases run by the check binary: (module, example file, R a state,
-/// record file).
-const CASES: [(&str, &str, bool, &str); 4] = [
-    ("valve", "perfect-tracking-valve.toml", false, "valve.csv"),
+/// The cases run by the check binary: (module, example file, (R a state,
+/// flux step), record file).
+const CASES: [(&str, &str, (bool, FluxStep), &str); 6] = [
     (
         "valve",
         "perfect-tracking-valve.toml",
-        false,
+        (false, FluxStep::Euler),
+        "valve.csv",
+    ),
+    (
+        "valve",
+        "perfect-tracking-valve.toml",
+        (false, FluxStep::Euler),
         "valve-holes.csv",
     ),
-    ("ja", "jiles-atherton-valve.toml", false, "ja.csv"),
-    ("resist", "perfect-tracking-valve.toml", true, "valve.csv"),
+    (
+        "ja",
+        "jiles-atherton-valve.toml",
+        (false, FluxStep::Euler),
+        "ja.csv",
+    ),
+    (
+        "resist",
+        "perfect-tracking-valve.toml",
+        (true, FluxStep::Euler),
+        "valve.csv",
+    ),
+    (
+        "valveexp",
+        "perfect-tracking-valve.toml",
+        (true, EXPONENTIAL),
+        "valve.csv",
+    ),
+    (
+        "jaexp",
+        "jiles-atherton-valve.toml",
+        (true, EXPONENTIAL),
+        "ja.csv",
+    ),
 ];
 
 /// The check crate: lib with the emitted modules, a binary that runs every
@@ -216,22 +253,47 @@ fn write_crate() -> ScratchCrate {
         "//! Emitted by codegen/tests/observer.rs.\n#![no_std]\n#![forbid(unsafe_code)]\n\n",
     );
     // the variants are compiled and linted only
-    for (module, d, resistance) in [
-        ("valve", example("perfect-tracking-valve.toml"), false),
-        ("ja", example("jiles-atherton-valve.toml"), false),
+    let euler = FluxStep::Euler;
+    for (module, d, resistance, flux_step) in [
+        (
+            "valve",
+            example("perfect-tracking-valve.toml"),
+            false,
+            euler,
+        ),
+        ("ja", example("jiles-atherton-valve.toml"), false, euler),
         (
             "current",
             variant("drive = \"voltage\"", "drive = \"current\""),
             false,
+            euler,
         ),
         (
             "drift",
             variant("eddy = 1500.0", "eddy = 1500.0\nresistance_drift = 50.0"),
             false,
+            euler,
         ),
-        ("resist", example("perfect-tracking-valve.toml"), true),
+        (
+            "resist",
+            example("perfect-tracking-valve.toml"),
+            true,
+            euler,
+        ),
+        (
+            "valveexp",
+            example("perfect-tracking-valve.toml"),
+            true,
+            EXPONENTIAL,
+        ),
+        (
+            "jaexp",
+            example("jiles-atherton-valve.toml"),
+            true,
+            EXPONENTIAL,
+        ),
     ] {
-        let code = emit(&d, resistance, &[Float::F64, Float::F32]);
+        let code = emit(&d, resistance, flux_step, &[Float::F64, Float::F32]);
         krate.write(&format!("src/{module}.rs"), &code);
         writeln!(lib, "pub mod {module};").unwrap();
     }
@@ -284,13 +346,15 @@ fn write_crate() -> ScratchCrate {
 #[test]
 fn emission_is_byte_identical_across_runs() {
     let floats = [Float::F64, Float::F32];
-    for (file, resistance) in [
-        ("perfect-tracking-valve.toml", false),
-        ("perfect-tracking-valve.toml", true),
-        ("jiles-atherton-valve.toml", false),
+    for (file, resistance, flux_step) in [
+        ("perfect-tracking-valve.toml", false, FluxStep::Euler),
+        ("perfect-tracking-valve.toml", true, FluxStep::Euler),
+        ("jiles-atherton-valve.toml", false, FluxStep::Euler),
+        ("jiles-atherton-valve.toml", true, EXPONENTIAL),
     ] {
         let d = example(file);
-        let (a, b) = (emit(&d, resistance, &floats), emit(&d, resistance, &floats));
+        let emit = || emit(&d, resistance, flux_step, &floats);
+        let (a, b) = (emit(), emit());
         assert!(a == b, "{file}: two emissions differ");
     }
 }
@@ -307,6 +371,7 @@ fn emitted_modules_hold_the_model_and_not_the_algorithm() {
     let code = emit(
         &example("perfect-tracking-valve.toml"),
         false,
+        FluxStep::Euler,
         &[Float::F64],
     );
     for needle in [
@@ -389,13 +454,14 @@ fn emitted_modules_hold_the_model_and_not_the_algorithm() {
 /// whatever the floats and filters.
 #[test]
 fn every_parameter_and_setting_is_written_once() {
-    for (file, resistance) in [
-        ("perfect-tracking-valve.toml", true),
-        ("jiles-atherton-valve.toml", false),
+    for (file, resistance, flux_step) in [
+        ("perfect-tracking-valve.toml", true, FluxStep::Euler),
+        ("jiles-atherton-valve.toml", false, FluxStep::Euler),
+        ("jiles-atherton-valve.toml", true, EXPONENTIAL),
     ] {
         let d = example(file);
-        let code = emit(&d, resistance, &[Float::F64, Float::F32]);
-        let dm = discrete(&d, resistance);
+        let code = emit(&d, resistance, flux_step, &[Float::F64, Float::F32]);
+        let dm = discrete(&d, resistance, flux_step);
         let mut names: Vec<String> = dm
             .model_params
             .iter()

@@ -18,7 +18,9 @@
 
 use designer::description::{parse_file, parse_str, Core, Description, Drive};
 use designer::model::Model;
-use designer::observe::discrete::{DiscreteModel, Estimate, KalmanSettings, StateKind, MAX_DIM};
+use designer::observe::discrete::{
+    DiscreteModel, Estimate, FluxStep, KalmanSettings, StateKind, MAX_DIM,
+};
 use designer::observe::ekf::Ekf;
 use designer::observe::ukf::Ukf;
 use designer::replay::replay;
@@ -101,20 +103,29 @@ fn settings(d: &Description, ts: f64) -> KalmanSettings {
         ukf_alpha: 1.0,
         ukf_beta: 2.0,
         ukf_kappa: 0.0,
+        flux_step: FluxStep::Euler,
     }
 }
 
 // ---------------------------------------------------------------- Jacobians
 
 /// Central differences of the discrete map and the measurement against the
-/// symbolic Jacobians. A component whose one-sided differences disagree lies
+/// symbolic Jacobians, with either flux step. A component whose one-sided differences disagree lies
 /// on a kink (the saturation (84a), |φ| at 0, the branch δ = sign(φ̇) of
 /// Jiles–Atherton, the clamp (52)) and is skipped; most must be checked.
 #[test]
 fn symbolic_jacobians_match_finite_differences() {
-    for (file, d) in all_examples() {
+    let steps = [FluxStep::Euler, FluxStep::Exponential { substeps: 2 }];
+    for ((file, d), flux_step) in all_examples()
+        .into_iter()
+        .flat_map(|e| steps.map(|s| (e.clone(), s)))
+    {
         let model = Model::build(&d);
-        let dm = DiscreteModel::new(&model, &settings(&d, 50e-6)).unwrap();
+        let settings = KalmanSettings {
+            flux_step,
+            ..settings(&d, 50e-6)
+        };
+        let dm = DiscreteModel::new(&model, &settings).unwrap();
         let mut tapes = dm.tapes();
         let n = dm.dim();
         let m = &d.mechanics;
@@ -205,7 +216,7 @@ fn symbolic_jacobians_match_finite_differences() {
                 }
             }
         }
-        println!("{file}: {checked} Jacobian entries checked, {skipped} on kinks skipped");
+        println!("{file} ({flux_step:?}): {checked} Jacobian entries checked, {skipped} on kinks skipped");
         assert!(
             skipped * 20 < checked,
             "{file}: too many kinks ({skipped} of {})",

@@ -13,7 +13,7 @@ use reldesign_build::{
 };
 use designer::description::parse_file;
 use designer::model::Model;
-use designer::observe::discrete::{DiscreteModel, KalmanSettings};
+use designer::observe::discrete::{DiscreteModel, FluxStep, KalmanSettings};
 use designer::replay::replay;
 use designer::sim::{Options, PiecewiseLinear};
 
@@ -66,6 +66,7 @@ fn main() {
         ukf_alpha: 1.0,
         ukf_beta: 2.0,
         ukf_kappa: 0.0,
+        flux_step: FluxStep::Euler,
     };
     let dm = DiscreteModel::new(&model, &settings).unwrap_or_else(|e| panic!("{e}"));
     let input = ObserverInput {

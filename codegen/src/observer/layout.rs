@@ -4,7 +4,7 @@
 //! implementation assembles from them.
 
 use designer::description::Drive;
-use designer::observe::discrete::{DiscreteModel, StateKind};
+use designer::observe::discrete::{DiscreteModel, FluxStep, StateKind};
 use designer::sym::{Graph, Id};
 use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
@@ -135,7 +135,16 @@ pub(super) struct Layout {
 }
 
 /// `[JA 84a]`… : the doc of F's output for a state.
-fn next_doc(k: StateKind) -> &'static str {
+fn next_doc(k: StateKind, step: FluxStep) -> &'static str {
+    match (k, step) {
+        (StateKind::Flux, FluxStep::Exponential { .. }) => "φ_{k+1}: exponential Euler on the coil's total rate dφ̇/dφ at the mid-step position (flux_step = \"exponential\"; [JA 84c] is its Euler form)",
+        (StateKind::CoreField, FluxStep::Exponential { .. }) => "H_c,{k+1}: the exponential step's share of T_s·f_Hc ([JA 84d] is its Euler form)",
+        _ => euler_doc(k),
+    }
+}
+
+/// The paper's doc of F's output for a state.
+fn euler_doc(k: StateKind) -> &'static str {
     match k {
         StateKind::Position => "[JA 84a] z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s [JA 85]",
         StateKind::PreviousPosition => "[JA 84b] z_prev,{k+1} = sat_{z_min}^{z_max}(z)",
@@ -159,7 +168,13 @@ fn transition(
         .iter()
         .zip(&dm.transition)
         .zip(&dm.kinds)
-        .map(|((s, &id), &k)| (format!("{}_next", s.short), id, next_doc(k).to_owned()))
+        .map(|((s, &id), &k)| {
+            (
+                format!("{}_next", s.short),
+                id,
+                next_doc(k, dm.settings.flux_step).to_owned(),
+            )
+        })
         .collect();
     outputs.push(("accel".to_owned(), dm.acceleration, ACCEL_DOC.to_owned()));
     let mut jacobian = Vec::new();

@@ -440,6 +440,9 @@ pub struct KalmanSection {
     pub ukf_kappa: f64,
     /// `estimate_resistance = true`: the coil resistance as a random-walk state.
     pub resistance: Option<ResistanceEstimate>,
+    /// `flux_step = "exponential"` with its `flux_substeps` (≥ 1); `None`:
+    /// `"euler"`, the paper's [JA 84c–84d].
+    pub flux_substeps: Option<u32>,
 }
 
 /// `estimate_resistance = true` in `[observer.kalman]` with its two keys.

@@ -292,7 +292,9 @@ pub const KEYS: &[Key] = &[
     number("observer.kalman.ukf_alpha", Domain::UnitLeftOpen, "-", Presence::Default(1.0), "the UKF's sigma-point spread α"),
     number("observer.kalman.ukf_beta", Domain::NonNegative, "-", Presence::Default(2.0), "the UKF's prior-knowledge weight β"),
     number("observer.kalman.ukf_kappa", Domain::Any, "-", Presence::Default(0.0), "the UKF's secondary scaling κ"),
-    Key { kind: Kind::Bool, domain: Domain::Any, unit: "", ..number("observer.kalman.estimate_resistance", Domain::Any, "", Presence::Optional("false"), "R becomes a random-walk state [z, z_prev, φ, R] (not with a jiles-atherton core)") },
+    Key { kind: Kind::Bool, domain: Domain::Any, unit: "", ..number("observer.kalman.estimate_resistance", Domain::Any, "", Presence::Optional("false"), "R becomes a random-walk state: [z, z_prev, φ, R], [z, z_prev, φ, H_c, R] with a jiles-atherton core") },
+    Key { kind: Kind::Choice(&["euler", "exponential"]), ..number("observer.kalman.flux_step", Domain::Any, "", Presence::Optional("euler"), "how φ (and H_c) advance over a sample: euler, the paper's φ⁺ = φ + T_s·f_φ (84c–84d), stable while T_s < 2τ; exponential, exponential Euler on the coil's total rate at the armature's mid-step position, exact for a linear coil and stable at any T_s") },
+    number("observer.kalman.flux_substeps", Domain::Positive, "-", Presence::When("only with flux_step = \"exponential\"; default 1"), "exponential substeps per sample (an integer in 1..=64)"),
     number("observer.kalman.resistance_rate_std", Domain::Positive, "Ω/s", Presence::When("required with estimate_resistance = true, refused otherwise"), "σ_Ṙ: w_R has σ = σ_Ṙ·T_s per step"),
     number("observer.kalman.initial_resistance_std", Domain::Positive, "Ω", Presence::When("required with estimate_resistance = true, refused otherwise"), "initial σ of R around coil.resistance"),
 ];

@@ -12,8 +12,8 @@
 //! | [JA 85] velocity | v = (z − z_prev)/T_s |
 //! | [JA 84a] position | z⁺ = sat_{z_min}^{z_max}(2z − z_prev + T_s²·f_v(z, v, φ)) |
 //! | [JA 84b] previous position | z_prev⁺ = sat_{z_min}^{z_max}(z) (= z for every state [JA 84a] produces) |
-//! | [JA 84c] flux | φ⁺ = φ + T_s·f_φ(z, φ, H_c, u) |
-//! | [JA 84d] core field | H_c⁺ = H_c + T_s·f_Hc(z, φ, H_c, u) |
+//! | [JA 84c] flux | φ⁺ = φ + T_s·f_φ(z, φ, H_c, u) (or the exponential step of [`FluxStep`]) |
+//! | [JA 84d] core field | H_c⁺ = H_c + T_s·f_Hc(z, φ, H_c, u) (or the exponential step) |
 //! | coil resistance (optional) | R⁺ = R (random walk: w_R of σ = σ_Ṙ·T_s, as semera's q_r) |
 //! | [JA 86] mode | 1 if z ≤ z_min + band, 3 if z ≥ z_max − band, else 2 |
 //! | [JA 87] acceleration | a = f_v(z, v, φ) in mode 2, else 0 |
@@ -86,11 +86,13 @@
 //! | file | concept |
 //! | --- | --- |
 //! | `mod.rs` | the model [JA 84–87] in the symbolic core, its Jacobians, the runtime filters' settings |
+//! | `flux_step.rs` | [JA 84c–84d] or the exponential step of the electrical states: [`FluxStep`] |
 //! | `settings.rs` | `[observer.kalman]`: [`KalmanSettings`], [`ResistanceSettings`], [`KalmanError`] |
 //! | `tapes.rs` | the model on tapes, and [`TapeModel`]: the runtime's model traits for the reference filters |
 //! | `estimate.rs` | the designer's [`Estimate`] |
 
 mod estimate;
+mod flux_step;
 mod settings;
 mod tapes;
 
@@ -104,7 +106,8 @@ use crate::model::{Model, Params};
 use crate::sym::{Graph, Id, Tape};
 
 pub use estimate::Estimate;
-pub use settings::{KalmanError, KalmanSettings, ResistanceSettings};
+pub use flux_step::FluxStep;
+pub use settings::{KalmanError, KalmanSettings, ResistanceSettings, MAX_FLUX_SUBSTEPS};
 pub use tapes::{DiscreteTapes, MeasurementEval, Prediction, TapeModel};
 
 /// The estimate counts as resting on a stop within this many q_z of it.
@@ -232,7 +235,9 @@ impl DiscreteModel {
                 Ok(g.symbol(name))
             }
         };
-        check_electrical_step(model, settings.sample_period)?;
+        if settings.flux_step == FluxStep::Euler {
+            check_electrical_step(model, settings.sample_period)?;
+        }
         let mech = &model.description.mechanics;
         let z_prev = fresh(&mut g, Z_PREV)?;
         for name in [T_S, Z_MIN, Z_MAX, PHI_LIM] {
@@ -281,9 +286,22 @@ impl DiscreteModel {
         let neg_prev = g.neg(z_prev);
         let raw = g.sum(&[two_z, neg_prev, step]);
         let z_next = clamp(&mut g, raw, z_lo, z_hi);
-        // [JA 84c] φ⁺ = φ + T_s·f_φ
-        let dphi = g.mul(ts, f_phi);
-        let phi_next = g.add(phi, dphi);
+        let (phi_next, hc_next) = match settings.flux_step {
+            FluxStep::Euler => {
+                // [JA 84c] φ⁺ = φ + T_s·f_φ
+                let dphi = g.mul(ts, f_phi);
+                let phi_next = g.add(phi, dphi);
+                // [JA 84d] H_c⁺ = H_c + T_s·f_Hc
+                let hc_next = hc.map(|hc| {
+                    let dh = g.mul(ts, subst[3]);
+                    g.add(hc, dh)
+                });
+                (phi_next, hc_next)
+            }
+            FluxStep::Exponential { substeps } => {
+                flux_step::exponential(&mut g, model, &map, (z_dom, z_next), ts, substeps)?
+            }
+        };
         // [JA 84b] z_prev⁺ = z, as sat(z): the same for every state [JA 84a] gives,
         // and no spurious velocity [JA 85] from sigma points beyond a stop
         let mut states = vec![z, z_prev, phi];
@@ -293,12 +311,10 @@ impl DiscreteModel {
             StateKind::Flux,
         ];
         let mut transition = vec![z_next, z_dom, phi_next];
-        if let Some(hc) = hc {
-            // [JA 84d] H_c⁺ = H_c + T_s·f_Hc
-            let dh = g.mul(ts, subst[3]);
+        if let (Some(hc), Some(hc_next)) = (hc, hc_next) {
             states.push(hc);
             kinds.push(StateKind::CoreField);
-            transition.push(g.add(hc, dh));
+            transition.push(hc_next);
         }
         if let Some(r) = r_symbol {
             // R⁺ = R: a random walk (its noise is in Q)

@@ -3,7 +3,11 @@
 
 use reldesign_runtime::observe::Weights;
 
+use super::FluxStep;
 use crate::description::Observer;
+
+/// The most substeps an exponential flux step takes per sample.
+pub const MAX_FLUX_SUBSTEPS: u32 = 64;
 
 /// Coil-resistance estimation (`estimate_resistance = true` in
 /// `[observer.kalman]`): R as a random-walk state.
@@ -54,6 +58,8 @@ pub struct KalmanSettings {
     pub ukf_beta: f64,
     /// UKF κ (n + κ > 0).
     pub ukf_kappa: f64,
+    /// How the flux (and H_c) advance over a sample.
+    pub flux_step: FluxStep,
 }
 
 /// Why a discretised model or filter could not be built.
@@ -76,10 +82,16 @@ pub enum KalmanError {
     #[error("estimate_resistance: the model has no coil resistance parameter `R`")]
     NoResistance,
     #[error(
+        "observer.kalman.flux_step = \"exponential\": the flux rate does not depend on the \
+         input, so the core field's share of it cannot be told (use \"euler\")"
+    )]
+    FluxStepNeedsInput,
+    #[error(
         "observer.sample_period = {sample_period:e} s is too long for the coil: the flux's \
          electrical time constant is τ = {tau:.3e} s at z = {z:e} m (φ = 0), and the \
          forward-Euler flux step [JA 84c] diverges once T_s > 2τ; sample at least every \
-         τ/5 = {:.3e} s for an accurate step",
+         τ/5 = {:.3e} s for an accurate step, or set observer.kalman.flux_step = \
+         \"exponential\" (stable at any T_s)",
         tau / 5.0
     )]
     SampleTooLong {
@@ -107,6 +119,10 @@ impl KalmanSettings {
             ukf_alpha: k.ukf_alpha,
             ukf_beta: k.ukf_beta,
             ukf_kappa: k.ukf_kappa,
+            flux_step: match k.flux_substeps {
+                None => FluxStep::Euler,
+                Some(substeps) => FluxStep::Exponential { substeps },
+            },
         })
     }
 
@@ -138,6 +154,15 @@ impl KalmanSettings {
             self.ukf_beta >= 0.0,
             "a finite number >= 0",
         )?;
+        if let FluxStep::Exponential { substeps } = self.flux_step {
+            if !(1..=MAX_FLUX_SUBSTEPS).contains(&substeps) {
+                return Err(KalmanError::BadSetting {
+                    name: "flux_substeps",
+                    value: f64::from(substeps),
+                    expected: "an integer in 1..=64",
+                });
+            }
+        }
         let n = if has_field_state { 4.0 } else { 3.0 };
         check(
             "ukf_kappa",
