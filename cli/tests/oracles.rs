@@ -98,7 +98,21 @@ fn examples() -> Vec<OsString> {
 fn eval_agrees_with_the_casadi_oracle_on_every_example() {
     let mut args: Vec<OsString> = vec![BIN.into()];
     args.extend(examples());
+    args.push(reversible_core().into_os_string());
     oracle("check_eval.py", &args, "check_eval: OK");
+}
+
+/// The Jiles–Atherton example with `core.reversal = "reversible"`, written
+/// under the target directory.
+fn reversible_core() -> std::path::PathBuf {
+    let text = std::fs::read_to_string(root().join("examples/jiles-atherton-valve.toml")).unwrap();
+    let anchor = "model = \"jiles-atherton\"\n";
+    assert!(text.contains(anchor));
+    let text = text.replacen(anchor, &format!("{anchor}reversal = \"reversible\"\n"), 1);
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let path = dir.join("jiles-atherton-reversible.toml");
+    std::fs::write(&path, text).unwrap();
+    path
 }
 
 #[test]

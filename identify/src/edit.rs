@@ -14,7 +14,7 @@
 use toml_edit::{DocumentMut, Item, TableLike, Value};
 
 use crate::description::{
-    parse_str, schema, Coil, Core, Description, DescriptionError, Gap, Mechanics,
+    parse_str, schema, Coil, Core, Description, DescriptionError, Gap, Mechanics, Reversal,
 };
 
 /// Why the physics could not be written into a description's text.
@@ -180,7 +180,7 @@ fn write_core(mut s: Sect, core: &Core) {
         }
         Core::JilesAtherton(ja) => {
             let keys = [
-                "length", "area", "m_sat", "b", "c", "kappa", "alpha", "epsilon",
+                "length", "area", "m_sat", "b", "c", "kappa", "alpha", "epsilon", "reversal",
             ];
             s.model("jiles-atherton", &keys);
             s.num("length", ja.length);
@@ -191,6 +191,11 @@ fn write_core(mut s: Sect, core: &Core) {
             s.num("kappa", ja.kappa);
             s.num("alpha", ja.alpha);
             s.opt_num("epsilon", ja.epsilon, 1e-3);
+            let reversal = match ja.reversal {
+                Reversal::Clamp => "clamp",
+                Reversal::Reversible => "reversible",
+            };
+            s.opt_str("reversal", reversal, "clamp");
         }
     }
 }
@@ -264,6 +269,16 @@ impl Sect<'_> {
         if self.table.contains_key(key) || x != default {
             self.num(key, x);
         }
+    }
+
+    /// Sets `key = "value"` for an optional string key: an absent key whose
+    /// value would be the default stays absent.
+    fn opt_str(&mut self, key: &str, value: &str, default: &str) {
+        let now = self.table.get(key).and_then(|i| i.as_str());
+        if now == Some(value) || (now.is_none() && value == default) {
+            return;
+        }
+        self.put(key, Value::from(value));
     }
 
     /// Sets an array of numbers (untouched when equal element by element).
@@ -532,6 +547,7 @@ mod tests {
             kappa: 943.0,
             alpha: 3.66e-3,
             epsilon: 1e-3,
+            reversal: Reversal::Clamp,
         };
         let (text, out) = rewrite("semera-valve.toml", |d| d.core = Core::JilesAtherton(ja));
         assert!(
@@ -565,11 +581,13 @@ mod tests {
             kappa: 800.0,
             alpha: 1e-3,
             epsilon: 2e-3,
+            reversal: Reversal::Reversible,
         });
         let out = write_physics(&lin, "lin.toml", &target).unwrap();
         let back = parse_str(&out, "lin.toml").unwrap();
         assert_eq!(back.core, target.core);
         assert!(out.contains("epsilon = 0.002  # [-]"), "{out}");
+        assert!(out.contains("reversal = \"reversible\""), "{out}");
         assert_eq!(back.observer, d.observer);
     }
 

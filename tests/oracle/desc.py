@@ -219,9 +219,12 @@ def load(desc) -> Params:
             raise DescriptionError("core.phi_sat must be > 0")
     elif cm == "jiles-atherton":
         keys = ("length", "area", "m_sat", "b", "c", "kappa", "alpha")
-        _check_keys(core, {"model", "epsilon", *keys}, "core")
+        _check_keys(core, {"model", "epsilon", "reversal", *keys}, "core")
         c = {k: _num(core, k, "core") for k in keys}
         c["epsilon"] = _num(core, "epsilon", "core", 1e-3)
+        c["reversal"] = core.get("reversal", "clamp")
+        if c["reversal"] not in ("clamp", "reversible"):
+            raise DescriptionError(f"unknown core.reversal {c['reversal']!r}")
         if not 0.0 <= c["c"] < 1.0:
             raise DescriptionError("core.c must be in [0, 1)")
     else:

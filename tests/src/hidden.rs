@@ -18,7 +18,7 @@
 
 use std::path::{Path, PathBuf};
 
-use designer::description::{parse_str, Core, Description, Gap, JilesAtherton};
+use designer::description::{parse_str, Core, Description, Gap, JilesAtherton, Reversal};
 use designer::model::{Model, Statics, MU0};
 use designer::replay::{replay, Replay};
 use designer::sim::{EventKind, Limit, Options, PiecewiseLinear};
@@ -498,6 +498,7 @@ fn draw_hysteresis(d: &mut Description, ctx: &Context, rng: &mut Rng) -> Drawn {
         kappa: rng.uniform(700.0, 1200.0),
         alpha,
         epsilon: 1e-3,
+        reversal: Reversal::Clamp,
     };
     ja.length = r0 / ja_linear_r0(&ja);
     d.core = Core::JilesAtherton(ja.clone());

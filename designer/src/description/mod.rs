@@ -105,6 +105,23 @@ pub struct JilesAtherton {
     pub alpha: f64,
     /// ε of [JA 52] (default 1e-3)
     pub epsilon: f64,
+    /// What the irreversible magnetisation does while it lags the field's
+    /// new direction after a reversal (`core.reversal`).
+    pub reversal: Reversal,
+}
+
+/// `core.reversal`: the irreversible magnetisation's rate [JA 26] where
+/// δ·(M_an − M_irr) < 0 (just after sgn φ̇ changes).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Reversal {
+    /// [JA 26] as it stands, with the clamp [JA 52]: the core's field jumps
+    /// to the physical region at a rate |Ḣ_c| ≫ |φ̇| (the paper's model).
+    #[default]
+    Clamp,
+    /// dM_irr/dB_e = 0 there: the core moves reversibly through a reversal,
+    /// until M_an crosses M_irr (the usual correction of the Jiles–Atherton
+    /// model against negative susceptibility).
+    Reversible,
 }
 
 #[derive(Debug, Clone, PartialEq)]

@@ -218,6 +218,7 @@ pub const KEYS: &[Key] = &[
     Key { variants: &["jiles-atherton"], ..param("core.c", "c_ja", Domain::UnitOpen, "-", "reversibility c") },
     Key { variants: &["jiles-atherton"], ..param("core.kappa", "kappa_ja", Domain::Positive, "A/m", "pinning κ (the hysteresis loop's width)") },
     Key { variants: &["jiles-atherton"], ..param("core.alpha", "alpha_ja", Domain::NonNegative, "-", "inter-domain coupling α") },
+    Key { variants: &["jiles-atherton"], kind: Kind::Choice(&["clamp", "reversible"]), ..number("core.reversal", Domain::Any, "", Presence::Optional("clamp"), "dM_irr/dB_e (26) just after a flux reversal, while δ·(M_an − M_irr) < 0: clamp, the paper's (26) with the clamp (52), where H_c jumps fast to the physical region; reversible, 0 there (the core moves reversibly until M_an crosses M_irr), smooth enough for a filter sampling at tens of µs") },
     Key { variants: &["jiles-atherton"], presence: Presence::Default(1e-3), fittable: false, ..param("core.epsilon", "eps_ja", Domain::Positive, "-", "ε of the clamp (52): dB_c/dB_e ≥ ε") },
     // [mechanics]
     param("mechanics.mass", "m", Domain::Positive, "kg", "moving mass"),

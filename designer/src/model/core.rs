@@ -8,7 +8,7 @@
 //!   model [JA 21–33] with the clamp [JA 52]): MMF = H_c·l_c, and dH_c/dt follows
 //!   from dφ/dt through the inverse differential permeability.
 
-use crate::description::{Core, JilesAtherton};
+use crate::description::{Core, JilesAtherton, Reversal};
 use crate::sym::{Graph, Id, E};
 
 use super::gap::MU0;
@@ -158,7 +158,13 @@ pub fn ja_field_rate(
         let m_irr = (mc - c * m_an) / (1.0 - c);
         // [JA 26] dM_irr/dB_e = δ·(M_an − M_irr)/(μ0·κ), δ = sgn(dB_c/dt) = sgn(φ̇)
         let delta = phi_dot.sign();
-        let dmirr = delta * ((m_an - m_irr) / (mu0 * kappa));
+        let lag = m_an - m_irr;
+        let lag = match ja.reversal {
+            Reversal::Clamp => lag,
+            // δ·max(δ·(M_an − M_irr), 0): no irreversible change against δ
+            Reversal::Reversible => delta * (delta * lag).max(0.0),
+        };
+        let dmirr = delta * (lag / (mu0 * kappa));
         // [JA 29] dM_c/dB_e = (1 − c)·dM_irr/dB_e + c·dM_an/dB_e
         let dmc = (1.0 - c) * dmirr + c * dman;
         // [JA 30] with the clamp [JA 52]: dB_c/dB_e = max(1 + μ0(1 − α)·dM_c/dB_e, ε)

@@ -7,7 +7,7 @@
 //! candidate refits only the resistance, so the ranking compares each
 //! extension with the best the baseline itself can do.
 
-use crate::description::{Core, Description, Gap, JilesAtherton};
+use crate::description::{Core, Description, Gap, JilesAtherton, Reversal};
 use crate::model::MU0;
 use crate::FitParam;
 
@@ -251,5 +251,6 @@ fn jiles_atherton(area: f64, r0: f64, b_sat: f64) -> JilesAtherton {
         kappa,
         alpha,
         epsilon: 1e-3,
+        reversal: Reversal::Clamp,
     }
 }

@@ -3,7 +3,7 @@
 //! unit and default; the keys a section allows follow its `model`.
 
 use super::sect::{Res, Sect};
-use crate::description::{Coil, Core, Drive, Gap, JilesAtherton, Mechanics, Supply};
+use crate::description::{Coil, Core, Drive, Gap, JilesAtherton, Mechanics, Reversal, Supply};
 
 pub(super) fn parse_coil(s: &Sect) -> Res<Coil> {
     s.check_keys(None, "in [coil]")?;
@@ -75,6 +75,10 @@ pub(super) fn parse_core(s: &Sect) -> Res<Core> {
             kappa: s.req("kappa")?,
             alpha: s.req("alpha")?,
             epsilon: s.or_default("epsilon")?,
+            reversal: match s.opt_choice("reversal", "reversal rule")? {
+                Some("reversible") => Reversal::Reversible,
+                _ => Reversal::Clamp,
+            },
         }),
     })
 }
