@@ -83,8 +83,7 @@ pub fn run_backstepping(
         inside.push(mechanical <= target.level);
         desired.push(controller.plan().desired_force(x[0], x[1], y_r));
         lyapunov.push(controller.plan().lyapunov(x, y_r));
-        sensing.held = u;
-        u
+        sensing.apply(u)
     };
     let (x0, mode0) = start(&plant_model, b.rest, initial);
     let t_end = duration.unwrap_or_else(|| default_duration(&b.reference, sample_period));

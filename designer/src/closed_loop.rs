@@ -25,6 +25,7 @@ use crate::sim::{
     simulate, simulate_sampled, EventKind, Limit, Measurement, Mode, Options, PiecewiseLinear,
     Plant, SimError, State, Trajectory,
 };
+use reldesign_runtime::resistance::compensate_resistance;
 
 /// Why a loop could not run.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -118,8 +119,18 @@ pub(crate) struct Sensing<'a> {
     nonnegative_current: bool,
     /// The input held over the last sample period (the current depends on it
     /// through the eddy-current term).
-    pub(crate) held: f64,
+    held: f64,
     estimates: Vec<(f64, Estimate)>,
+    /// `controller.compensate_resistance`: the design's R and the supply's
+    /// limits, with the current measured at the last sample.
+    compensation: Option<Compensation>,
+}
+
+/// The law's voltage corrected to the observer's resistance estimate.
+struct Compensation {
+    resistance: f64,
+    limits: (f64, f64),
+    current: f64,
 }
 
 impl<'a> Sensing<'a> {
@@ -139,7 +150,21 @@ impl<'a> Sensing<'a> {
             nonnegative_current,
             held: 0.0,
             estimates: Vec::new(),
+            compensation: compensation(design),
         })
+    }
+
+    /// Applies the controller's `u` from this sample on: corrected to the
+    /// observer's resistance estimate (`controller.compensate_resistance`,
+    /// [`reldesign_runtime::resistance`]), held until the next sample.
+    pub(crate) fn apply(&mut self, u: f64) -> f64 {
+        let estimate = self.estimates.last().and_then(|(_, e)| e.r);
+        let u = match (&self.compensation, estimate) {
+            (Some(c), Some(r)) => compensate_resistance(u, r, c.resistance, c.current, c.limits),
+            _ => u,
+        };
+        self.held = u;
+        u
     }
 
     /// [z, v, φ, H_c] and the acceleration a at the sample `m` (H_c is 0
@@ -151,6 +176,9 @@ impl<'a> Sensing<'a> {
                 // the ADC samples i just before the new voltage is applied
                 let (i, _) = self.plant.current_and_voltage(m.t, x, self.held);
                 let (e, i) = o.step(self.held, i);
+                if let Some(c) = &mut self.compensation {
+                    c.current = i;
+                }
                 self.estimates.push((m.t, e));
                 let phi = if self.nonnegative_current { i } else { e.phi };
                 ([e.z, e.v, phi, e.hc.unwrap_or(0.0)], e.a)
@@ -220,9 +248,25 @@ impl Sequencer<'_> {
         let (state, a) = self.sensing.read(m);
         self.z_ref.push((m.t, c.reference(m.t)[0]));
         let u = c.step(m.t, state, a);
-        self.sensing.held = u;
-        u
+        self.sensing.apply(u)
     }
+}
+
+/// The compensation `design`'s `controller.compensate_resistance` asks for
+/// (the parser checked that its estimator estimates R).
+fn compensation(design: &Design) -> Option<Compensation> {
+    let d = &design.description;
+    let c = d.controller.as_ref()?;
+    // the model-based sliding mode keeps its input in [0, u_max] [JA 94]
+    let lower = match c.law {
+        crate::description::Law::ModelSlidingMode(_) => 0.0,
+        _ => d.supply.u_min,
+    };
+    c.compensate_resistance.then(|| Compensation {
+        resistance: d.coil.resistance,
+        limits: (lower, d.supply.u_max),
+        current: f64::NAN,
+    })
 }
 
 /// Runs `design`'s controller at `sample_period` for `duration` (default: every
@@ -348,8 +392,7 @@ pub fn run_hold(
         let ([z, v, phi, hc], _) = sensing.read(m);
         z_ref.push((m.t, h.position));
         let u = hold.step(z, v, phi, hc);
-        sensing.held = u;
-        u
+        sensing.apply(u)
     };
     let (mut x0, mode0) = start_state(&mut plant_model, None);
     if plant_model.dim() == 4 {

@@ -430,6 +430,7 @@ fn both_sections_parse_into_the_expected_values() {
             creep_speed: None,
             landed_band: None,
             estimator: None,
+            compensate_resistance: false,
         }),
         "float defaults to both, creep_speed to the generator's"
     );

@@ -24,6 +24,7 @@ pub mod linalg;
 #[allow(clippy::as_conversions)]
 mod ln;
 pub mod observe;
+pub mod resistance;
 pub mod semera;
 pub mod sliding;
 

@@ -247,6 +247,10 @@ pub struct Controller {
     /// loops of `reldesign loop` and `sweep` (`Ekf` or `Ukf`); `None`: the
     /// controller reads the plant's state.
     pub estimator: Option<Estimator>,
+    /// `compensate_resistance = true`: in the closed loops the law's voltage
+    /// is corrected to the estimator's coil resistance, u + (R̂ − R)·i
+    /// (`reldesign_runtime::resistance`); needs an estimator that estimates R.
+    pub compensate_resistance: bool,
 }
 
 /// `controller.law` with the keys of that law.

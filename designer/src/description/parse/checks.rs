@@ -281,8 +281,44 @@ pub(super) fn estimator_warning(
     })
 }
 
+/// `compensate_resistance = true` needs a voltage-driven coil and an
+/// estimator that estimates R.
+fn check_compensation(
+    s: &Sect,
+    c: &Controller,
+    observer: Option<&Observer>,
+    drive: Drive,
+) -> Res<()> {
+    const KEY: &str = "compensate_resistance";
+    if !c.compensate_resistance {
+        return Ok(());
+    }
+    if drive != Drive::Voltage {
+        let msg = "compensate_resistance = true corrects a voltage for the coil resistance; \
+                   with supply.drive = \"current\" the law commands the current, which R \
+                   does not enter";
+        return Err(s.err(KEY, msg, "not a voltage drive"));
+    }
+    let estimates_r = observer
+        .and_then(|o| o.kalman.as_ref())
+        .is_some_and(|k| k.resistance.is_some());
+    if c.estimator.is_some() && estimates_r {
+        return Ok(());
+    }
+    let msg = "compensate_resistance = true corrects the law's voltage to the estimated coil \
+               resistance: it needs controller.estimator (\"ekf\" or \"ukf\") and \
+               observer.kalman.estimate_resistance = true";
+    Err(s.err(KEY, msg, "no resistance estimate"))
+}
+
 /// `controller.estimator` names an observer that `[observer]` designs.
-pub(super) fn check_estimator(s: &Sect, c: &Controller, observer: Option<&Observer>) -> Res<()> {
+pub(super) fn check_estimator(
+    s: &Sect,
+    c: &Controller,
+    observer: Option<&Observer>,
+    drive: Drive,
+) -> Res<()> {
+    check_compensation(s, c, observer, drive)?;
     let Some(wanted) = c.estimator else {
         return Ok(());
     };

@@ -70,6 +70,7 @@ pub(super) fn parse_controller(s: &Sect) -> Res<Controller> {
         "ekf" => Estimator::Ekf,
         _ => Estimator::Ukf,
     });
+    let compensate_resistance = s.opt_bool("compensate_resistance")?.unwrap_or(false);
     Ok(Controller {
         law,
         sample_period,
@@ -77,6 +78,7 @@ pub(super) fn parse_controller(s: &Sect) -> Res<Controller> {
         creep_speed,
         landed_band,
         estimator,
+        compensate_resistance,
     })
 }
 
