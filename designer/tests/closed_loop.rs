@@ -287,7 +287,11 @@ fn resistance_compensation_tracks_the_estimated_coil() {
             .fold(0.0, f64::max)
     };
     let nominal = rmse(1.0, false);
-    eprintln!("R ×1: {:.2} µm uncompensated, {:.2} µm compensated", nominal * 1e6, rmse(1.0, true) * 1e6);
+    eprintln!(
+        "R ×1: {:.2} µm uncompensated, {:.2} µm compensated",
+        nominal * 1e6,
+        rmse(1.0, true) * 1e6
+    );
     for r_factor in [0.9, 1.1] {
         let (off, on) = (rmse(r_factor, false), rmse(r_factor, true));
         eprintln!(
@@ -297,6 +301,9 @@ fn resistance_compensation_tracks_the_estimated_coil() {
             on * 1e6,
             nominal * 1e6
         );
-        assert!(on < off && on <= 1.1 * nominal, "R ×{r_factor}: {on} vs {off}");
+        assert!(
+            on < off && on <= 1.1 * nominal,
+            "R ×{r_factor}: {on} vs {off}"
+        );
     }
 }
