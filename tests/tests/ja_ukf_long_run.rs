@@ -1,7 +1,12 @@
-//! The emitted UKF of the Jiles–Atherton valve
-//! (`reldesign_generated::jiles_atherton_valve::ukf`, the runtime's
-//! `observe::Ukf` on the emitted model [JA 84–87]) over 10⁶ samples (50 s
-//! of the valve at 20 kHz).
+//! The emitted UKFs on a Jiles–Atherton core over 10⁶ samples (50 s at
+//! 20 kHz), the runtime's `observe::Ukf` on the emitted model [JA 84–87]:
+//!
+//! - the Jiles–Atherton valve's (`reldesign_generated::jiles_atherton_valve::ukf`:
+//!   the paper's Euler step, its core's clamp [JA 52]) on the valve;
+//! - the sensorless design at 20 kHz (`tests/data/sensorless-ja-valve.toml`,
+//!   emitted by `tests/build.rs`: the exponential flux step with 4 substeps,
+//!   the reversal rule "reversible") on its plant, the perfect-tracking valve
+//!   with the paper's Jiles–Atherton core (`tests/src/sensorless.rs`).
 //!
 //! The plant is the valve's hybrid model (the designer's simulator), driven
 //! open loop by a one-second cycle repeated 50 times: rest, a 24 V pulse
@@ -31,17 +36,23 @@
 //! definiteness in f32 (correlation computed beyond −1) and the repairs
 //! cascaded, about 55 a second, with 2–4 garbage estimates per cycle.
 
-use designer::description::parse_file;
+use designer::description::{parse_file, Description};
 use designer::model::{Model, ModelPlant};
 use designer::random::SplitMix64;
 use designer::replay::rest_state;
 use designer::sim::{simulate, Mode, Options, PiecewiseLinear, State};
 use reldesign_generated::jiles_atherton_valve::ukf;
+use reldesign_tests::sensorless::mismatched_plant;
 use support::example_path;
 
-/// T_s [s] and z_max [m] of the example.
+/// The sensorless design at 20 kHz, emitted by `tests/build.rs`.
+#[allow(dead_code)] // the test uses the filters only
+mod sensorless_ja_valve {
+    include!(concat!(env!("OUT_DIR"), "/sensorless_ja_valve.rs"));
+}
+
+/// T_s [s] of both filters.
 const T_S: f64 = ukf::f64::T_S;
-const Z_MAX: f64 = ukf::f64::Z_MAX;
 /// Samples per cycle: 1 s at T_s = 50 µs.
 const CYCLE: usize = 20_000;
 /// The filter's states [z, z_prev, φ, H_c, R].
@@ -68,11 +79,14 @@ struct Plant {
 }
 
 impl Plant {
-    fn new() -> Plant {
-        let d = parse_file(&example_path("jiles-atherton-valve.toml")).unwrap();
-        let model = Model::build(&d);
+    fn new(d: &Description) -> Plant {
+        let model = Model::build(d);
         let state = rest_state(&model);
         Plant { model, state }
+    }
+
+    fn z_max(&self) -> f64 {
+        self.model.description.mechanics.z_max
     }
 
     fn cycle(&mut self) -> Cycle {
@@ -104,8 +118,9 @@ impl Plant {
             z.iter().any(|&z| z == 0.0),
             "the 24 V pulse closes the valve"
         );
+        let z_max = self.z_max();
         assert!(
-            z[REST..].iter().all(|&z| z == Z_MAX),
+            z[REST..].iter().all(|&z| z == z_max),
             "the valve rests open from 100 ms on"
         );
         self.state = *tr.x.last().unwrap();
@@ -143,11 +158,13 @@ macro_rules! filter {
 }
 filter!(ukf::f64::Filter, f64);
 filter!(ukf::f32::Filter, f32);
+filter!(sensorless_ja_valve::ukf::f64::Filter, f64);
+filter!(sensorless_ja_valve::ukf::f32::Filter, f32);
 
 /// Lower Cholesky factor exists (P is positive definite).
 fn positive_definite(p: &[[f64; N]; N]) -> bool {
     let mut l = [[0.0; N]; N];
-    for i in 0..4 {
+    for i in 0..N {
         for j in 0..=i {
             let mut s = p[i][j];
             for k in 0..j {
@@ -169,7 +186,7 @@ fn positive_definite(p: &[[f64; N]; N]) -> bool {
 /// The largest |Pᵢⱼ − Pⱼᵢ| / √(Pᵢᵢ·Pⱼⱼ).
 fn asymmetry(p: &[[f64; N]; N]) -> f64 {
     let mut worst = 0.0f64;
-    for i in 0..4 {
+    for i in 0..N {
         for j in 0..i {
             worst = worst.max((p[i][j] - p[j][i]).abs() / (p[i][i] * p[j][j]).sqrt());
         }
@@ -177,10 +194,10 @@ fn asymmetry(p: &[[f64; N]; N]) -> f64 {
     worst
 }
 
-/// Runs `filter` over [`CYCLES`] cycles and checks it at every sample (see
-/// the module docs).
-fn long_run(mut filter: impl Filter) {
-    let mut plant = Plant::new();
+/// Runs `filter` over [`CYCLES`] cycles of `plant` and checks it at every
+/// sample (see the module docs).
+fn long_run(mut filter: impl Filter, plant: &Description) {
+    let mut plant = Plant::new(plant);
     let mut noise = SplitMix64::new(0x4A_11FE);
     let (sigma_v, sigma_i) = (15e-3, 1e-3);
     let (mut worst_asym, mut worst_rest) = (0.0f64, 0.0f64);
@@ -236,12 +253,29 @@ fn long_run(mut filter: impl Filter) {
     );
 }
 
+fn ja_valve() -> Description {
+    parse_file(&example_path("jiles-atherton-valve.toml")).unwrap()
+}
+
 #[test]
 fn the_f64_ukf_stays_positive_definite_over_1e6_samples() {
-    long_run(ukf::f64::Filter::new());
+    long_run(ukf::f64::Filter::new(), &ja_valve());
 }
 
 #[test]
 fn the_f32_ukf_stays_positive_definite_over_1e6_samples() {
-    long_run(ukf::f32::Filter::new());
+    long_run(ukf::f32::Filter::new(), &ja_valve());
+}
+
+#[test]
+fn the_exponential_step_f64_ukf_stays_positive_definite_over_1e6_samples() {
+    assert_eq!(sensorless_ja_valve::ukf::f64::T_S, T_S);
+    let filter = sensorless_ja_valve::ukf::f64::Filter::new();
+    long_run(filter, &mismatched_plant(1.0, 1.0));
+}
+
+#[test]
+fn the_exponential_step_f32_ukf_stays_positive_definite_over_1e6_samples() {
+    let filter = sensorless_ja_valve::ukf::f32::Filter::new();
+    long_run(filter, &mismatched_plant(1.0, 1.0));
 }
