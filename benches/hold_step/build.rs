@@ -9,11 +9,16 @@
 //! [u, i, ẑ, v̂, φ̂, Ĥ_c] with u the voltage held over the sample ending
 //! there and i the current then (σ_v = 15 mV, σ_i = 1 mA, seeded), and the
 //! loop's estimate there (what its hold read).
+//!
+//! Also the sensorless design at 20 kHz (`tests/data/sensorless-ja-valve.toml`:
+//! its UKF with the exponential flux step) into `OUT_DIR/sensorless_ja_valve.rs`,
+//! and its own closed loop's (`run_loop`, 1001 samples: a closing, an opening,
+//! the hold after it) measured voltage and current into `OUT_DIR/record_ja.rs`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use designer::closed_loop::run_hold;
+use designer::closed_loop::{run_hold, run_loop};
 use designer::description::parse_file;
 use designer::design::Design;
 use designer::model::{Model, ModelPlant};
@@ -78,4 +83,38 @@ fn main() {
     }
     text.push_str("];\n");
     std::fs::write(out.join("record.rs"), text).unwrap();
+    sensorless(&root, &out);
+}
+
+/// The sensorless design's file and the record of its own loop.
+fn sensorless(root: &Path, out: &Path) {
+    let toml = root.join("tests/data/sensorless-ja-valve.toml");
+    println!("cargo:rerun-if-changed={}", toml.display());
+    let d = parse_file(&toml).unwrap_or_else(|e| panic!("{e}"));
+    let design = Design::new(&d).unwrap_or_else(|e| panic!("{e}"));
+    let code = reldesign_build::emit(&design).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::write(out.join("sensorless_ja_valve.rs"), code).unwrap();
+    let noise = designer::closed_loop::Noise::seeded(0);
+    let run = run_loop(&design, None, TS, Some(1000.0 * TS), noise, &Options::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut model = Model::build(&d);
+    let plant = ModelPlant::new(&mut model);
+    let tr = &run.trajectory;
+    assert_eq!(tr.t.len(), 1001, "the record's length");
+    let mut noise = SplitMix64::new(0x4A_5E45);
+    let mut text = format!(
+        "/// [u [V], i [A], 0, 0, 0, 0] at k·T_s, T_s = {TS:e} s.\n\
+         pub const RECORD: [[f64; 6]; {}] = [\n",
+        tr.t.len()
+    );
+    let mut held = 0.0;
+    for k in 0..tr.t.len() {
+        let (i, _) = plant.current_and_voltage(tr.t[k], &tr.x[k], held);
+        let u = held + 15e-3 * noise.normal();
+        let i = i + 1e-3 * noise.normal();
+        writeln!(text, "    [{u:?}, {i:?}, 0.0, 0.0, 0.0, 0.0],").unwrap();
+        held = tr.u[k];
+    }
+    text.push_str("];\n");
+    std::fs::write(out.join("record_ja.rs"), text).unwrap();
 }

@@ -64,6 +64,8 @@ STROKE, U_MAX = 9e-4, 24.0
 ROWS = [
     ("ukf64", "UKF f64 Filter::step"),
     ("ukf32", "UKF f32 Filter::step"),
+    ("ukfx64", "UKF f64, exponential step ×4"),
+    ("ukfx32", "UKF f32, exponential step ×4"),
     ("hold64", "hold f64 Controller::step"),
     ("hold32", "hold f32 Controller::step"),
     ("law64", "law [JA 89] alone f64"),

@@ -15,6 +15,10 @@
 //!   φ guard, else the law [JA 89], saturated;
 //! - law64, law32: the law [JA 89] alone (`hold::Hold::law` of the emitted
 //!   `Design`) at every sample: what a step costs in motion;
+//! - ukfx64, ukfx32: the UKF of the sensorless design at 20 kHz
+//!   (`tests/data/sensorless-ja-valve.toml`: [z, z_prev, φ, H_c, R], the
+//!   exponential flux step with 4 substeps) on its own loop's voltage and
+//!   current (`record_ja`, as long as the record);
 //! - base64, base32: the same loop without the call.
 //!
 //! The record is the same in every run, so a run of 2N calls minus one of N
@@ -27,6 +31,14 @@ use reldesign_runtime::hold::Hold;
 
 mod record {
     include!(concat!(env!("OUT_DIR"), "/record.rs"));
+}
+mod record_ja {
+    include!(concat!(env!("OUT_DIR"), "/record_ja.rs"));
+}
+// the sensorless design at 20 kHz: its UKF with the exponential flux step
+#[allow(clippy::all, dead_code)]
+mod sensorless {
+    include!(concat!(env!("OUT_DIR"), "/sensorless_ja_valve.rs"));
 }
 // the generated file holds more than the driver calls
 #[allow(clippy::all, dead_code)]
@@ -83,6 +95,17 @@ macro_rules! calls {
 calls!(f64, filter64, hold_step64, law_alone64, nothing64);
 calls!(f32, filter32, hold_step32, law_alone32, nothing32);
 
+#[inline(always)]
+fn exp_filter64(f: &mut sensorless::ukf::f64::Filter, r: [f64; 6]) -> f64 {
+    black_box(f.step(r[0], r[1])).z
+}
+#[inline(always)]
+fn exp_filter32(f: &mut sensorless::ukf::f32::Filter, r: [f32; 6]) -> f32 {
+    black_box(f.step(r[0], r[1])).z
+}
+record_loop!(ukfx64, f64, sensorless::ukf::f64::Filter::new(), exp_filter64);
+record_loop!(ukfx32, f32, sensorless::ukf::f32::Filter::new(), exp_filter32);
+
 record_loop!(ukf64, f64, ukf::f64::Filter::new(), filter64);
 record_loop!(ukf32, f32, ukf::f32::Filter::new(), filter32);
 record_loop!(hold64, f64, valve::f64::Controller::new(), hold_step64);
@@ -125,6 +148,8 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let rec64: Vec<[f64; 6]> = RECORD.to_vec();
     let rec32: Vec<[f32; 6]> = RECORD.iter().map(|s| s.map(|x| x as f32)).collect();
+    let ja64: Vec<[f64; 6]> = record_ja::RECORD.to_vec();
+    let ja32: Vec<[f32; 6]> = ja64.iter().map(|s| s.map(|x| x as f32)).collect();
     if args.len() == 2 && args[1] == "dump" {
         dump(&rec64, &rec32);
         return;
@@ -140,6 +165,8 @@ fn main() {
         match kind {
             "ukf64" => ukf64(&rec64, n),
             "ukf32" => ukf32(&rec32, n),
+            "ukfx64" => ukfx64(&ja64, n),
+            "ukfx32" => ukfx32(&ja32, n),
             "hold64" => hold64(&rec64, n),
             "hold32" => hold32(&rec32, n),
             "law64" => law64(&rec64, n),
