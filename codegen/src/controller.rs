@@ -407,6 +407,19 @@ pub fn runtime_state_pattern(model: &Model) -> (TokenStream, TokenStream) {
     (pattern, quote!(#(#state),*))
 }
 
+/// The sentence a controller's docs add where the description sets
+/// `controller.compensate_resistance`: firmware applies the correction.
+pub fn compensation_doc(model: &Model) -> &'static str {
+    let on = (model.description.controller.as_ref()).is_some_and(|c| c.compensate_resistance);
+    if on {
+        "\nThe design compensates the coil resistance (`compensate_resistance`): pass the\n\
+         step's u through `reldesign_runtime::resistance::compensate_resistance(u, r̂, R,\n\
+         i, (U_MIN, U_MAX))` with the observer's R̂ and the measured current i."
+    } else {
+        ""
+    }
+}
+
 /// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.
 fn float_module(input: &ControllerInput, float: Float) -> Result<String, ControllerError> {
     let ty = float.ty();
@@ -424,7 +437,8 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
          pre-movement stage before t₀ (ξ_r = [z₀, 0, 0], which brings ξ₃ to 0 so the\n\
          forces balance at takeoff), tracking of the table on [t₀, t_f], hold at z_f\n\
          after t_f with the expert rules of model-free-sliding-mode [SM 43] at the end\n\
-         stop; `new`, `start`, `reference`, {step}. Allocation- and panic-free."
+         stop; `new`, `start`, `reference`, {step}. Allocation- and panic-free.{}",
+        compensation_doc(input.model)
     ));
     let plan = plan_items(
         input.model,

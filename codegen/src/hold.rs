@@ -16,7 +16,9 @@ use designer::design::HoldDesign;
 use designer::model::Model;
 use quote::{format_ident, quote};
 
-use crate::controller::{law_macro_text, runtime_state_pattern, ControllerError, LawSource};
+use crate::controller::{
+    compensation_doc, law_macro_text, runtime_state_pattern, ControllerError, LawSource,
+};
 use crate::float::Float;
 use crate::format::{format_items, space_items};
 use crate::operations::{documented_consts, unique_floats};
@@ -89,7 +91,9 @@ fn float_module(input: &HoldInput, float: Float) -> Result<String, ControllerErr
     } else {
         "The armature held at `POSITION` (`reldesign_runtime::hold::PositionHold`): the mode\nrules [JA 94] at the stops, else u₂ of [JA 89], saturated to [0, U_MAX]; `new`,\n`step(z, v, phi, 0.0)` (the core has no field state). Allocation- and panic-free."
     };
-    let step_doc = crate::emit::doc_attrs(step_doc);
+    let step_doc = format!("{step_doc}{}", compensation_doc(input.model))
+        .replace("(U_MIN, U_MAX)", "(0.0, U_MAX)");
+    let step_doc = crate::emit::doc_attrs(&step_doc);
     let tokens = quote! {
         #[doc = " The hold in this float type."]
         pub mod #module {

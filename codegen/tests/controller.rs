@@ -435,3 +435,22 @@ fn emitted_controller_compiles_passes_clippy_and_matches_the_tape() {
     }
     assert!(lines.next().is_none());
 }
+
+/// `controller.compensate_resistance`: the emitted controller's docs tell
+/// firmware to pass u through the runtime's correction; without the key
+/// they do not.
+#[test]
+fn the_resistance_compensation_is_documented_where_set() {
+    let path = support::root().join("tests/data/sensorless-ja-valve.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    for (on, text) in [
+        (true, text.clone()),
+        (false, text.replacen("compensate_resistance = true", "", 1)),
+    ] {
+        let d = parse_str(&text, "sensorless-ja-valve.toml").unwrap_or_else(|e| panic!("{e}"));
+        let design = designer::design::Design::new(&d).unwrap_or_else(|e| panic!("{e}"));
+        let code = reldesign_build::emit(&design).unwrap_or_else(|e| panic!("{e}"));
+        let says = code.contains("reldesign_runtime::resistance::compensate_resistance(u, r̂, R,");
+        assert_eq!(says, on, "compensate_resistance = {on}");
+    }
+}

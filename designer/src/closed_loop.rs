@@ -256,17 +256,14 @@ impl Sequencer<'_> {
 /// (the parser checked that its estimator estimates R).
 fn compensation(design: &Design) -> Option<Compensation> {
     let d = &design.description;
-    let c = d.controller.as_ref()?;
-    // the model-based sliding mode keeps its input in [0, u_max] [JA 94]
-    let lower = match c.law {
-        crate::description::Law::ModelSlidingMode(_) => 0.0,
-        _ => d.supply.u_min,
-    };
-    c.compensate_resistance.then(|| Compensation {
-        resistance: d.coil.resistance,
-        limits: (lower, d.supply.u_max),
-        current: f64::NAN,
-    })
+    d.controller
+        .as_ref()?
+        .compensate_resistance
+        .then(|| Compensation {
+            resistance: d.coil.resistance,
+            limits: (crate::design::lowest_input(d), d.supply.u_max),
+            current: f64::NAN,
+        })
 }
 
 /// Runs `design`'s controller at `sample_period` for `duration` (default: every

@@ -116,7 +116,14 @@ fn settings(d: &Description, ts: f64) -> KalmanSettings {
 #[test]
 fn symbolic_jacobians_match_finite_differences() {
     let steps = [FluxStep::Euler, FluxStep::Exponential { substeps: 2 }];
-    for ((file, d), flux_step) in all_examples()
+    let text = std::fs::read_to_string(example_path("perfect-tracking-valve.toml")).unwrap();
+    let physics = &text[..text.find("\n[trajectory]").unwrap()];
+    let current = physics.replacen("drive = \"voltage\"", "drive = \"current\"", 1);
+    let current = parse_str(&current, "current drive").unwrap();
+    let subjects = all_examples()
+        .into_iter()
+        .chain([("current drive".into(), current)]);
+    for ((file, d), flux_step) in subjects
         .into_iter()
         .flat_map(|e| steps.map(|s| (e.clone(), s)))
     {

@@ -4,13 +4,15 @@
 //! Under voltage drive the model's electrical equation is
 //! φ̇ = (N·u − R·MMF)/(N² + R·k_e) with the coil current
 //! i = (N·MMF + k_e·u)/(N² + R·k_e); solved for the input that gives a
-//! flux rate φ̇ it reads u = N·φ̇ + R·i, i = (MMF + k_e·φ̇)/N. Every law
-//! commands a flux rate through u computed with the design's R; for the
-//! same flux rate a coil of resistance R̂ needs u + (R̂ − R)·i. The current
-//! used is the one measured at the sample (the observer's input): it
-//! differs from the current of the commanded flux rate by k_e·Δφ̇/N where
-//! the law changes φ̇ from one sample to the next, a second-order term of
-//! (R̂ − R).
+//! flux rate φ̇ it reads u = N·φ̇ + R·i, i = (MMF + k_e·φ̇)/N. The laws that
+//! compute their voltage from the model (feedback linearization [PT 50],
+//! the model-based sliding mode [JA 89]) command a flux rate through u
+//! computed with the design's R; for the same flux rate a coil of
+//! resistance R̂ needs u + (R̂ − R)·i. The current used is the one measured
+//! at the sample (the observer's input): it differs from the current of the
+//! commanded flux rate by k_e·Δφ̇/N where the law changes φ̇ from one sample
+//! to the next, an error (R̂ − R)·k_e·Δφ̇/N: the product of the resistance's
+//! error and of the flux rate's change.
 
 use crate::control::saturate_to;
 use crate::linalg::Scalar;

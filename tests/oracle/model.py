@@ -136,11 +136,11 @@ def build(desc) -> dict:
         dMan = msat / b * dL
         Mirr = (Mc - cr * Man) / (1 - cr)
         delta = ca.sign(dphi)
-        lag = Man - Mirr
         if c["reversal"] == "reversible":
             # no irreversible change against the field's direction
-            lag = delta * ca.fmax(delta * lag, 0.0)
-        dMirr = delta * lag / (MU0 * kappa)
+            dMirr = ca.fmax(delta * (Man - Mirr), 0.0) / (MU0 * kappa)
+        else:
+            dMirr = delta * (Man - Mirr) / (MU0 * kappa)
         dMc = (1 - cr) * dMirr + cr * dMan
         dBc = ca.fmax(1 + MU0 * (1 - alpha) * dMc, c["epsilon"])
         dHdB = 1 / MU0 - dMc / dBc
@@ -312,10 +312,10 @@ class NumpyModel:
         dMan = c["m_sat"] / c["b"] * dL
         Mirr = (Mc - cr * Man) / (1 - cr)
         delta = 1.0 if dphi > 0 else (-1.0 if dphi < 0 else 0.0)
-        lag = Man - Mirr
         if c["reversal"] == "reversible":
-            lag = delta * max(delta * lag, 0.0)
-        dMirr = delta * lag / (MU0 * c["kappa"])
+            dMirr = max(delta * (Man - Mirr), 0.0) / (MU0 * c["kappa"])
+        else:
+            dMirr = delta * (Man - Mirr) / (MU0 * c["kappa"])
         dMc = (1 - cr) * dMirr + cr * dMan
         raw = 1 + MU0 * (1 - alpha) * dMc
         dBc = max(raw, c["epsilon"])

@@ -461,10 +461,24 @@ pub struct KalmanSection {
     pub ukf_kappa: f64,
     /// `estimate_resistance = true`: the coil resistance as a random-walk state.
     pub resistance: Option<ResistanceEstimate>,
-    /// `flux_step = "exponential"` with its `flux_substeps` (≥ 1); `None`:
-    /// `"euler"`, the paper's [JA 84c–84d].
-    pub flux_substeps: Option<u32>,
+    /// `flux_step` (with `flux_substeps`).
+    pub flux_step: FluxStep,
 }
+
+/// `observer.kalman.flux_step`: how the flux (and H_c) advance over one
+/// sample (`observe::discrete::flux_step`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum FluxStep {
+    /// [JA 84c]–[JA 84d]: forward Euler at the sample's position.
+    #[default]
+    Euler,
+    /// Exponential Euler on the coil's total rate, `substeps` (in
+    /// 1..=[`MAX_FLUX_SUBSTEPS`]) per sample at the moving position.
+    Exponential { substeps: u32 },
+}
+
+/// The most substeps an exponential flux step takes per sample.
+pub const MAX_FLUX_SUBSTEPS: u32 = 64;
 
 /// `estimate_resistance = true` in `[observer.kalman]` with its two keys.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -76,7 +76,8 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         .transpose()?;
     let mut warnings = Vec::new();
     if let (Some(s), Some(c)) = (&controller_sect, &controller) {
-        checks::check_estimator(s, c, observer.as_ref(), supply.drive)?;
+        checks::check_estimator(s, c, observer.as_ref())?;
+        checks::check_compensation(s, c, observer.as_ref(), supply.drive)?;
         warnings.extend(checks::estimator_warning(s, c).map(|w| w.to_string()));
     }
     let source = Source {

@@ -80,6 +80,7 @@ pub use optimal::{
     energy_optimal, CostateGuess, HamiltonianSystem, OptimalError, OptimalSpec, OptimalTrajectory,
     Switch,
 };
+pub(crate) use plan::lowest_input;
 pub use plan::{
     design_controller, design_kalman, design_reference, Design, PlanError, SharedReference,
 };

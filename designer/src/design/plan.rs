@@ -235,7 +235,7 @@ pub fn design_controller(
 
 /// The controller's lowest input: the supply's, or 0 for the model-based
 /// sliding mode, which saturates to [0, u_max] [JA 94].
-fn lowest_input(description: &Description) -> f64 {
+pub(crate) fn lowest_input(description: &Description) -> f64 {
     match description.controller.as_ref().map(|c| c.law) {
         Some(Law::ModelSlidingMode(_)) => description.supply.u_min.max(0.0),
         _ => description.supply.u_min,

@@ -6,7 +6,10 @@
 //!   MMF = R_core0·φ / (1 − |φ|/φ_sat)
 //! - jiles-atherton (inverse JA of Sadowski et al., jiles-atherton-actuator-
 //!   model [JA 21–33] with the clamp [JA 52]): MMF = H_c·l_c, and dH_c/dt follows
-//!   from dφ/dt through the inverse differential permeability.
+//!   from dφ/dt through the inverse differential permeability; with
+//!   `core.reversal = "reversible"` the irreversible magnetisation does not
+//!   move against the field's direction just after a reversal (no red
+//!   region for the clamp to act on).
 
 use crate::description::{Core, JilesAtherton, Reversal};
 use crate::sym::{Graph, Id, E};

@@ -283,7 +283,7 @@ pub(super) fn estimator_warning(
 
 /// `compensate_resistance = true` needs a voltage-driven coil and an
 /// estimator that estimates R.
-fn check_compensation(
+pub(super) fn check_compensation(
     s: &Sect,
     c: &Controller,
     observer: Option<&Observer>,
@@ -312,13 +312,7 @@ fn check_compensation(
 }
 
 /// `controller.estimator` names an observer that `[observer]` designs.
-pub(super) fn check_estimator(
-    s: &Sect,
-    c: &Controller,
-    observer: Option<&Observer>,
-    drive: Drive,
-) -> Res<()> {
-    check_compensation(s, c, observer, drive)?;
+pub(super) fn check_estimator(s: &Sect, c: &Controller, observer: Option<&Observer>) -> Res<()> {
     let Some(wanted) = c.estimator else {
         return Ok(());
     };

@@ -4,12 +4,10 @@
 //! the Kalman filters' keys follow the core model's state.
 
 use super::design::parse_floats;
-use crate::observe::discrete::MAX_FLUX_SUBSTEPS;
-
 use super::sect::{Res, Sect};
 use crate::description::{
-    Core, Drive, Estimator, IntegralSettings, KalmanSection, Observer, ResistanceEstimate,
-    SemeraSettings, Supply,
+    Core, Drive, Estimator, FluxStep, IntegralSettings, KalmanSection, Observer,
+    ResistanceEstimate, SemeraSettings, Supply, MAX_FLUX_SUBSTEPS,
 };
 
 pub(super) fn parse_observer(
@@ -144,7 +142,7 @@ fn parse_kalman(s: &Sect, core_sect: &Sect, core: &Core) -> Res<KalmanSection> {
     let initial_phi_std = s.req("initial_phi_std")?;
     let initial_hc_std = parse_hc(s, "initial_hc_std", ja, core_sect)?;
     let resistance = parse_resistance_estimate(s)?;
-    let flux_substeps = parse_flux_step(s)?;
+    let flux_step = parse_flux_step(s)?;
     Ok(KalmanSection {
         process_z,
         process_phi,
@@ -156,17 +154,21 @@ fn parse_kalman(s: &Sect, core_sect: &Sect, core: &Core) -> Res<KalmanSection> {
         ukf_beta: s.or_default("ukf_beta")?,
         ukf_kappa: s.or_default("ukf_kappa")?,
         resistance,
-        flux_substeps,
+        flux_step,
     })
 }
 
 /// `flux_step` ("euler" by default, or "exponential") and `flux_substeps`
-/// (an integer in 1..=64, default 1, only with "exponential").
-fn parse_flux_step(s: &Sect) -> Res<Option<u32>> {
+/// (an integer in 1..=[`MAX_FLUX_SUBSTEPS`], default 1, only with "exponential").
+fn parse_flux_step(s: &Sect) -> Res<FluxStep> {
     const KEY: &str = "flux_substeps";
     let exponential = s.opt_choice("flux_step", "flux step")? == Some("exponential");
     let Some(m) = s.opt(KEY)? else {
-        return Ok(exponential.then_some(1));
+        return Ok(if exponential {
+            FluxStep::Exponential { substeps: 1 }
+        } else {
+            FluxStep::Euler
+        });
     };
     if !exponential {
         let msg = "only allowed with flux_step = \"exponential\" (the Euler step [JA 84c] \
@@ -178,7 +180,7 @@ fn parse_flux_step(s: &Sect) -> Res<Option<u32>> {
         let msg = format!("expected an integer in 1..={max} (substeps per sample), found {m}");
         return Err(s.err(KEY, msg, "not a substep count"));
     }
-    Ok(Some(m as u32))
+    Ok(FluxStep::Exponential { substeps: m as u32 })
 }
 
 /// A key of the state H_c [A/m]: required with a Jiles–Atherton core (`ja`),

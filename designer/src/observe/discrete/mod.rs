@@ -55,7 +55,7 @@
 //! over the last sample ((t_{k−1}, t_k], what the controller applied after the
 //! previous step) and y_k the output sampled at t_k, before the next input is
 //! applied. It predicts the prior x_{k|k−1} from the last posterior with u
-//! (zero-order hold, forward Euler [JA 84c]), updates it with y_k (h at the same
+//! (zero-order hold, the flux step of [`FluxStep`]), updates it with y_k (h at the same
 //! held u: the eddy term k_e·u of the current) and reports the posterior,
 //! which the controller uses at once. (Updating first and predicting with the
 //! same u would use each input one sample late: in closed loop, where u
@@ -81,12 +81,15 @@
 //! measurement noise) are pushed back by f_v only slowly, the clamped ones
 //! not at all, and the mean of the truncated spread hovers ≈ γ·σ_z off the
 //! stop in mode 2 with a spurious velocity towards it. Only q_z then remains
-//! of the position's uncertainty.
+//! of the position's uncertainty. (The exponential flux step evaluates the
+//! flux at positions between z and the unpinned z⁺ of [JA 84a]; the pin
+//! comes after, so a sigma point's φ⁺ is the one of a motion up to the
+//! stop plus the nm its prediction went beyond it.)
 //!
 //! | file | concept |
 //! | --- | --- |
 //! | `mod.rs` | the model [JA 84–87] in the symbolic core, its Jacobians, the runtime filters' settings |
-//! | `flux_step.rs` | [JA 84c–84d] or the exponential step of the electrical states: [`FluxStep`] |
+//! | `flux_step.rs` | the exponential step of the electrical states ([`FluxStep`]; the Euler step [JA 84c–84d] is in `mod.rs`) and the coil's total rate |
 //! | `settings.rs` | `[observer.kalman]`: [`KalmanSettings`], [`ResistanceSettings`], [`KalmanError`] |
 //! | `tapes.rs` | the model on tapes, and [`TapeModel`]: the runtime's model traits for the reference filters |
 //! | `estimate.rs` | the designer's [`Estimate`] |
@@ -107,7 +110,7 @@ use crate::sym::{Graph, Id, Tape};
 
 pub use estimate::Estimate;
 pub use flux_step::FluxStep;
-pub use settings::{KalmanError, KalmanSettings, ResistanceSettings, MAX_FLUX_SUBSTEPS};
+pub use settings::{KalmanError, KalmanSettings, ResistanceSettings};
 pub use tapes::{DiscreteTapes, MeasurementEval, Prediction, TapeModel};
 
 /// The estimate counts as resting on a stop within this many q_z of it.
@@ -299,7 +302,7 @@ impl DiscreteModel {
                 (phi_next, hc_next)
             }
             FluxStep::Exponential { substeps } => {
-                flux_step::exponential(&mut g, model, &map, (z_dom, z_next), ts, substeps)?
+                flux_step::exponential(&mut g, model, &map, (z_dom, z_next), ts, substeps)
             }
         };
         // [JA 84b] z_prev⁺ = z, as sat(z): the same for every state [JA 84a] gives,
@@ -497,18 +500,7 @@ impl DiscreteModel {
 /// step there in practice, see `tests/tests/ja_ukf_long_run.rs`.)
 fn check_electrical_step(model: &Model, sample_period: f64) -> Result<(), KalmanError> {
     let mut m = model.clone();
-    let (phi, u) = (m.states[2], m.input);
-    let g = &mut m.graph;
-    let mut rate = g.diff(m.f[2], phi);
-    if let Some(&hc) = m.states.get(3) {
-        // dH_c/dφ along the step: (∂f_Hc/∂u)/(∂f_φ/∂u)
-        let dh_du = g.diff(m.f[3], u);
-        let dphi_du = g.diff(m.f[2], u);
-        let dh_dphi = g.div(dh_du, dphi_du);
-        let via_field = g.diff(m.f[2], hc);
-        let through = g.mul(via_field, dh_dphi);
-        rate = g.add(rate, through);
-    }
+    let rate = flux_step::total_rate(&mut m.graph, model);
     let tape = m.compile(&[rate]);
     let mech = &m.description.mechanics;
     let mut out = [0.0];

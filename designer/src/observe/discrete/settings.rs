@@ -3,11 +3,7 @@
 
 use reldesign_runtime::observe::Weights;
 
-use super::FluxStep;
-use crate::description::Observer;
-
-/// The most substeps an exponential flux step takes per sample.
-pub const MAX_FLUX_SUBSTEPS: u32 = 64;
+use crate::description::{FluxStep, Observer, MAX_FLUX_SUBSTEPS};
 
 /// Coil-resistance estimation (`estimate_resistance = true` in
 /// `[observer.kalman]`): R as a random-walk state.
@@ -81,11 +77,7 @@ pub enum KalmanError {
     BadResistanceSetting { name: &'static str, value: f64 },
     #[error("estimate_resistance: the model has no coil resistance parameter `R`")]
     NoResistance,
-    #[error(
-        "observer.kalman.flux_step = \"exponential\": the flux rate does not depend on the \
-         input, so the core field's share of it cannot be told (use \"euler\")"
-    )]
-    FluxStepNeedsInput,
+
     #[error(
         "observer.sample_period = {sample_period:e} s is too long for the coil: the flux's \
          electrical time constant is τ = {tau:.3e} s at z = {z:e} m (φ = 0), and the \
@@ -119,10 +111,7 @@ impl KalmanSettings {
             ukf_alpha: k.ukf_alpha,
             ukf_beta: k.ukf_beta,
             ukf_kappa: k.ukf_kappa,
-            flux_step: match k.flux_substeps {
-                None => FluxStep::Euler,
-                Some(substeps) => FluxStep::Exponential { substeps },
-            },
+            flux_step: k.flux_step,
         })
     }
 
@@ -159,7 +148,7 @@ impl KalmanSettings {
                 return Err(KalmanError::BadSetting {
                     name: "flux_substeps",
                     value: f64::from(substeps),
-                    expected: "an integer in 1..=64",
+                    expected: "an integer in 1..=MAX_FLUX_SUBSTEPS (64)",
                 });
             }
         }
