@@ -481,19 +481,23 @@ const FRICTIONS: [Outside; 2] = [Outside::Friction(0.1), Outside::Friction(0.3)]
 struct Tally {
     total: usize,
     unexplained: usize,
-    none: usize,
-    /// The lines of the other answers.
+    /// `none` where the record shows no trace above the noise (the
+    /// description leaves less than `NONE_ABOVE_FLOOR` floors).
+    unseen: usize,
+    /// The lines of the other answers (a cause named, or a `none` that
+    /// leaves a trace).
     other: Vec<String>,
 }
 
 impl Tally {
-    /// Counts `answer`, reported by `line`; `none` as such where allowed.
-    fn add(&mut self, answer: &Causes, line: String, none_allowed: bool) {
+    /// Counts `answer`, reported by `line`.
+    fn add(&mut self, answer: &Causes, line: String) {
+        use reldesign_identify::diagnose::recalibration::NONE_ABOVE_FLOOR;
         self.total += 1;
         if answer.unexplained() {
             self.unexplained += 1;
-        } else if none_allowed && answer.names() == [Cause::None] {
-            self.none += 1;
+        } else if answer.names() == [Cause::None] && answer.residual.over_floor < NONE_ABOVE_FLOOR {
+            self.unseen += 1;
         } else {
             self.other.push(line);
         }
@@ -502,13 +506,11 @@ impl Tally {
 
 impl std::fmt::Display for Tally {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        let (n, total, unseen) = (self.unexplained, self.total, self.unseen);
+        let other = self.other.len();
         write!(
             f,
-            "{} of {} unexplained, {} none, {} otherwise",
-            self.unexplained,
-            self.total,
-            self.none,
-            self.other.len()
+            "{n} of {total} unexplained, {unseen} none below the noise, {other} otherwise"
         )
     }
 }
@@ -533,11 +535,12 @@ fn outside_answer(label: &str, case: &HiddenCase) -> (Causes, String) {
 /// Effects outside the vocabulary (issue 17 §2, `reldesign_tests::outside`)
 /// on four actuators, with and without `z`, every candidate tried: how often
 /// the answer is `unexplained`, and what else is named (the table of
-/// docs/validation/diagnose.md). Coulomb friction is answered `unexplained`
-/// or `none` (6 of 16 when written: 4 leave at most 1.3× the floor, no trace
-/// above the noise; 2 with `z` leave 2.7–2.8× the floor in the current,
-/// below the residual test's 3.5×, and a `none` answer is not
-/// recalibrated), never a cause with a high gain.
+/// docs/validation/diagnose.md). Every record is `unexplained` but 4
+/// frictions answered `none` that leave at most 1.31× the floor (below
+/// `NONE_ABOVE_FLOOR`: no trace above the noise); the 2 frictions with `z`
+/// that beat no candidate and leave 2.7–2.8× the floor (below the residual
+/// test's 3.5×) are caught by the recalibration of `none` (they were
+/// answered `none` before it). Never a cause with a high gain.
 #[test]
 #[ignore = "slow: 64 records, every candidate"]
 fn outside_matrix() {
@@ -556,26 +559,26 @@ fn outside_matrix() {
                     let case = outside_case(example, effect, &e, with_z, seed);
                     let label = format!("{example} {effect:?} z={with_z} seed={seed}");
                     let (answer, line) = outside_answer(&label, &case);
-                    tally.add(&answer, line, matches!(effect, Outside::Friction(_)));
+                    tally.add(&answer, line);
                 }
             }
         }
     }
-    eprintln!("{tally} (`none`: frictions only)");
+    eprintln!("{tally}");
     assert!(
         tally.other.is_empty(),
-        "a cause named, or `none` for an effect of the chain or the spring:\n{}",
+        "a cause named, or `none`:\n{}",
         tally.other.join("\n")
     );
-    assert!(tally.none <= 6, "{} frictions answered `none`", tally.none);
 }
 
 /// The effects outside the vocabulary on devices nobody tuned the diagnosis
 /// to (family 12, devices 0–14: every class × gap model), one effect per
 /// device in turn, without `z`: no cause of the vocabulary may be named; the
-/// answer is `unexplained`, or `none` once (device_12_10's probe lag when
-/// written: 3.36× the floor left, below the residual test, and a `none`
-/// answer is not recalibrated).
+/// answer is `unexplained`, or `none` where the record shows no trace above
+/// the noise (none when written: device_12_10's probe lag, 3.36× the floor
+/// left, below the residual test, was answered `none` before `none` answers
+/// were recalibrated).
 #[test]
 #[ignore = "slow: 60 records, every candidate (450 s)"]
 fn outside_on_generated_devices() {
@@ -593,16 +596,15 @@ fn outside_on_generated_devices() {
             let effect = effects[(4 * index as usize + k) % effects.len()];
             let case = outside_case_of(&device.toml, &file, effect, &excitation, false, seed);
             let (answer, line) = outside_answer(&format!("{file} {effect:?} seed={seed}"), &case);
-            tally.add(&answer, line, true);
+            tally.add(&answer, line);
         }
     }
     eprintln!("{tally}");
     assert!(
         tally.other.is_empty(),
-        "a vocabulary cause named:\n{}",
+        "a vocabulary cause named, or `none`:\n{}",
         tally.other.join("\n")
     );
-    assert!(tally.none <= 1, "{} answered `none`", tally.none);
 }
 
 #[test]

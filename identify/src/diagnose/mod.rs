@@ -485,8 +485,11 @@ pub fn diagnose_causes(
     }
     let fitted_together = steps.len() > 1 && joint::refit(&mut steps, data, &fit_options(options));
     let residual = Residual::of(&steps, data);
-    // the causes found against a recalibration of the description
-    let recalibration = (steps[0].cause != Cause::None && !residual.unexplained())
+    // the causes found (or the description itself, for a `none` that leaves
+    // a trace above the noise) against a recalibration of the description
+    let consulted =
+        steps[0].cause != Cause::None || residual.over_floor >= recalibration::NONE_ABOVE_FLOOR;
+    let recalibration = (consulted && !residual.unexplained())
         .then(|| recalibration::check(baseline, &steps, data, &fit_options(options)))
         .flatten();
     let (first, last) = (&steps[0], &steps[steps.len() - 1]);

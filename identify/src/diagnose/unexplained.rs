@@ -3,7 +3,8 @@
 //! something outside the vocabulary (a current probe's gain, a driver's
 //! delay, a wrong spring), and the causes the selection found explain part
 //! of it only: they are reported as partial, never named. The same answer
-//! where the description recalibrated does as well as the causes found
+//! where the description recalibrated does as well as the causes found, or
+//! better than the description itself where none is found
 //! ([`super::recalibration`]).
 //!
 //! The test is the error left after the selection against the noise floor.
