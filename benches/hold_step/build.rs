@@ -13,7 +13,9 @@
 //! Also the sensorless design at 20 kHz (`tests/data/sensorless-ja-valve.toml`:
 //! its UKF with the exponential flux step) into `OUT_DIR/sensorless_ja_valve.rs`,
 //! and its own closed loop's (`run_loop`, 1001 samples: a closing, an opening,
-//! the hold after it) measured voltage and current into `OUT_DIR/record_ja.rs`.
+//! the hold after it) measured voltage and current into `OUT_DIR/record_ja.rs`;
+//! and the same design with `flux_substeps = 1` into
+//! `OUT_DIR/sensorless_ja_valve_1.rs`.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -94,6 +96,15 @@ fn sensorless(root: &Path, out: &Path) {
     let design = Design::new(&d).unwrap_or_else(|e| panic!("{e}"));
     let code = reldesign_build::emit(&design).unwrap_or_else(|e| panic!("{e}"));
     std::fs::write(out.join("sensorless_ja_valve.rs"), code).unwrap();
+    // the same design with one exponential substep per sample
+    let text = std::fs::read_to_string(&toml).unwrap();
+    let one = text.replacen("flux_substeps = 4", "flux_substeps = 1", 1);
+    assert_ne!(one, text, "the design's flux_substeps");
+    let d1 = designer::description::parse_str(&one, "one-substep.toml")
+        .unwrap_or_else(|e| panic!("{e}"));
+    let design1 = Design::new(&d1).unwrap_or_else(|e| panic!("{e}"));
+    let code = reldesign_build::emit(&design1).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::write(out.join("sensorless_ja_valve_1.rs"), code).unwrap();
     let noise = designer::closed_loop::Noise::seeded(0);
     let run = run_loop(&design, None, TS, Some(1000.0 * TS), noise, &Options::default())
         .unwrap_or_else(|e| panic!("{e}"));

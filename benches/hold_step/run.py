@@ -66,6 +66,8 @@ ROWS = [
     ("ukf32", "UKF f32 Filter::step"),
     ("ukfx64", "UKF f64, exponential step ×4"),
     ("ukfx32", "UKF f32, exponential step ×4"),
+    ("ukfo64", "UKF f64, exponential step ×1"),
+    ("ukfo32", "UKF f32, exponential step ×1"),
     ("hold64", "hold f64 Controller::step"),
     ("hold32", "hold f32 Controller::step"),
     ("law64", "law [JA 89] alone f64"),

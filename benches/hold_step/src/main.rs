@@ -19,6 +19,7 @@
 //!   (`tests/data/sensorless-ja-valve.toml`: [z, z_prev, φ, H_c, R], the
 //!   exponential flux step with 4 substeps) on its own loop's voltage and
 //!   current (`record_ja`, as long as the record);
+//! - ukfo64, ukfo32: the same with one exponential substep per sample;
 //! - base64, base32: the same loop without the call.
 //!
 //! The record is the same in every run, so a run of 2N calls minus one of N
@@ -39,6 +40,11 @@ mod record_ja {
 #[allow(clippy::all, dead_code)]
 mod sensorless {
     include!(concat!(env!("OUT_DIR"), "/sensorless_ja_valve.rs"));
+}
+// the same with one substep per sample
+#[allow(clippy::all, dead_code)]
+mod sensorless_one {
+    include!(concat!(env!("OUT_DIR"), "/sensorless_ja_valve_1.rs"));
 }
 // the generated file holds more than the driver calls
 #[allow(clippy::all, dead_code)]
@@ -106,6 +112,17 @@ fn exp_filter32(f: &mut sensorless::ukf::f32::Filter, r: [f32; 6]) -> f32 {
 record_loop!(ukfx64, f64, sensorless::ukf::f64::Filter::new(), exp_filter64);
 record_loop!(ukfx32, f32, sensorless::ukf::f32::Filter::new(), exp_filter32);
 
+#[inline(always)]
+fn one_filter64(f: &mut sensorless_one::ukf::f64::Filter, r: [f64; 6]) -> f64 {
+    black_box(f.step(r[0], r[1])).z
+}
+#[inline(always)]
+fn one_filter32(f: &mut sensorless_one::ukf::f32::Filter, r: [f32; 6]) -> f32 {
+    black_box(f.step(r[0], r[1])).z
+}
+record_loop!(ukfo64, f64, sensorless_one::ukf::f64::Filter::new(), one_filter64);
+record_loop!(ukfo32, f32, sensorless_one::ukf::f32::Filter::new(), one_filter32);
+
 record_loop!(ukf64, f64, ukf::f64::Filter::new(), filter64);
 record_loop!(ukf32, f32, ukf::f32::Filter::new(), filter32);
 record_loop!(hold64, f64, valve::f64::Controller::new(), hold_step64);
@@ -167,6 +184,8 @@ fn main() {
             "ukf32" => ukf32(&rec32, n),
             "ukfx64" => ukfx64(&ja64, n),
             "ukfx32" => ukfx32(&ja32, n),
+            "ukfo64" => ukfo64(&ja64, n),
+            "ukfo32" => ukfo32(&ja32, n),
             "hold64" => hold64(&rec64, n),
             "hold32" => hold32(&rec32, n),
             "law64" => law64(&rec64, n),
