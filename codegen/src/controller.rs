@@ -408,15 +408,18 @@ pub fn runtime_state_pattern(model: &Model) -> (TokenStream, TokenStream) {
 }
 
 /// The sentence a controller's docs add where the description sets
-/// `controller.compensate_resistance`: firmware applies the correction.
-pub fn compensation_doc(model: &Model) -> &'static str {
+/// `controller.compensate_resistance`: firmware applies the correction
+/// within the controller's `limits` (the consts' names, e.g. `(U_MIN, U_MAX)`).
+pub fn compensation_doc(model: &Model, limits: &str) -> String {
     let on = (model.description.controller.as_ref()).is_some_and(|c| c.compensate_resistance);
     if on {
-        "\nThe design compensates the coil resistance (`compensate_resistance`): pass the\n\
-         step's u through `reldesign_runtime::resistance::compensate_resistance(u, r̂, R,\n\
-         i, (U_MIN, U_MAX))` with the observer's R̂ and the measured current i."
+        format!(
+            "\nThe design compensates the coil resistance (`compensate_resistance`): pass the\n\
+             step's u through `reldesign_runtime::resistance::compensate_resistance(u, r̂, R,\n\
+             i, {limits})` with the observer's R̂ and the measured current i."
+        )
     } else {
-        ""
+        String::new()
     }
 }
 
@@ -438,7 +441,7 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
          forces balance at takeoff), tracking of the table on [t₀, t_f], hold at z_f\n\
          after t_f with the expert rules of model-free-sliding-mode [SM 43] at the end\n\
          stop; `new`, `start`, `reference`, {step}. Allocation- and panic-free.{}",
-        compensation_doc(input.model)
+        compensation_doc(input.model, "(U_MIN, U_MAX)")
     ));
     let plan = plan_items(
         input.model,

@@ -91,8 +91,10 @@ fn float_module(input: &HoldInput, float: Float) -> Result<String, ControllerErr
     } else {
         "The armature held at `POSITION` (`reldesign_runtime::hold::PositionHold`): the mode\nrules [JA 94] at the stops, else u₂ of [JA 89], saturated to [0, U_MAX]; `new`,\n`step(z, v, phi, 0.0)` (the core has no field state). Allocation- and panic-free."
     };
-    let step_doc = format!("{step_doc}{}", compensation_doc(input.model))
-        .replace("(U_MIN, U_MAX)", "(0.0, U_MAX)");
+    let step_doc = format!(
+        "{step_doc}{}",
+        compensation_doc(input.model, "(0.0, U_MAX)")
+    );
     let step_doc = crate::emit::doc_attrs(&step_doc);
     let tokens = quote! {
         #[doc = " The hold in this float type."]

@@ -74,13 +74,19 @@ macro_rules! record_loop {
     };
 }
 
+/// `$name`: one step of the filter `$filter` on a row [u, i, …], its ẑ.
+macro_rules! filter_call {
+    ($name:ident, $filter:ty, $f:ty) => {
+        #[inline(always)]
+        fn $name(f: &mut $filter, r: [$f; 6]) -> $f {
+            black_box(f.step(r[0], r[1])).z
+        }
+    };
+}
 /// One call of each kind on a row [u, i, ẑ, v̂, φ̂, Ĥ_c] of the record.
 macro_rules! calls {
     ($f:ident, $filter:ident, $hold:ident, $law:ident, $base:ident) => {
-        #[inline(always)]
-        fn $filter(f: &mut ukf::$f::Filter, r: [$f; 6]) -> $f {
-            black_box(f.step(r[0], r[1])).z
-        }
+        filter_call!($filter, ukf::$f::Filter, $f);
         #[inline(always)]
         fn $hold(c: &mut valve::$f::Controller, r: [$f; 6]) -> $f {
             c.step(r[2], r[3], r[4], r[5])
@@ -101,25 +107,12 @@ macro_rules! calls {
 calls!(f64, filter64, hold_step64, law_alone64, nothing64);
 calls!(f32, filter32, hold_step32, law_alone32, nothing32);
 
-#[inline(always)]
-fn exp_filter64(f: &mut sensorless::ukf::f64::Filter, r: [f64; 6]) -> f64 {
-    black_box(f.step(r[0], r[1])).z
-}
-#[inline(always)]
-fn exp_filter32(f: &mut sensorless::ukf::f32::Filter, r: [f32; 6]) -> f32 {
-    black_box(f.step(r[0], r[1])).z
-}
+filter_call!(exp_filter64, sensorless::ukf::f64::Filter, f64);
+filter_call!(exp_filter32, sensorless::ukf::f32::Filter, f32);
+filter_call!(one_filter64, sensorless_one::ukf::f64::Filter, f64);
+filter_call!(one_filter32, sensorless_one::ukf::f32::Filter, f32);
 record_loop!(ukfx64, f64, sensorless::ukf::f64::Filter::new(), exp_filter64);
 record_loop!(ukfx32, f32, sensorless::ukf::f32::Filter::new(), exp_filter32);
-
-#[inline(always)]
-fn one_filter64(f: &mut sensorless_one::ukf::f64::Filter, r: [f64; 6]) -> f64 {
-    black_box(f.step(r[0], r[1])).z
-}
-#[inline(always)]
-fn one_filter32(f: &mut sensorless_one::ukf::f32::Filter, r: [f32; 6]) -> f32 {
-    black_box(f.step(r[0], r[1])).z
-}
 record_loop!(ukfo64, f64, sensorless_one::ukf::f64::Filter::new(), one_filter64);
 record_loop!(ukfo32, f32, sensorless_one::ukf::f32::Filter::new(), one_filter32);
 

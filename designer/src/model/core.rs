@@ -161,13 +161,11 @@ pub fn ja_field_rate(
         let m_irr = (mc - c * m_an) / (1.0 - c);
         // [JA 26] dM_irr/dB_e = δ·(M_an − M_irr)/(μ0·κ), δ = sgn(dB_c/dt) = sgn(φ̇)
         let delta = phi_dot.sign();
-        let lag = m_an - m_irr;
-        let lag = match ja.reversal {
-            Reversal::Clamp => lag,
-            // δ·max(δ·(M_an − M_irr), 0): no irreversible change against δ
-            Reversal::Reversible => delta * (delta * lag).max(0.0),
+        let dmirr = match ja.reversal {
+            Reversal::Clamp => delta * ((m_an - m_irr) / (mu0 * kappa)),
+            // max(δ·(M_an − M_irr), 0)/(μ0·κ): no irreversible change against δ
+            Reversal::Reversible => (delta * (m_an - m_irr)).max(0.0) / (mu0 * kappa),
         };
-        let dmirr = delta * (lag / (mu0 * kappa));
         // [JA 29] dM_c/dB_e = (1 − c)·dM_irr/dB_e + c·dM_an/dB_e
         let dmc = (1.0 - c) * dmirr + c * dman;
         // [JA 30] with the clamp [JA 52]: dB_c/dB_e = max(1 + μ0(1 − α)·dM_c/dB_e, ε)

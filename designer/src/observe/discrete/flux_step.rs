@@ -28,7 +28,6 @@
 
 use std::collections::HashMap;
 
-pub use crate::description::FluxStep;
 use crate::model::Model;
 use crate::sym::{Graph, Id};
 

@@ -108,8 +108,8 @@ use crate::description::{Core, Drive};
 use crate::model::{Model, Params};
 use crate::sym::{Graph, Id, Tape};
 
+pub use crate::description::FluxStep;
 pub use estimate::Estimate;
-pub use flux_step::FluxStep;
 pub use settings::{KalmanError, KalmanSettings, ResistanceSettings};
 pub use tapes::{DiscreteTapes, MeasurementEval, Prediction, TapeModel};
 

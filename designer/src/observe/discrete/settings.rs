@@ -77,7 +77,6 @@ pub enum KalmanError {
     BadResistanceSetting { name: &'static str, value: f64 },
     #[error("estimate_resistance: the model has no coil resistance parameter `R`")]
     NoResistance,
-
     #[error(
         "observer.sample_period = {sample_period:e} s is too long for the coil: the flux's \
          electrical time constant is τ = {tau:.3e} s at z = {z:e} m (φ = 0), and the \
