@@ -78,6 +78,9 @@ pub struct FitOptions {
     /// How the Jacobian is computed (analytic falls back to finite
     /// differences when a fitted parameter has no analytic sensitivity).
     pub sensitivities: Sensitivities,
+    /// Stops the fit before its next trial step once raised (its report
+    /// then has the status [`lm::Status::Stopped`]).
+    pub stop: Option<lm::Stop>,
 }
 
 /// How the fit's Jacobian is computed.
@@ -103,6 +106,7 @@ impl Default for FitOptions {
             ftol: 1e-8,
             max_steps_per_sample: 200,
             sensitivities: Sensitivities::Analytic,
+            stop: None,
         }
     }
 }
@@ -522,6 +526,7 @@ pub fn fit(
         max_iterations: options.max_iterations,
         ftol: options.ftol,
         fd_step: options.fd_step,
+        stop: options.stop.clone(),
         ..lm::Options::default()
     };
     let starts = options.starts.max(1);

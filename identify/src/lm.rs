@@ -23,7 +23,8 @@
 //!   columns evaluated in parallel (rayon) when the residual is `Fn + Sync`
 //!   ([`minimize`]) and in turn when it is only `FnMut` ([`minimize_mut`]).
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -44,6 +45,30 @@ pub struct Options {
     pub initial_damping: f64,
     /// Consecutive rejected steps before giving up.
     pub max_rejections: usize,
+    /// Stops the solver before its next trial step once raised (from
+    /// another thread: a start whose result is no longer needed).
+    pub stop: Option<Stop>,
+}
+
+/// A flag that stops a running minimisation ([`Status::Stopped`]).
+#[derive(Debug, Clone, Default)]
+pub struct Stop(Arc<AtomicBool>);
+
+impl Stop {
+    pub fn raise(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    pub fn raised(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+}
+
+/// Two flags are equal when they are the same flag.
+impl PartialEq for Stop {
+    fn eq(&self, other: &Stop) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 impl Default for Options {
@@ -56,6 +81,7 @@ impl Default for Options {
             fd_step: 1e-6,
             initial_damping: 1e-3,
             max_rejections: 30,
+            stop: None,
         }
     }
 }
@@ -75,6 +101,8 @@ pub enum Status {
     NoProgress,
     /// The Jacobian could not be evaluated at the last point.
     JacobianFailed,
+    /// [`Options::stop`] was raised.
+    Stopped,
 }
 
 impl Status {
@@ -425,6 +453,9 @@ where
         if iterations >= options.max_iterations {
             break Status::MaxIterations;
         }
+        if options.stop.as_ref().is_some_and(Stop::raised) {
+            break Status::Stopped;
+        }
         update_diag(&mut diag, &pt.jac);
         let g = pt.jac.tr_mul(&pt.r);
         let free = free_variables(p.map, &pt.y, &g);
@@ -474,6 +505,9 @@ where
     R: FnMut(&[f64]) -> Option<Vec<f64>>,
 {
     for _ in 0..options.max_rejections {
+        if options.stop.as_ref().is_some_and(Stop::raised) {
+            return Outcome::Stop(Status::Stopped);
+        }
         let h = step.projected(p.map, &pt.y, *mu);
         if h.amax() <= options.xtol {
             return Outcome::Stop(Status::StepConverged);
@@ -692,6 +726,33 @@ mod tests {
             seq.theta, rep.theta,
             "parallel and sequential columns agree bit for bit"
         );
+    }
+
+    #[test]
+    fn a_raised_stop_ends_the_solver_before_its_next_step() {
+        let bounds = [(-5.0, 5.0), (-5.0, 5.0)];
+        let stop = Stop::default();
+        let options = Options {
+            stop: Some(stop.clone()),
+            ..Options::default()
+        };
+        // raised by the monitor (another thread in `diagnose`) after 3 iterations
+        let mut raise_at_3 = |it: &Iteration| {
+            if it.iteration == 3 {
+                stop.raise();
+            }
+        };
+        let rep = minimize(rosenbrock, &[-1.2, 1.0], &bounds, &options, &mut raise_at_3).unwrap();
+        assert_eq!((rep.status, rep.iterations), (Status::Stopped, 3));
+        assert!(!rep.status.converged());
+        // the flag stays raised: the next run stops at the start point
+        assert!(stop.raised());
+        let rep = minimize(rosenbrock, &[-1.2, 1.0], &bounds, &options, &mut quiet).unwrap();
+        assert_eq!((rep.status, rep.iterations), (Status::Stopped, 0));
+        assert_eq!(rep.theta, vec![-1.2, 1.0]);
+        // a flag is equal to its clones only
+        assert_eq!(options.stop, Some(stop.clone()));
+        assert_ne!(options.stop, Some(Stop::default()));
     }
 
     #[test]

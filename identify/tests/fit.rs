@@ -160,6 +160,40 @@ fn saturating_valve_parameters_are_recovered_from_noisy_data() {
     assert!(report.status.converged(), "{:?}", report.status);
 }
 
+/// A fit's `stop` reaches its solver: raised from the progress callback
+/// (in `diagnose`, another thread's fit) after the second iteration, the
+/// fit ends there, not converged, with the values of that iteration.
+#[test]
+fn a_fit_stops_when_its_stop_is_raised() {
+    let truth = example("semera-valve.toml");
+    let (t, v) = square(30.0, 0.0, 20e-3, 20e-6, 1500);
+    let data = synthetic(&truth, t, v, 7);
+    let start = perturbed(&truth, &[("coil.resistance", 1.3), ("core.r0", 1.5)]);
+    let fitted = [
+        bounds(&truth, "coil.resistance", 3.0, 3.0),
+        bounds(&truth, "core.r0", 3.0, 3.0),
+    ];
+    let stop = reldesign_identify::lm::Stop::default();
+    let options = FitOptions {
+        stop: Some(stop.clone()),
+        ..FitOptions::default()
+    };
+    let at_two = |p: reldesign_identify::FitProgress| {
+        if p.iteration == 2 {
+            stop.raise();
+        }
+    };
+    let stopped = fit(&start, &data, &fitted, &options, &at_two).unwrap();
+    assert_eq!(stopped.status, reldesign_identify::lm::Status::Stopped);
+    assert_eq!(stopped.iterations, 2);
+    // unstopped, the same fit goes on to converge
+    let whole = fit(&start, &data, &fitted, &FitOptions::default(), &|_| {}).unwrap();
+    assert!(
+        whole.status.converged() && whole.iterations > 2,
+        "{whole:?}"
+    );
+}
+
 /// The five Jiles–Atherton parameters (79) on the JA valve: ±24 V, 10 µs
 /// samples, so that the plunger closes and the core saturates.
 fn ja_case(n: usize) -> (Description, Description, Measured, Vec<FitParam>) {
