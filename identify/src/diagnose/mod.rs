@@ -643,16 +643,21 @@ fn fit_all(
     let scored = Mutex::new(Vec::new());
     let starts = Mutex::new(Vec::new());
     let second = SecondStart::default();
+    // The order of the spawns: rayon runs a scope's spawns last-first on
+    // the spawning thread and first-first on a thread that steals them. So
+    // the saturation fit goes first (stolen at once: the second start waits
+    // for it, and runs next on its thread), the own hysteresis start last
+    // (run at once here), and the others between by their number of
+    // starts × parameters, cheapest first: the costliest run here next,
+    // while the other threads take the cheap ones.
+    let mut order: Vec<usize> = (0..others.len()).collect();
+    order.sort_by_key(|&k| {
+        let c = &others[k];
+        (c.cause != Cause::Saturation, c.starts * c.params.len())
+    });
     rayon::scope(|s| {
-        if let Some(own) = hysteresis {
-            let (starts, push, second) = (&starts, &push, &second);
-            s.spawn(move |_| {
-                let result = fit(own, None);
-                second.own_fitted(result.bic);
-                push(starts, (0, result));
-            });
-        }
-        for (k, c) in others.iter().enumerate() {
+        for k in order {
+            let c = &others[k];
             let (scored, starts, push, second) = (&scored, &starts, &push, &second);
             s.spawn(move |s| {
                 let result = fit(c, None);
@@ -670,6 +675,14 @@ fn fit_all(
                     });
                 }
                 push(scored, (k, result));
+            });
+        }
+        if let Some(own) = hysteresis {
+            let (starts, push, second) = (&starts, &push, &second);
+            s.spawn(move |_| {
+                let result = fit(own, None);
+                second.own_fitted(result.bic);
+                push(starts, (0, result));
             });
         }
     });
