@@ -26,7 +26,7 @@ use designer::sim::{Options, PiecewiseLinear};
 use reldesign_build::{
     emit_ekf, emit_kalman_macro, emit_observer_params, emit_ukf, wrap_module, Float, ObserverInput,
 };
-use support::{example_path, ScratchCrate};
+use support::{example_path, example_physics, replaced_once, ScratchCrate};
 
 const TS: f64 = 50e-6;
 
@@ -37,10 +37,7 @@ fn example(file: &str) -> Description {
 /// The perfect-tracking valve's physics with a text replacement: current
 /// drive, or a resistance drift (the model then depends on t).
 fn variant(from: &str, to: &str) -> Description {
-    let text = std::fs::read_to_string(example_path("perfect-tracking-valve.toml")).unwrap();
-    let physics = &text[..text.find("\n[trajectory]").unwrap()];
-    let changed = physics.replacen(from, to, 1);
-    assert_ne!(changed, physics);
+    let changed = replaced_once(&example_physics("perfect-tracking-valve.toml"), from, to);
     parse_str(&changed, "variant.toml").unwrap_or_else(|e| panic!("{e}"))
 }
 

@@ -15,7 +15,7 @@ use designer::observe::discrete::{
 };
 use designer::replay::replay;
 use designer::sim::{Mode, Options, PiecewiseLinear};
-use support::{example_path, root};
+use support::{example_path, replaced_once, root, without_design_sections};
 
 const TS: f64 = 50e-6;
 
@@ -104,8 +104,8 @@ fn sensorless_valve() -> Description {
 /// The sensorless valve's physics driven by its current.
 fn current_driven() -> Description {
     let text = std::fs::read_to_string(root().join("tests/data/sensorless-valve.toml")).unwrap();
-    let physics = &text[..text.find("\n[trajectory]").unwrap()];
-    let text = physics.replacen("drive = \"voltage\"", "drive = \"current\"", 1);
+    let physics = without_design_sections(&text);
+    let text = replaced_once(&physics, "drive = \"voltage\"", "drive = \"current\"");
     let mut d = parse_str(&text, "current-driven.toml").unwrap_or_else(|e| panic!("{e}"));
     d.name = "current_driven".into();
     d

@@ -25,7 +25,7 @@ use designer::observe::ekf::Ekf;
 use designer::observe::ukf::Ukf;
 use designer::replay::replay;
 use designer::sim::{EventKind, Mode, Options, PiecewiseLinear};
-use support::{example_path, example_paths};
+use support::{example_path, example_paths, example_physics, replaced_once};
 
 fn example(file: &str) -> Description {
     parse_file(&example_path(file)).unwrap_or_else(|e| panic!("{e}"))
@@ -116,9 +116,8 @@ fn settings(d: &Description, ts: f64) -> KalmanSettings {
 #[test]
 fn symbolic_jacobians_match_finite_differences() {
     let steps = [FluxStep::Euler, FluxStep::Exponential { substeps: 2 }];
-    let text = std::fs::read_to_string(example_path("perfect-tracking-valve.toml")).unwrap();
-    let physics = &text[..text.find("\n[trajectory]").unwrap()];
-    let current = physics.replacen("drive = \"voltage\"", "drive = \"current\"", 1);
+    let physics = example_physics("perfect-tracking-valve.toml");
+    let current = replaced_once(&physics, "drive = \"voltage\"", "drive = \"current\"");
     let current = parse_str(&current, "current drive").unwrap();
     let subjects = all_examples()
         .into_iter()
@@ -548,17 +547,20 @@ fn filters_on_the_jiles_atherton_valve() {
 /// tracked.
 #[test]
 fn current_drive_and_resistance_drift_run() {
-    let text = std::fs::read_to_string(example_path("perfect-tracking-valve.toml")).unwrap();
     // the physics sections only (a controller needs voltage drive)
-    let physics = &text[..text.find("\n[trajectory]").unwrap()];
+    let physics = example_physics("perfect-tracking-valve.toml");
     let variants = [
         (
             "current drive",
-            physics.replacen("drive = \"voltage\"", "drive = \"current\"", 1),
+            replaced_once(&physics, "drive = \"voltage\"", "drive = \"current\""),
         ),
         (
             "resistance drift",
-            physics.replacen("eddy = 1500.0", "eddy = 1500.0\nresistance_drift = 50.0", 1),
+            replaced_once(
+                &physics,
+                "eddy = 1500.0",
+                "eddy = 1500.0\nresistance_drift = 50.0",
+            ),
         ),
     ];
     print_header();
