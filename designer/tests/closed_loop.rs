@@ -7,7 +7,7 @@ use designer::closed_loop::{run_loop, sweep, switching_baseline};
 use designer::description::parse_file;
 use designer::design::Design;
 use designer::sim::{EventKind, Limit, Options};
-use support::example_path;
+use support::{example_path, replaced_once};
 
 /// The speed of the first impact at each operation's destination after its
 /// takeoff (signed), per operation.
@@ -249,21 +249,25 @@ fn every_law_lands_softly_on_the_hysteretic_core() {
 /// 9.8 µm; R̂ ends within 0.05 % of the plant's R.
 #[test]
 fn resistance_compensation_tracks_the_estimated_coil() {
-    let text = std::fs::read_to_string(support::root().join("tests/data/sensorless-valve.toml"))
-        .unwrap()
-        .replacen("[controller]\n", "[controller]\nestimator = \"ukf\"\n", 1);
+    let text =
+        std::fs::read_to_string(support::root().join("tests/data/sensorless-valve.toml")).unwrap();
+    let text = replaced_once(
+        &text,
+        "[controller]\n",
+        "[controller]\nestimator = \"ukf\"\n",
+    );
     // the worst RMS of z − z_r over the operations, and R̂ at the end
     let rmse = |r_factor: f64, on: bool| {
-        let plant_text = text.replacen(
+        let plant_text = replaced_once(
+            &text,
             "resistance = 75.0",
             &format!("resistance = {}", 75.0 * r_factor),
-            1,
         );
         let plant = designer::description::parse_str(&plant_text, "plant.toml").unwrap();
-        let with = text.replacen(
+        let with = replaced_once(
+            &text,
             "[controller]\n",
             &format!("[controller]\ncompensate_resistance = {on}\n"),
-            1,
         );
         let d = designer::description::parse_str(&with, "design.toml").unwrap();
         let design = Design::new(&d).unwrap_or_else(|e| panic!("{e}"));
