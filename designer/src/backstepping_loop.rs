@@ -106,6 +106,7 @@ pub fn run_backstepping(
             operations: Vec::new(),
             operation_length: t_end,
             estimates,
+            stops: crate::closed_loop::end_stops(plant_description),
         },
         modes,
         inside,

@@ -78,6 +78,8 @@ pub struct LoopRun {
     pub operation_length: f64,
     /// The observer's estimate at every sample, where one drives the controller.
     pub estimates: Option<Vec<Estimate>>,
+    /// The plant's end stops [z_min, z_max] [m].
+    pub stops: [f64; 2],
 }
 
 /// The observer that drives the controller from the measured voltage and
@@ -283,6 +285,7 @@ pub fn run_loop(
         return Err(LoopError::NoController);
     };
     let plant_description = plant.unwrap_or(&design.description);
+    let stops = end_stops(plant_description);
     let mut plant_model = Model::build(plant_description);
     check_plant(design, &plant_model)?;
     let model_plant = ModelPlant::new(&mut plant_model);
@@ -339,6 +342,7 @@ pub fn run_loop(
         operations,
         operation_length: length,
         estimates,
+        stops,
     })
 }
 
@@ -413,6 +417,7 @@ pub fn run_hold(
         operations: Vec::new(),
         operation_length: t_end,
         estimates,
+        stops: end_stops(plant_description),
     })
 }
 
@@ -629,6 +634,10 @@ pub struct OperationOutcome {
     pub rmse_z: Option<f64>,
     /// Impacts at the end stop within the operation that bounced.
     pub bounces: usize,
+    /// The highest bounce [m]: the largest distance from the end stop, at
+    /// the samples, between an impact there that bounced and the next
+    /// impact (or the operation's end); 0 without a bounce.
+    pub highest_bounce: f64,
 }
 
 impl LoopRun {
@@ -640,6 +649,7 @@ impl LoopRun {
                 let end = start + self.operation_length;
                 let (impact_velocity, bounces) =
                     impacts(&self.trajectory, operation, start + takeoff, end);
+                let highest_bounce = self.highest_bounce(operation, start + takeoff, end);
                 let tr = &self.trajectory;
                 let (mut sum, mut n) = (0.0, 0usize);
                 for ((t, x), zr) in tr.t.iter().zip(&tr.x).zip(&self.z_ref) {
@@ -653,10 +663,48 @@ impl LoopRun {
                     impact_velocity,
                     rmse_z: (n > 0).then(|| (sum / n as f64).sqrt()),
                     bounces,
+                    highest_bounce,
                 }
             })
             .collect()
     }
+
+    /// [`OperationOutcome::highest_bounce`] of `operation` within (from, to].
+    fn highest_bounce(&self, operation: Operation, from: f64, to: f64) -> f64 {
+        let (destination, stop) = match operation {
+            Operation::Closing => (Limit::Min, self.stops[0]),
+            Operation::Opening => (Limit::Max, self.stops[1]),
+        };
+        let tr = &self.trajectory;
+        let impacts: Vec<(f64, bool)> = tr
+            .events
+            .iter()
+            .filter(|e| e.t > from && e.t <= to)
+            .filter_map(|e| match e.kind {
+                EventKind::Impact { limit, v_after, .. } if limit == destination => {
+                    Some((e.t, v_after != 0.0))
+                }
+                _ => None,
+            })
+            .collect();
+        let mut highest = 0.0_f64;
+        for (k, &(t, bounced)) in impacts.iter().enumerate() {
+            let next = impacts.get(k + 1).map_or(to, |&(t, _)| t);
+            if bounced {
+                for (s, x) in tr.t.iter().zip(&tr.x) {
+                    if *s > t && *s < next {
+                        highest = highest.max((x[0] - stop).abs());
+                    }
+                }
+            }
+        }
+        highest
+    }
+}
+
+/// The end stops [z_min, z_max] of `description`'s armature [m].
+pub(crate) fn end_stops(description: &Description) -> [f64; 2] {
+    [description.mechanics.z_min, description.mechanics.z_max]
 }
 
 /// The first impact's velocity at `operation`'s end stop in (from, to], and

@@ -24,11 +24,10 @@
 //! CI runs the 10 µs UKF row of the first design and the 50 µs row of the
 //! second on one seed.
 
-use designer::closed_loop::{resample_observer, run_loop, switching_baseline, LoopRun, Noise};
-use designer::description::{parse_str, Description, Operation};
-use designer::design::Design;
-use designer::sim::{EventKind, Limit, Options};
-use reldesign_tests::{root, sensorless::mismatched_plant};
+use designer::closed_loop::resample_observer;
+use designer::description::{parse_str, Description};
+use reldesign_tests::root;
+use reldesign_tests::sensorless::{landings, mismatched_plant, Landings};
 
 /// (k_s factor, R factor) of the plants.
 const PLANTS: [(f64, f64); 5] = [(1.0, 1.0), (1.1, 0.9), (0.9, 1.1), (1.1, 1.1), (0.9, 0.9)];
@@ -37,23 +36,6 @@ const PLANTS: [(f64, f64); 5] = [(1.0, 1.0), (1.1, 0.9), (0.9, 1.1), (1.1, 1.1),
 const SATURATING: &str = "tests/data/sensorless-valve.toml";
 /// The design on the Jiles–Atherton core (exponential step, tuned at 50 µs).
 const JILES_ATHERTON: &str = "tests/data/sensorless-ja-valve.toml";
-
-/// Over plants and seeds, per operation (closing, opening): how many times
-/// softer than the switching the first impact is (0 where the armature
-/// never lands within t₀ after t_f), worst and best; the runs below 10×; the
-/// most bounces within that window and the runs with more than one; the
-/// highest bounce [m] (the largest excursion from the stop between an
-/// impact that bounced and the next one, at the samples).
-#[derive(Debug, Clone, Copy)]
-struct Row {
-    worst: [f64; 2],
-    best: [f64; 2],
-    below_ten: usize,
-    bounces: usize,
-    bouncing: usize,
-    highest: f64,
-    runs: usize,
-}
 
 /// The design of `file` with its observer `estimator` driving the law, at `ts`.
 fn design(file: &str, estimator: &str, ts: f64) -> Description {
@@ -81,81 +63,17 @@ fn design(file: &str, estimator: &str, ts: f64) -> Description {
     d
 }
 
-/// The highest bounce [m] at `operation`'s stop of `d` within (from, to]:
-/// the largest distance from the stop between an impact that bounced and
-/// the next impact, at the samples.
-fn highest_bounce(run: &LoopRun, d: &Description, operation: Operation, from: f64, to: f64) -> f64 {
-    let (limit, stop) = match operation {
-        Operation::Closing => (Limit::Min, d.mechanics.z_min),
-        Operation::Opening => (Limit::Max, d.mechanics.z_max),
-    };
-    let tr = &run.trajectory;
-    let impacts: Vec<(f64, bool)> = tr
-        .events
+fn row(file: &str, estimator: &str, ts: f64, seeds: std::ops::Range<u64>) -> Landings {
+    let plants: Vec<_> = PLANTS
         .iter()
-        .filter(|e| e.t > from && e.t <= to)
-        .filter_map(|e| match e.kind {
-            EventKind::Impact {
-                limit: l, v_after, ..
-            } if l == limit => Some((e.t, v_after != 0.0)),
-            _ => None,
-        })
+        .map(|&(ks, r)| mismatched_plant(ks, r))
         .collect();
-    let mut highest = 0.0_f64;
-    for (k, &(t, bounced)) in impacts.iter().enumerate() {
-        let next = impacts.get(k + 1).map_or(to, |&(t, _)| t);
-        if bounced {
-            for (s, x) in tr.t.iter().zip(&tr.x) {
-                if *s > t && *s < next {
-                    highest = highest.max((x[0] - stop).abs());
-                }
-            }
-        }
-    }
-    highest
-}
-
-fn row(file: &str, estimator: &str, ts: f64, seeds: std::ops::Range<u64>) -> Row {
-    let d = design(file, estimator, ts);
-    let design = Design::new(&d).unwrap_or_else(|e| panic!("{e}"));
-    let t = d.trajectory.as_ref().unwrap();
-    let mut row = Row {
-        worst: [f64::INFINITY; 2],
-        best: [0.0; 2],
-        below_ten: 0,
-        bounces: 0,
-        bouncing: 0,
-        highest: 0.0,
-        runs: 0,
-    };
-    for (ks, r) in PLANTS {
-        let plant = mismatched_plant(ks, r);
-        let switching = switching_baseline(&d, Some(&plant), &Options::default()).unwrap();
-        for seed in seeds.clone() {
-            let noise = Noise {
-                seed,
-                sigma: Some([15e-3, 1e-3]),
-            };
-            let run = run_loop(&design, Some(&plant), ts, None, noise, &Options::default())
-                .unwrap_or_else(|e| panic!("{e}"));
-            let outcomes = run.outcomes(t.takeoff, t.landing);
-            for (k, (o, (_, hard))) in outcomes.iter().zip(&switching).enumerate() {
-                let hard = hard.expect("the switching lands").abs();
-                let softer = o.impact_velocity.map_or(0.0, |v| hard / v.abs().max(1e-12));
-                row.worst[k] = row.worst[k].min(softer);
-                row.best[k] = row.best[k].max(softer);
-                row.below_ten += usize::from(softer < 10.0);
-                row.bounces = row.bounces.max(o.bounces);
-                row.bouncing += usize::from(o.bounces > 1);
-                let (_, start) = run.operations[k];
-                let window = (start + t.takeoff, start + run.operation_length);
-                let highest = highest_bounce(&run, &d, o.operation, window.0, window.1);
-                row.highest = row.highest.max(highest);
-                row.runs += 1;
-            }
-        }
-    }
-    row
+    landings(
+        &design(file, estimator, ts),
+        &plants,
+        Some([15e-3, 1e-3]),
+        seeds,
+    )
 }
 
 /// CI, on the first noise seed: at 10 µs the saturating design's UKF lands
