@@ -316,19 +316,25 @@ impl Draw {
                 self.r_core
             ),
             CoreKind::JilesAtherton => {
-                // a soft steel of the jiles-atherton-actuator-model's kind,
-                // scaled to the drawn pole: B_sat → m_sat, path length from r0
-                let length = self.r_core * MU0 * 1000.0 * self.area;
-                let b_sat = phi_sat / self.area;
+                // a soft steel of the jiles-atherton-actuator-model's kind
+                // (Table 2: b = 2.45 mT, α = 3.66e-3, c = 0.736, κ = 943 A/m),
+                // scaled to the drawn pole: B_sat → M_sat, and b such that the
+                // anhysteretic curve's initial relative permeability is the
+                // μr = 1000 the path length l_c = r0·μ0·μr·A_c assumes. On
+                // the curve M = M_sat·L(μ0(H + αM)/b), dM/dH at 0 is
+                // k/(1 − α·k) with k = μ0·M_sat/(3b).
+                let mu_r = 1000.0;
+                let length = self.r_core * MU0 * mu_r * self.area;
+                let m_sat = phi_sat / self.area / MU0;
+                let alpha = log_uniform(rng, 1e-3, 8e-3);
+                let k = (mu_r - 1.0) / (1.0 + alpha * (mu_r - 1.0));
+                let b = MU0 * m_sat / (3.0 * k);
                 format!(
                     "[core]\nmodel = \"jiles-atherton\"\nlength = {length:e}\narea = {:e}\n\
-                     m_sat = {:e}\nb = {:e}\nc = {:e}\nkappa = {:e}\nalpha = {:e}\n",
+                     m_sat = {m_sat:e}\nb = {b:e}\nc = {:e}\nkappa = {:e}\nalpha = {alpha:e}\n",
                     self.area,
-                    b_sat / MU0,
                     rng.uniform(0.3, 0.8),
-                    rng.uniform(0.1, 0.4),
-                    rng.uniform(50.0, 400.0),
-                    rng.uniform(1e-4, 1e-3),
+                    log_uniform(rng, 50.0, 1000.0),
                 )
             }
         }
@@ -360,12 +366,24 @@ mod tests {
         }
     }
 
+    /// The core is a soft steel: on its anhysteretic curve the relative
+    /// permeability at low flux is the μr = 1000 its length assumes (the
+    /// generator's first Jiles–Atherton cores had b of 0.1–0.4 T, μr ≈ 2–7:
+    /// no supply could close them).
     #[test]
-    fn jiles_atherton_devices_parse() {
+    fn jiles_atherton_devices_parse_and_are_soft_steel() {
+        use designer::description::Core;
         for i in 0..6 {
             let d = device(5, i, true);
             assert_eq!(d.core, CoreKind::JilesAtherton);
-            d.description();
+            let Core::JilesAtherton(ja) = d.description().core else {
+                panic!("{}: not a Jiles–Atherton core", d.name);
+            };
+            let b = 1e-3;
+            let mu_r = b / (MU0 * designer::model::anhysteretic_field(&ja, b));
+            assert!((mu_r - 1000.0).abs() < 10.0, "{}: μr = {mu_r}", d.name);
+            let b_sat = MU0 * ja.m_sat;
+            assert!((1.2..=2.7).contains(&b_sat), "{}: B_sat = {b_sat}", d.name);
         }
     }
 
