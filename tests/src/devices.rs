@@ -317,7 +317,7 @@ impl Draw {
             ),
             CoreKind::JilesAtherton => {
                 // a soft steel of the jiles-atherton-actuator-model's kind
-                // (Table 2: b = 2.45 mT, α = 3.66e-3, c = 0.736, κ = 943 A/m),
+                // ([JA Table 2]: b = 2.45 mT, α = 3.66e-3, c = 0.736, κ = 943 A/m),
                 // scaled to the drawn pole: B_sat → M_sat, and b such that the
                 // anhysteretic curve's initial relative permeability is the
                 // μr = 1000 the path length l_c = r0·μ0·μr·A_c assumes. On

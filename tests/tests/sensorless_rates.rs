@@ -26,6 +26,7 @@
 
 use designer::closed_loop::resample_observer;
 use designer::description::{parse_str, Description};
+use designer::sim::Options;
 use reldesign_tests::root;
 use reldesign_tests::sensorless::{landings, mismatched_plant, Landings};
 
@@ -73,6 +74,7 @@ fn row(file: &str, estimator: &str, ts: f64, seeds: std::ops::Range<u64>) -> Lan
         &plants,
         Some([15e-3, 1e-3]),
         seeds,
+        &Options::default(),
     )
 }
 
