@@ -54,7 +54,8 @@ struct FilterNoise {
 /// What the filter's flux and field noises scale with.
 #[derive(Debug, Clone, Copy)]
 enum Scale {
-    /// w_φ ∝ μ0·M_sat·A_c, w_Hc absolute.
+    /// w_φ and the initial φ spread ∝ μ0·M_sat·A_c, w_Hc absolute, the
+    /// initial H_c spread ∝ κ.
     Saturation,
     /// The device's operating point relative to the valve's: the largest
     /// flux its references need, and the anhysteretic field there.
@@ -108,8 +109,8 @@ fn core_scales(d: &Description) -> (f64, f64) {
 /// - T_s = τ/140, at most 50 µs (the valve's samples per motion);
 /// - settling time 2.5/7·τ, creep speed 10 mm/s × (stroke/1 mm)·(7 ms/τ);
 /// - σ_v, σ_i: 15 mV and 1 mA scaled to the supply and the full-scale current;
-/// - the filter's noises scaled by the stroke, the flux μ0·M_sat·A_c, κ, R
-///   and T_s; w_φ and w_Hc from `noise`.
+/// - the filter's noises scaled by the stroke, R and T_s; w_φ, w_Hc and the
+///   initial φ, H_c spreads from `noise`.
 fn sensorless_design(device: &Device, tau: f64, takeoff: f64, noise: FilterNoise) -> Description {
     let nominal = device.description();
     let (kappa, flux) = core_scales(&nominal);
@@ -429,72 +430,4 @@ fn study_tables() {
             "{below} runs below 10×, measured {measured}"
         );
     }
-}
-
-#[test]
-#[ignore = "exploration"]
-fn explore_trace0() {
-    let i: u64 = std::env::var("DEV")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(0);
-    let device = device(TUNING_FAMILY, i, true);
-    let (_, mut d) = shortest_design(&device, VALVE_NOISE).unwrap();
-    if std::env::var("NOR").is_ok() {
-        d.observer
-            .as_mut()
-            .unwrap()
-            .kalman
-            .as_mut()
-            .unwrap()
-            .resistance = None;
-        d.controller.as_mut().unwrap().compensate_resistance = false;
-    }
-    if let Ok(n) = std::env::var("SUB") {
-        d.observer
-            .as_mut()
-            .unwrap()
-            .kalman
-            .as_mut()
-            .unwrap()
-            .flux_step = designer::description::FluxStep::Exponential {
-            substeps: n.parse().unwrap(),
-        };
-    }
-    if let Ok(ts) = std::env::var("TS") {
-        let ts: f64 = ts.parse().unwrap();
-        d.controller.as_mut().unwrap().sample_period = ts;
-        designer::closed_loop::resample_observer(d.observer.as_mut().unwrap(), ts);
-    }
-    let design = Design::new(&d).unwrap();
-    let ts = d.controller.as_ref().unwrap().sample_period;
-    let run = designer::closed_loop::run_loop(
-        &design,
-        Some(&d),
-        ts,
-        None,
-        designer::closed_loop::Noise {
-            seed: 0,
-            sigma: Some([0.0, 0.0]),
-        },
-        &options(),
-    )
-    .unwrap();
-    let est = run.estimates.as_ref().unwrap();
-    let tr = &run.trajectory;
-    let t = d.trajectory.as_ref().unwrap();
-    println!("t0 {} tf {} stroke {}", t.takeoff, t.landing, device.stroke);
-    println!("{}", device.toml);
-    let step: usize = std::env::var("STEP")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(10);
-    for k in (0..tr.t.len()).step_by(step) {
-        if tr.t[k] > run.operation_length {
-            break;
-        }
-        let x = &tr.x[k];
-        println!("{:7.2} ms z {:7.1} ẑ−z {:7.2} µm v {:7.1} v̂ {:7.1} mm/s Hc {:6.1} Ĥc {:6.1} φ {:.3e} φ̂/φ−1 {:+.5} R̂ {:.4} u {:6.2} zr {:7.1}", tr.t[k]*1e3, x[0]*1e6, (est[k].z-x[0])*1e6, x[1]*1e3, est[k].v*1e3, x[3], est[k].hc.unwrap_or(0.0), x[2], est[k].phi/x[2]-1.0, est[k].r.unwrap_or(f64::NAN), tr.u[k], run.z_ref[k]*1e6);
-    }
-    println!("{:?}", run.outcomes(t.takeoff, t.landing));
 }
