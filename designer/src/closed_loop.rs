@@ -636,7 +636,7 @@ pub struct OperationOutcome {
     pub bounces: usize,
     /// The highest bounce [m]: the largest distance from the end stop, at
     /// the samples, between an impact there that bounced and the next
-    /// impact (or the operation's end); 0 without a bounce.
+    /// impact or stick there (or the operation's end); 0 without a bounce.
     pub highest_bounce: f64,
 }
 
@@ -675,31 +675,41 @@ impl LoopRun {
             Operation::Closing => (Limit::Min, self.stops[0]),
             Operation::Opening => (Limit::Max, self.stops[1]),
         };
-        let tr = &self.trajectory;
-        let impacts: Vec<(f64, bool)> = tr
-            .events
-            .iter()
-            .filter(|e| e.t > from && e.t <= to)
-            .filter_map(|e| match e.kind {
-                EventKind::Impact { limit, v_after, .. } if limit == destination => {
-                    Some((e.t, v_after != 0.0))
-                }
-                _ => None,
-            })
-            .collect();
-        let mut highest = 0.0_f64;
-        for (k, &(t, bounced)) in impacts.iter().enumerate() {
-            let next = impacts.get(k + 1).map_or(to, |&(t, _)| t);
-            if bounced {
-                for (s, x) in tr.t.iter().zip(&tr.x) {
-                    if *s > t && *s < next {
-                        highest = highest.max((x[0] - stop).abs());
-                    }
-                }
-            }
-        }
-        highest
+        highest_bounce(&self.trajectory, destination, stop, from, to)
     }
+}
+
+/// The largest |z − `stop`| at the samples of `tr` between an impact at
+/// `destination` within (from, to] that bounced and the next event there
+/// (impact or stick; else `to`); 0 without a bounce.
+fn highest_bounce(tr: &Trajectory, destination: Limit, stop: f64, from: f64, to: f64) -> f64 {
+    let at_destination: Vec<(f64, bool)> = tr
+        .events
+        .iter()
+        .filter(|e| e.t > from && e.t <= to)
+        .filter_map(|e| match e.kind {
+            EventKind::Impact { limit, v_after, .. } if limit == destination => {
+                Some((e.t, v_after != 0.0))
+            }
+            EventKind::Stick { limit } if limit == destination => Some((e.t, false)),
+            _ => None,
+        })
+        .collect();
+    let mut highest = 0.0_f64;
+    for (k, &(t, bounced)) in at_destination.iter().enumerate() {
+        if !bounced {
+            continue;
+        }
+        let next = at_destination.get(k + 1).map_or(to, |&(t, _)| t);
+        let (first, last) = (
+            tr.t.partition_point(|&s| s <= t),
+            tr.t.partition_point(|&s| s < next),
+        );
+        for x in tr.x.get(first..last).unwrap_or_default() {
+            highest = highest.max((x[0] - stop).abs());
+        }
+    }
+    highest
 }
 
 /// The end stops [z_min, z_max] of `description`'s armature [m].
@@ -873,6 +883,56 @@ pub fn sweep(
 mod tests {
     use super::*;
     use crate::sim::Event;
+
+    /// The height counts from a bouncing impact to the next event at the
+    /// stop: not before it, not after a stick (a lift-off and a drift then
+    /// are no bounce), not for an impact at the other stop or outside the
+    /// window.
+    #[test]
+    fn the_highest_bounce_is_measured_between_a_bounce_and_the_next_event_at_the_stop() {
+        let impact = |t, limit, v_after| Event {
+            t,
+            kind: EventKind::Impact {
+                limit,
+                v_before: -0.01,
+                v_after,
+                zeno: false,
+            },
+            mode_after: Mode::Free,
+        };
+        let stop = 1e-4;
+        // z − stop at t = 0, 1, …, 9: the approach, a bounce of 7 µm
+        // (impact at 2.5, stick at 5.5), then a lift-off and a 50 µm drift
+        let heights = [
+            90e-6, 40e-6, 0.0, 3e-6, 7e-6, 2e-6, 0.0, 20e-6, 50e-6, 60e-6,
+        ];
+        let tr = Trajectory {
+            t: (0..10).map(f64::from).collect(),
+            x: heights.iter().map(|h| [stop + h, 0.0, 0.0, 0.0]).collect(),
+            events: vec![
+                impact(2.5, Limit::Min, 0.005),
+                Event {
+                    t: 5.5,
+                    kind: EventKind::Stick { limit: Limit::Min },
+                    mode_after: Mode::StuckMin,
+                },
+                impact(8.5, Limit::Max, 0.005),
+            ],
+            ..Trajectory::default()
+        };
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-15;
+        assert!(close(highest_bounce(&tr, Limit::Min, stop, 0.0, 9.0), 7e-6));
+        // outside the window, and at the other stop: none
+        assert_eq!(highest_bounce(&tr, Limit::Min, stop, 3.0, 9.0), 0.0);
+        assert_eq!(highest_bounce(&tr, Limit::Max, stop, 0.0, 8.0), 0.0);
+        // a bounce that never comes back counts up to the window's end
+        let mut tr = tr;
+        tr.events.remove(1);
+        assert!(close(
+            highest_bounce(&tr, Limit::Min, stop, 0.0, 7.5),
+            20e-6
+        ));
+    }
 
     fn trajectory(events: Vec<Event>) -> Trajectory {
         Trajectory {

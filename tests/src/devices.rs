@@ -124,6 +124,9 @@ struct Draw {
     stroke: f64,
     mass: f64,
     r_core: f64,
+    /// The core's magnetic path [m] and relative permeability.
+    path: f64,
+    mu_r: f64,
     phi_sat: f64,
 }
 
@@ -209,6 +212,8 @@ impl Draw {
             stroke: rng.uniform(stroke.0, stroke.1),
             mass: log_uniform(rng, mass.0, mass.1),
             r_core: path / (MU0 * mu_r * area),
+            path,
+            mu_r,
             phi_sat: rng.uniform(1.2, 1.8) * area,
         }
     }
@@ -316,22 +321,22 @@ impl Draw {
                 self.r_core
             ),
             CoreKind::JilesAtherton => {
-                // a soft steel of the jiles-atherton-actuator-model's kind
-                // ([JA Table 2]: b = 2.45 mT, α = 3.66e-3, c = 0.736, κ = 943 A/m),
-                // scaled to the drawn pole: B_sat → M_sat, and b such that the
+                // a soft steel around the jiles-atherton-actuator-model's
+                // ([JA Table 2]: b = 2.45 mT, α = 3.66e-3, c = 0.736, κ = 943
+                // A/m) on the drawn path, B_sat → M_sat, and b such that the
                 // anhysteretic curve's initial relative permeability is the
-                // μr = 1000 the path length l_c = r0·μ0·μr·A_c assumes. On
-                // the curve M = M_sat·L(μ0(H + αM)/b), dM/dH at 0 is
-                // k/(1 − α·k) with k = μ0·M_sat/(3b).
-                let mu_r = 1000.0;
-                let length = self.r_core * MU0 * mu_r * self.area;
+                // drawn μr (so the core's reluctance at small flux is the
+                // linear cores' r0). On M = M_sat·L(μ0(H + αM)/b), L(x) ≈ x/3,
+                // dM/dH at 0 is χ = k/(1 − α·k) with k = μ0·M_sat/(3b).
                 let m_sat = phi_sat / self.area / MU0;
                 let alpha = log_uniform(rng, 1e-3, 8e-3);
-                let k = (mu_r - 1.0) / (1.0 + alpha * (mu_r - 1.0));
+                let chi = self.mu_r - 1.0;
+                let k = chi / (1.0 + alpha * chi);
                 let b = MU0 * m_sat / (3.0 * k);
                 format!(
-                    "[core]\nmodel = \"jiles-atherton\"\nlength = {length:e}\narea = {:e}\n\
+                    "[core]\nmodel = \"jiles-atherton\"\nlength = {:e}\narea = {:e}\n\
                      m_sat = {m_sat:e}\nb = {b:e}\nc = {:e}\nkappa = {:e}\nalpha = {alpha:e}\n",
+                    self.path,
                     self.area,
                     rng.uniform(0.3, 0.8),
                     log_uniform(rng, 50.0, 1000.0),
@@ -367,9 +372,10 @@ mod tests {
     }
 
     /// The core is a soft steel: on its anhysteretic curve the relative
-    /// permeability at low flux is the μr = 1000 its length assumes (the
-    /// generator's first Jiles–Atherton cores had b of 0.1–0.4 T, μr ≈ 2–7:
-    /// no supply could close them).
+    /// permeability at low flux is the drawn μr, so its reluctance there is
+    /// the linear cores' r0 (the generator's first Jiles–Atherton cores had
+    /// b of 0.1–0.4 T, μr ≈ 2–7: no supply could close them). (From a
+    /// demagnetised core the initial curve is lower, χ₀ ≈ c·χ.)
     #[test]
     fn jiles_atherton_devices_parse_and_are_soft_steel() {
         use designer::description::Core;
@@ -379,9 +385,18 @@ mod tests {
             let Core::JilesAtherton(ja) = d.description().core else {
                 panic!("{}: not a Jiles–Atherton core", d.name);
             };
+            // the same draw with the input-affine core (saturating below 15)
+            let Core::Saturating { r0, .. } = device(5, i, false).description().core else {
+                panic!("device {i} of family 5 is not saturating");
+            };
             let b = 1e-3;
-            let mu_r = b / (MU0 * designer::model::anhysteretic_field(&ja, b));
-            assert!((mu_r - 1000.0).abs() < 10.0, "{}: μr = {mu_r}", d.name);
+            let h = designer::model::anhysteretic_field(&ja, b);
+            let reluctance = h * ja.length / (b * ja.area);
+            assert!(
+                (reluctance / r0 - 1.0).abs() < 1e-4,
+                "{}: {reluctance} H⁻¹ against r0 = {r0}",
+                d.name
+            );
             let b_sat = MU0 * ja.m_sat;
             assert!((1.2..=2.7).contains(&b_sat), "{}: B_sat = {b_sat}", d.name);
         }

@@ -4,6 +4,7 @@
 pub mod devices;
 pub mod friction;
 pub mod hidden;
+pub mod landings;
 pub mod outside;
 pub mod sensorless;
 

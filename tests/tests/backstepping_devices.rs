@@ -6,7 +6,7 @@
 //! from rest on the spring's stop converges to the position within 1 % of
 //! the stroke in 100 ms with at most two switches of the input law, or it is
 //! refused with a named reason (the position cannot be held within the
-//! supply, or no quadratic V holds the spring's rest); most devices certify.
+//! supply, or no quadratic V holds the spring's rest).
 //! The family is seeded, so the outcome is asserted exactly: all 33 devices
 //! certify and converge (to within 1.1e-6 of the stroke at worst, measured;
 //! the 3 Jiles–Atherton ones to 9e-9–1.1e-6). (The generator's first

@@ -5,19 +5,23 @@
 //! the device itself (the paper's clamp [JA 52], where the design has the
 //! reversal rule "reversible") and ±10 % on k_s and R, as in
 //! `tests/tests/sensorless_rates.rs`; the measurement noise is the valve's
-//! ADC's scaled to the device's supply and full-scale current.
+//! ADC's scaled to the device's supply and full-scale current. Each device
+//! is also run perfectly observed (the true state and R in the same law), to
+//! tell the observer's share from the law's.
 //!
 //! ```sh
 //! cargo test --release -p reldesign-tests --test sensorless_devices -- --include-ignored --nocapture
 //! ```
 
 use std::ops::Range;
+use std::sync::OnceLock;
 
-use designer::description::Description;
+use designer::description::{Core, Description, Gains, Law, Shape};
 use designer::design::Design;
+use designer::model::{anhysteretic_field, MU0};
 use designer::sim::Options;
 use reldesign_tests::devices::{device, Device};
-use reldesign_tests::sensorless::{landings, Landings};
+use reldesign_tests::landings::{landings, Landings};
 use support::replaced_once;
 
 /// (k_s factor, R factor) of the plants, as `sensorless_rates.rs`.
@@ -28,103 +32,187 @@ const MOTION_TIMES: [f64; 10] = [
     2e-3, 3e-3, 4e-3, 5e-3, 7e-3, 10e-3, 14e-3, 20e-3, 28e-3, 40e-3,
 ];
 
-/// The valve's design, which the recipe scales: τ = 7 ms, t₀ = 1 ms, T_s =
-/// 50 µs, 1 mm stroke, 24 V, 75 Ω, the core's κ = 60 A/m and μ0·M_sat·A_c.
-mod valve {
-    pub const TAU: f64 = 7e-3;
-    pub const TAKEOFF: f64 = 1e-3;
-    pub const SAMPLE_PERIOD: f64 = 50e-6;
-    pub const STROKE: f64 = 1e-3;
-    pub const SUPPLY: f64 = 24.0;
-    pub const RESISTANCE: f64 = 75.0;
-    pub const KAPPA: f64 = 60.0;
-    /// μ0·M_sat·A_c [Wb].
-    pub const FLUX: f64 = 4e-7 * std::f64::consts::PI * 1.0715e6 * 20e-6;
+/// The valve's design, which the recipe scales.
+const VALVE: &str = "tests/data/sensorless-ja-valve.toml";
+
+/// The valve's figures the recipe scales from (read from [`VALVE`]).
+struct Valve {
+    description: Description,
+    /// t_f − t₀, t₀ [s].
+    tau: f64,
+    takeoff: f64,
+    /// trajectory.u_bound / supply.u_max.
+    u_share: f64,
+    settling_time: f64,
+    creep_speed: f64,
+    stroke: f64,
+    /// The largest flux its references need [Wb] and the anhysteretic field
+    /// there [A/m].
+    operating_point: (f64, f64),
 }
 
-/// The filter's process noise per 50 µs (∝ T_s): w_Hc [A/m], and w_φ [Wb]
-/// for the valve's flux μ0·M_sat·A_c (∝ the device's).
+impl Valve {
+    fn get() -> &'static Valve {
+        static VALVE_FIGURES: OnceLock<Valve> = OnceLock::new();
+        VALVE_FIGURES.get_or_init(|| {
+            let path = reldesign_tests::root().join(VALVE);
+            let text = std::fs::read_to_string(&path).expect("the valve's design");
+            let d =
+                designer::description::parse_str(&text, VALVE).unwrap_or_else(|e| panic!("{e}"));
+            let t = d.trajectory.as_ref().expect("a [trajectory]");
+            let c = d.controller.as_ref().expect("a [controller]");
+            let Law::FeedbackLinearization(Gains::SettlingTime(settling_time)) = c.law else {
+                panic!("{VALVE}: feedback linearization with a settling time");
+            };
+            let k = d
+                .observer
+                .as_ref()
+                .and_then(|o| o.kalman.as_ref())
+                .expect("a filter");
+            assert_eq!(
+                (k.process_hc, k.process_phi),
+                (Some(VALVE_NOISE.hc), VALVE_NOISE.phi),
+                "VALVE_NOISE is {VALVE}'s"
+            );
+            Valve {
+                tau: t.landing - t.takeoff,
+                takeoff: t.takeoff,
+                u_share: t.u_bound / d.supply.u_max,
+                settling_time,
+                creep_speed: c.creep_speed.expect("a creep speed"),
+                stroke: d.mechanics.z_max - d.mechanics.z_min,
+                operating_point: operating_point(&d),
+                description: d,
+            }
+        })
+    }
+
+    fn sample_period(&self) -> f64 {
+        self.description
+            .controller
+            .as_ref()
+            .map_or(f64::NAN, |c| c.sample_period)
+    }
+
+    fn observer(&self) -> &designer::description::Observer {
+        self.description.observer.as_ref().expect("an [observer]")
+    }
+
+    fn kalman(&self) -> &designer::description::KalmanSection {
+        self.observer()
+            .kalman
+            .as_ref()
+            .expect("an [observer.kalman]")
+    }
+}
+
+/// The filter's process noise per sample of the valve: w_Hc [A/m] and w_φ
+/// [Wb], scaled to a device by `by`.
 #[derive(Debug, Clone, Copy)]
 struct FilterNoise {
     hc: f64,
     phi: f64,
-    at: Scale,
+    by: ScaleBy,
 }
 
-/// What the filter's flux and field noises scale with.
-#[derive(Debug, Clone, Copy)]
-enum Scale {
-    /// w_φ and the initial φ spread ∝ μ0·M_sat·A_c, w_Hc absolute, the
-    /// initial H_c spread ∝ κ.
+/// What scales the filter's flux and field noises (and initial spreads)
+/// from the valve to a device.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum ScaleBy {
+    /// The flux ones by the saturation flux μ0·M_sat·A_c; the field ones not.
     Saturation,
-    /// The device's operating point relative to the valve's: the largest
-    /// flux its references need, and the anhysteretic field there.
-    Operating(f64, f64),
+    /// The operating point: the largest flux the references need, and the
+    /// anhysteretic field there.
+    OperatingPoint,
 }
 
-/// The valve's own (tests/data/sensorless-ja-valve.toml).
+/// A device's flux and field relative to the valve's.
+#[derive(Debug, Clone, Copy)]
+struct Scales {
+    flux: f64,
+    field: f64,
+}
+
+/// The valve's own noises (w_Hc 15 A/m, w_φ 10 nWb per 50 µs).
 const VALVE_NOISE: FilterNoise = FilterNoise {
     hc: 15.0,
     phi: 1e-8,
-    at: Scale::Saturation,
+    by: ScaleBy::Saturation,
 };
 
 /// Chosen on the devices of [`TUNING_FAMILY`] (runs below 10× over 5 plants
-/// × 2 noise seeds, out of 300: the valve's 123; w_Hc 5 A/m: 123; w_φ /3:
-/// 94, ×3: 176; w_φ /10 with w_Hc 2 A/m: 70, with 12 A/m: 154; one flux
-/// substep, w_z /10, σ_Ṙ /5, 1.5× the settling time, the UKF's α /10 or the
-/// EKF: no better).
+/// × 2 noise seeds, out of 300, on an interim draw of the cores, μr 1000 on
+/// paths of 7–270 mm: the valve's
+/// 123; w_Hc 5 A/m: 123; w_φ /3: 94, ×3: 176; w_φ /10 with w_Hc 2 A/m: 70,
+/// with 12 A/m: 154; one flux substep, w_z /10, σ_Ṙ /5, 1.5× the settling
+/// time, the UKF's α /10 or the EKF: no better).
 const TUNED_NOISE: FilterNoise = FilterNoise {
     hc: 2.0,
     phi: 1e-9,
-    at: Scale::Saturation,
+    by: ScaleBy::Saturation,
 };
 
-/// The valve's noises scaled by the device's operating point rather than
-/// its saturation flux (the scale is filled in per device).
+/// The valve's noises scaled by the device's operating point.
 const OPERATING_NOISE: FilterNoise = FilterNoise {
-    hc: 15.0,
-    phi: 1e-8,
-    at: Scale::Operating(1.0, 1.0),
+    by: ScaleBy::OperatingPoint,
+    ..VALVE_NOISE
 };
 
 /// The family the filter's noises were chosen on, and one held out.
 const TUNING_FAMILY: u64 = 20261126;
 const HELD_OUT_FAMILY: u64 = 20261127;
 
-/// What a device's Jiles–Atherton core says: κ [A/m] and μ0·M_sat·A_c [Wb].
-fn core_scales(d: &Description) -> (f64, f64) {
+/// The Jiles–Atherton core of `d`.
+fn jiles_atherton(d: &Description) -> &designer::description::JilesAtherton {
     match &d.core {
-        designer::description::Core::JilesAtherton(ja) => {
-            (ja.kappa, 4e-7 * std::f64::consts::PI * ja.m_sat * ja.area)
-        }
-        other => panic!("not a Jiles–Atherton core: {other:?}"),
+        Core::JilesAtherton(ja) => ja,
+        other => panic!("{}: not a Jiles–Atherton core: {other:?}", d.name),
     }
 }
 
+/// The largest flux the references of the design `d` need [Wb] and the
+/// anhysteretic field of its core there [A/m].
+fn operating_point(d: &Description) -> (f64, f64) {
+    let design = Design::new(d).unwrap_or_else(|e| panic!("{}: {e}", d.name));
+    let flux = (design.controller.as_ref().expect("a controller").operations)
+        .iter()
+        .map(|o| o.feasibility.max_flux)
+        .fold(0.0, f64::max);
+    let ja = jiles_atherton(d);
+    (flux, anhysteretic_field(ja, flux / ja.area))
+}
+
 /// The valve's sensorless design scaled to `device` with the motion time
-/// `tau` (a bipolar driver of the device's supply; the reference within
-/// 20/24 of it, the rest the feedback's):
-/// - t₀: τ/7, or longer where the flux needs it to reach takeoff;
-/// - T_s = τ/140, at most 50 µs (the valve's samples per motion);
-/// - settling time 2.5/7·τ, creep speed 10 mm/s × (stroke/1 mm)·(7 ms/τ);
-/// - σ_v, σ_i: 15 mV and 1 mA scaled to the supply and the full-scale current;
-/// - the filter's noises scaled by the stroke, R and T_s; w_φ, w_Hc and the
-///   initial φ, H_c spreads from `noise`.
-fn sensorless_design(device: &Device, tau: f64, takeoff: f64, noise: FilterNoise) -> Description {
+/// `tau` (a bipolar driver of the device's supply; the reference within the
+/// valve's share of it, the rest the feedback's):
+/// - t₀ as given (the valve's share of τ, or longer where the flux needs it
+///   to reach takeoff);
+/// - T_s: the valve's samples per motion, at most the valve's period;
+/// - the settling time and the creep (per stroke) as the valve's per τ;
+/// - σ_v, σ_i: the valve's scaled to the supply and the full-scale current;
+/// - the filter's noises per sample ∝ T_s (the convention of
+///   `designer::closed_loop::resample_observer`), w_z and the initial z
+///   spread by the stroke, σ_Ṙ and the initial R spread by R, and w_φ, w_Hc
+///   and their initial spreads from `noise` at `scales`.
+fn sensorless_design(
+    device: &Device,
+    tau: f64,
+    takeoff: f64,
+    noise: FilterNoise,
+    scales: Scales,
+) -> Description {
+    let valve = Valve::get();
+    let (o, k) = (valve.observer(), valve.kalman());
     let nominal = device.description();
-    let (kappa, flux) = core_scales(&nominal);
-    let (flux, field) = match noise.at {
-        Scale::Saturation => (flux / valve::FLUX, 1.0),
-        Scale::Operating(flux, field) => (flux, field),
-    };
     let supply = device.supply;
     let r = nominal.coil.resistance;
-    let ts = (tau / valve::TAU * valve::SAMPLE_PERIOD).min(valve::SAMPLE_PERIOD);
-    let per_step = ts / valve::SAMPLE_PERIOD;
-    let stroke = device.stroke / valve::STROKE;
-    let kappa = kappa / valve::KAPPA;
-    let current = (supply / r) / (valve::SUPPLY / valve::RESISTANCE);
+    let ts = (tau / valve.tau * valve.sample_period()).min(valve.sample_period());
+    let per_step = ts / valve.sample_period();
+    let stroke = device.stroke / valve.stroke;
+    let current =
+        (supply / r) / (valve.description.supply.u_max / valve.description.coil.resistance);
+    let resistance = r / valve.description.coil.resistance;
+    let rate = k.resistance.expect("R estimated");
     let design = format!(
         "[trajectory]\noperations = [\"closing\", \"opening\"]\ntakeoff = {takeoff:e}\n\
          landing = {landing:e}\nshape = \"polynomial\"\nu_bound = {u_bound:e}\n\n\
@@ -133,29 +221,29 @@ fn sensorless_design(device: &Device, tau: f64, takeoff: f64, noise: FilterNoise
          estimator = \"ukf\"\ncompensate_resistance = true\n\n\
          [observer]\nestimators = [\"ukf\"]\nsample_period = {ts:e}\nfloat = [\"f64\"]\n\
          voltage_noise = {sv:e}\ncurrent_noise = {si:e}\n\n\
-         [observer.kalman]\nflux_step = \"exponential\"\nflux_substeps = 4\n\
+         [observer.kalman]\nflux_step = \"exponential\"\nflux_substeps = {substeps}\n\
          process_z = {qz:e}\nprocess_phi = {qphi:e}\nprocess_hc = {qhc:e}\n\
          initial_z_std = {z0:e}\ninitial_phi_std = {phi0:e}\ninitial_hc_std = {hc0:e}\n\
          estimate_resistance = true\nresistance_rate_std = {rdot:e}\n\
          initial_resistance_std = {r0:e}\n",
         landing = takeoff + tau,
-        u_bound = supply * 20.0 / 24.0,
-        settling = tau * 2.5 / 7.0,
-        creep = 10e-3 * stroke * valve::TAU / tau,
-        sv = 15e-3 * supply / valve::SUPPLY,
-        si = 1e-3 * current,
-        qz = 5e-9 * stroke * per_step,
-        qphi = noise.phi * flux * per_step,
-        qhc = noise.hc * field * per_step,
-        z0 = 1e-5 * stroke,
-        phi0 = 1e-7 * flux,
-        hc0 = 50.0
-            * match noise.at {
-                Scale::Saturation => kappa,
-                Scale::Operating(..) => field,
-            },
-        rdot = 10.0 * r / valve::RESISTANCE,
-        r0 = 0.1 * r,
+        u_bound = supply * valve.u_share,
+        settling = valve.settling_time * tau / valve.tau,
+        creep = valve.creep_speed * stroke * valve.tau / tau,
+        sv = o.voltage_noise * supply / valve.description.supply.u_max,
+        si = o.current_noise * current,
+        substeps = match k.flux_step {
+            designer::description::FluxStep::Exponential { substeps } => substeps,
+            other => panic!("{VALVE}: {other:?}"),
+        },
+        qz = k.process_z * stroke * per_step,
+        qphi = noise.phi * scales.flux * per_step,
+        qhc = noise.hc * scales.field * per_step,
+        z0 = k.initial_z_std * stroke,
+        phi0 = k.initial_phi_std * scales.flux,
+        hc0 = k.initial_hc_std.expect("an initial H_c spread") * scales.field,
+        rdot = rate.rate_std * resistance,
+        r0 = rate.initial_std * resistance,
     );
     let physics = replaced_once(
         &device.toml,
@@ -197,67 +285,38 @@ fn lift_off(d: &Description, u: f64, horizon: f64) -> Option<f64> {
         .find_map(|e| matches!(e.kind, EventKind::LiftOff { limit: Limit::Max }).then_some(e.t))
 }
 
-/// The largest flux the references of `d` need [Wb] and the anhysteretic
-/// field of its core there [A/m].
-fn operating_point(d: &Description) -> Option<(f64, f64)> {
-    let design = Design::new(d).ok()?;
-    let flux = design
-        .controller
-        .as_ref()?
-        .operations
-        .iter()
-        .map(|o| o.feasibility.max_flux)
-        .fold(0.0, f64::max);
-    let designer::description::Core::JilesAtherton(ja) = &d.core else {
-        return None;
-    };
-    Some((
-        flux,
-        designer::model::anhysteretic_field(ja, flux / ja.area),
-    ))
-}
-
-/// The valve's operating point (tests/data/sensorless-ja-valve.toml).
-fn valve_operating_point() -> (f64, f64) {
-    let path = reldesign_tests::root().join("tests/data/sensorless-ja-valve.toml");
-    let text = std::fs::read_to_string(&path).expect("the valve's design");
-    let d = designer::description::parse_str(&text, "sensorless-ja-valve.toml").expect("parses");
-    operating_point(&d).expect("the valve's design")
-}
-
-/// `noise` at `device`'s operating point with the design `d`, relative to
-/// the valve's `valve` (see [`Scale::Operating`]).
-fn at_operating_point(
-    noise: FilterNoise,
-    d: &Description,
-    valve: (f64, f64),
-) -> Option<FilterNoise> {
-    let (flux, field) = operating_point(d)?;
-    Some(FilterNoise {
-        at: Scale::Operating(flux / valve.0, field / valve.1),
-        ..noise
-    })
-}
-
 /// The shortest motion time of [`MOTION_TIMES`] whose design the designer
-/// accepts (the feasibility check at u_bound), and that design.
+/// accepts (the feasibility check at u_bound), and that design with the
+/// filter's `noise` scaled to the device.
 fn shortest_design(device: &Device, noise: FilterNoise) -> Option<(f64, Description)> {
+    let valve = Valve::get();
     let nominal = device.description();
-    let u_bound = device.supply * 20.0 / 24.0;
-    let reach = lift_off(&nominal, u_bound, 1.0)?;
+    let reach = lift_off(&nominal, device.supply * valve.u_share, 1.0)?;
+    let saturation = {
+        let flux = |d: &Description| MU0 * jiles_atherton(d).m_sat * jiles_atherton(d).area;
+        Scales {
+            flux: flux(&nominal) / flux(&valve.description),
+            field: 1.0,
+        }
+    };
     MOTION_TIMES.into_iter().find_map(|tau| {
-        let takeoff = (tau / valve::TAU * valve::TAKEOFF).max(1.5 * reach);
-        let d = sensorless_design(device, tau, takeoff, noise);
-        if !Design::new(&d).is_ok() {
+        let takeoff = (tau / valve.tau * valve.takeoff).max(1.5 * reach);
+        let d = sensorless_design(device, tau, takeoff, noise, saturation);
+        if Design::new(&d).is_err() {
             return None;
         }
-        match noise.at {
-            Scale::Saturation => Some((tau, d)),
-            Scale::Operating(..) => {
-                let noise = at_operating_point(noise, &d, valve_operating_point())?;
-                Some((tau, sensorless_design(device, tau, takeoff, noise)))
+        Some(match noise.by {
+            ScaleBy::Saturation => (tau, d),
+            ScaleBy::OperatingPoint => {
+                let ((flux, field), (valve_flux, valve_field)) =
+                    (operating_point(&d), valve.operating_point);
+                let scales = Scales {
+                    flux: flux / valve_flux,
+                    field: field / valve_field,
+                };
+                (tau, sensorless_design(device, tau, takeoff, noise, scales))
             }
-        }
+        })
     })
 }
 
@@ -279,6 +338,12 @@ fn options() -> Options {
 /// need.)
 fn perfectly_observed(d: &Description, plant: &Description) -> Description {
     let mut d = d.clone();
+    assert!(
+        d.trajectory
+            .as_ref()
+            .is_some_and(|t| t.shape == Shape::Polynomial),
+        "u_bound shapes an energy-optimal reference"
+    );
     if let Some(c) = &mut d.controller {
         c.estimator = None;
         c.compensate_resistance = false;
@@ -344,90 +409,107 @@ fn summary(rows: &[Option<Row>]) -> (usize, usize, usize) {
 }
 
 fn print_table(rows: &[Option<Row>]) {
-    println!("| device | class | gap | τ | T_s | perfectly observed × (worst) | closing × (worst–best) | opening × (worst–best) | runs < 10× | runs > 1 bounce |");
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    println!("| device | class | gap | τ | T_s | perfectly observed × (worst) | closing × (worst–best) | opening × (worst–best) | runs < 10× | unscored | runs > 1 bounce |");
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     for row in rows.iter().flatten() {
-        let (r, s) = (&row.sensorless, &row.perfect);
+        let (r, perfect) = (&row.sensorless, &row.perfect);
         println!(
-            "| {} | {:?} | {:?} | {:.0} ms | {:.0} µs | {:.0} / {:.0} | {:.1}–{:.0} | {:.1}–{:.0} | {} of {} | {} |",
+            "| {} | {:?} | {:?} | {:.0} ms | {:.0} µs | {:.0} / {:.0} | {:.1}–{:.0} | {:.1}–{:.0} | {} of {} | {} | {} |",
             row.device.name.trim_start_matches("device_"),
             row.device.class,
             row.device.gap,
             row.tau * 1e3,
             row.sample_period * 1e6,
-            s.worst[0],
-            s.worst[1],
+            perfect.worst[0],
+            perfect.worst[1],
             r.worst[0],
             r.best[0],
             r.worst[1],
             r.best[1],
             r.below_ten,
             r.runs,
+            r.unscored,
             r.bouncing,
         );
     }
     let (all, below, runs) = summary(rows);
     let devices = rows.iter().flatten().count();
+    let unscored = rows
+        .iter()
+        .flatten()
+        .filter(|r| r.sensorless.below_ten == 0 && r.sensorless.unscored > 0)
+        .count();
     println!(
-        "\n{all} of {devices} devices land every run ≥ 10×; {below} of {runs} runs below 10×\n"
+        "\n{all} of {devices} devices land every run ≥ 10× ({unscored} of them with unscored runs); {below} of {runs} runs below 10×\n"
     );
 }
 
-/// CI: device 7 of the tuning family (a small valve, fitted McLyman gap,
-/// τ = 14 ms) lands sensorless on its nominal plant, on one noise seed, ≥ 10×
-/// softer than switching for both operations (measured 109× and 25×; over
-/// the study's 5 plants × 5 seeds 47× and 14× at worst), and perfectly
-/// observed ≥ 100× and ≥ 10× (measured 1007× and 320×).
+/// CI: devices 3 (a relay, McLyman gap, τ = 7 ms) and 14 (a large valve,
+/// table gap, τ = 10 ms) of the tuning family land sensorless on their
+/// nominal plants, on one noise seed, ≥ 10× softer than switching for both
+/// operations with the valve's filter noises at their operating point
+/// (measured 45× / 25× and 149× / 19×; over the study's 5 plants × 5 seeds
+/// 11× / 1.5× and 11.5× / 1.6× at worst), and perfectly observed ≥ 100× and
+/// ≥ 10× (measured 595× / 259× and 697× / 405×).
 #[test]
-fn a_generated_valve_lands_sensorless_with_the_recipe() {
-    let device = device(TUNING_FAMILY, 7, true);
-    let (tau, d) = shortest_design(&device, TUNED_NOISE).expect("a feasible motion");
-    assert_eq!(tau, 14e-3);
-    let plant = &plants(&device)[0];
-    let r = landings(&d, std::slice::from_ref(plant), None, 0..1, &options());
-    eprintln!("sensorless: {r:?}");
-    assert!(r.worst[0] >= 10.0 && r.worst[1] >= 10.0, "{r:?}");
-    let p = perfectly_observed_landings(&d, std::slice::from_ref(plant));
-    eprintln!("perfectly observed: {p:?}");
-    assert!(p.worst[0] >= 100.0 && p.worst[1] >= 10.0, "{p:?}");
+fn generated_devices_land_sensorless_with_the_recipe() {
+    for (index, motion) in [(3, 7e-3), (14, 10e-3)] {
+        let device = device(TUNING_FAMILY, index, true);
+        let (tau, d) = shortest_design(&device, OPERATING_NOISE).expect("a feasible motion");
+        assert_eq!(tau, motion, "{}", device.name);
+        let plant = &plants(&device)[0];
+        let r = landings(&d, std::slice::from_ref(plant), None, 0..1, &options());
+        assert!(
+            r.worst[0] >= 10.0 && r.worst[1] >= 10.0,
+            "{}: {r:?}",
+            device.name
+        );
+        assert_eq!(r.unscored, 0, "{}: the switching lands", device.name);
+        let p = perfectly_observed_landings(&d, std::slice::from_ref(plant));
+        assert!(
+            p.worst[0] >= 100.0 && p.worst[1] >= 10.0,
+            "{}: {p:?}",
+            device.name
+        );
+    }
 }
 
 /// The tables of docs/validation/sensorless.md, "On devices nobody tuned it
-/// for": both families, the valve's and the tuned filter noises. The
-/// asserted counts are the measured ones (runs below 10× of 750), so that
-/// a change that makes it worse shows.
+/// for": both families; the valve's, the tuned, and the valve's filter
+/// noises at the operating point. The runs below 10× (of 750) are asserted
+/// as measured (the study is seeded), so that a change shows, either way.
 #[test]
-#[ignore = "the tables of docs/validation/sensorless.md: 4 min in release"]
+#[ignore = "the tables of docs/validation/sensorless.md: 3 min in release"]
 fn study_tables() {
     let cases = [
-        (TUNING_FAMILY, "tuning", VALVE_NOISE, "the valve's", 385),
-        (TUNING_FAMILY, "tuning", TUNED_NOISE, "tuned", 189),
+        (TUNING_FAMILY, "tuning", VALVE_NOISE, "the valve's"),
+        (TUNING_FAMILY, "tuning", TUNED_NOISE, "tuned"),
         (
             TUNING_FAMILY,
             "tuning",
             OPERATING_NOISE,
             "the valve's at the operating point",
-            750,
         ),
-        (HELD_OUT_FAMILY, "held out", VALVE_NOISE, "the valve's", 465),
-        (HELD_OUT_FAMILY, "held out", TUNED_NOISE, "tuned", 448),
+        (HELD_OUT_FAMILY, "held out", VALVE_NOISE, "the valve's"),
+        (HELD_OUT_FAMILY, "held out", TUNED_NOISE, "tuned"),
         (
             HELD_OUT_FAMILY,
             "held out",
             OPERATING_NOISE,
             "the valve's at the operating point",
-            750,
         ),
     ];
-    for (family, what, noise, name, measured) in cases {
+    let mut below = Vec::new();
+    for (family, what, noise, name) in cases {
         println!("family {family} ({what}), {name} filter noises {noise:?}:\n");
         let rows = study(family, 15, noise, 0..5);
         print_table(&rows);
-        let (_, below, runs) = summary(&rows);
+        let (_, misses, runs) = summary(&rows);
         assert_eq!(runs, 750);
-        assert!(
-            below <= measured,
-            "{below} runs below 10×, measured {measured}"
-        );
+        below.push(misses);
     }
+    assert_eq!(below, MEASURED, "runs below 10×");
 }
+
+/// The runs below 10× of [`study_tables`]' cases, measured 2026-11-26.
+const MEASURED: [usize; 6] = [296, 162, 223, 459, 453, 409];

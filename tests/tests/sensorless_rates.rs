@@ -27,8 +27,9 @@
 use designer::closed_loop::resample_observer;
 use designer::description::{parse_str, Description};
 use designer::sim::Options;
+use reldesign_tests::landings::{landings, Landings};
 use reldesign_tests::root;
-use reldesign_tests::sensorless::{landings, mismatched_plant, Landings};
+use reldesign_tests::sensorless::mismatched_plant;
 
 /// (k_s factor, R factor) of the plants.
 const PLANTS: [(f64, f64); 5] = [(1.0, 1.0), (1.1, 0.9), (0.9, 1.1), (1.1, 1.1), (0.9, 0.9)];
@@ -64,18 +65,22 @@ fn design(file: &str, estimator: &str, ts: f64) -> Description {
     d
 }
 
+/// The figures of `file`'s design at `ts` with `estimator`, over the plants
+/// and `seeds` (the switching of every plant lands: each run has its ratio).
 fn row(file: &str, estimator: &str, ts: f64, seeds: std::ops::Range<u64>) -> Landings {
     let plants: Vec<_> = PLANTS
         .iter()
         .map(|&(ks, r)| mismatched_plant(ks, r))
         .collect();
-    landings(
+    let r = landings(
         &design(file, estimator, ts),
         &plants,
         Some([15e-3, 1e-3]),
         seeds,
         &Options::default(),
-    )
+    );
+    assert_eq!(r.unscored, 0, "a plant's switching does not land: {r:?}");
+    r
 }
 
 /// CI, on the first noise seed: at 10 µs the saturating design's UKF lands
