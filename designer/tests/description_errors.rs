@@ -623,3 +623,57 @@ fn an_ekf_driven_soft_landing_is_warned_against() {
     assert!(w.contains("hovers") && w.contains("ukf"), "{w}");
     assert!(with("ukf").warnings.is_empty());
 }
+
+/// Feedback linearization whose gains would leave the armature more than
+/// 2 % of the stroke from its stop where the spring is 10 % off parses,
+/// with a warning at the gain's key that gives the steady error
+/// (k3/k1)·Δk_s·z/m and a settling time that keeps it within 2 %; the
+/// perfect-tracking valve itself (its spring soft against its gains:
+/// 1.2 µm at 1 ms) gets none.
+#[test]
+fn gains_too_slow_for_the_spring_are_warned_about() {
+    let text = example_text("perfect-tracking-valve.toml") + TRAJECTORY + CONTROLLER;
+    assert!(parse_str(&text, "design.toml").unwrap().warnings.is_empty());
+    // k_s ×40: (3/λ²)·0.1·2000 N/m·1 mm/2 g with λ = 6295.8/s: 7.6 µm; at
+    // a settling time of 2 ms, 30 µm
+    let stiff = support::replaced_once(&text, "stiffness = 50.0", "stiffness = 2000.0");
+    let stiff = support::replaced_once(&stiff, "settling_time = 1e-3", "settling_time = 2e-3");
+    let d = parse_str(&stiff, "design.toml").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(d.warnings.len(), 1, "{:?}", d.warnings);
+    let w = &d.warnings[0];
+    assert!(
+        w.starts_with("design.toml:") && w.contains("controller.settling_time"),
+        "{w}"
+    );
+    let lambda = designer::description::triple_pole_settling_product() / 2e-3;
+    let error = 3.0 / (lambda * lambda) * 0.1 * 2000.0 * 1e-3 / 2e-3;
+    assert!((error - 3.03e-5).abs() < 1e-7, "{error}");
+    assert!(
+        w.contains(&format!("{error:.3e} m")) && w.contains("z_max"),
+        "{w}"
+    );
+    // within 2 % of the 1 mm stroke at t_s·√(20 µm / e)
+    let needed = 2e-3 * (2e-5 / error).sqrt();
+    assert!(w.contains(&format!("{needed:.3e} s")), "{w}");
+    let at_needed = support::replaced_once(
+        &stiff,
+        "settling_time = 2e-3",
+        &format!("settling_time = {:e}", 0.99 * needed),
+    );
+    assert!(parse_str(&at_needed, "design.toml")
+        .unwrap()
+        .warnings
+        .is_empty());
+    // the same with poles: the warning names `poles`
+    let poles = support::replaced_once(
+        &stiff,
+        "settling_time = 2e-3",
+        "poles = [-3000.0, -3000.0, -3000.0]",
+    );
+    let d = parse_str(&poles, "design.toml").unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        d.warnings.iter().any(|w| w.contains("controller.poles")),
+        "{:?}",
+        d.warnings
+    );
+}

@@ -376,6 +376,8 @@ struct Row {
     sample_period: f64,
     sensorless: Landings,
     perfect: Landings,
+    /// The description warns that a spring mismatch leaves a steady error.
+    warned: bool,
 }
 
 /// Devices 0..n of `family` with the recipe at `noise`, on the device's
@@ -392,6 +394,7 @@ fn study(family: u64, n: u64, noise: FilterNoise, noise_seeds: Range<u64>) -> Ve
                 sample_period: d.controller.as_ref()?.sample_period,
                 sensorless: landings(&d, &plants, None, noise_seeds.clone(), &options()),
                 perfect: perfectly_observed_landings(&d, &plants),
+                warned: d.warnings.iter().any(|w| w.contains("mechanics.stiffness")),
                 device,
             })
         })
@@ -409,12 +412,12 @@ fn summary(rows: &[Option<Row>]) -> (usize, usize, usize) {
 }
 
 fn print_table(rows: &[Option<Row>]) {
-    println!("| device | class | gap | τ | T_s | perfectly observed × (worst) | closing × (worst–best) | opening × (worst–best) | runs < 10× | unscored | runs > 1 bounce |");
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    println!("| device | class | gap | τ | T_s | perfectly observed × (worst) | closing × (worst–best) | opening × (worst–best) | runs < 10× | unscored | runs > 1 bounce | spring warning |");
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     for row in rows.iter().flatten() {
         let (r, perfect) = (&row.sensorless, &row.perfect);
         println!(
-            "| {} | {:?} | {:?} | {:.0} ms | {:.0} µs | {:.0} / {:.0} | {:.1}–{:.0} | {:.1}–{:.0} | {} of {} | {} | {} |",
+            "| {} | {:?} | {:?} | {:.0} ms | {:.0} µs | {:.0} / {:.0} | {:.1}–{:.0} | {:.1}–{:.0} | {} of {} | {} | {} | {} |",
             row.device.name.trim_start_matches("device_"),
             row.device.class,
             row.device.gap,
@@ -430,6 +433,7 @@ fn print_table(rows: &[Option<Row>]) {
             r.runs,
             r.unscored,
             r.bouncing,
+            if row.warned { "yes" } else { "–" },
         );
     }
     let (all, below, runs) = summary(rows);

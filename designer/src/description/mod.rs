@@ -6,11 +6,13 @@
 //! Everything downstream (model, simulator, designers) reads only these types.
 
 mod error;
+mod gains;
 pub mod params;
 mod parse;
 pub mod schema;
 
 pub use error::DescriptionError;
+pub use gains::triple_pole_settling_product;
 pub use parse::{parse_file, parse_str};
 
 /// A whole, validated actuator description. All quantities SI.

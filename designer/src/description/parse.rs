@@ -79,6 +79,8 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
         checks::check_estimator(s, c, observer.as_ref())?;
         checks::check_compensation(s, c, observer.as_ref(), supply.drive)?;
         warnings.extend(checks::estimator_warning(s, c).map(|w| w.to_string()));
+        let spring = checks::spring_warning(s, c, trajectory.as_ref(), &mechanics);
+        warnings.extend(spring.map(|w| w.to_string()));
     }
     let source = Source {
         file_name: file_name.to_string(),

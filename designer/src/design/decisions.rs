@@ -13,9 +13,6 @@ use super::optimal::OptimalTrajectory;
 use super::plan::PlanError;
 use super::segments::Segments;
 
-/// 5 % settling-time criterion of a triple real pole.
-const SETTLING_FRACTION: f64 = 0.05;
-
 /// Fraction of the smallest reference flux below which the law is not
 /// evaluated (before rounding down to one significant digit).
 const GUARD_FRACTION: f64 = 1e-3;
@@ -33,43 +30,12 @@ const CREEP_MAX_FRACTION: f64 = 0.05;
 /// Reference samples per segment when searching the smallest flux.
 const FLUX_SAMPLES: usize = 64;
 
-/// λ·t_s of a triple real pole −λ with 5 % settling time t_s: the root of
-/// e^{−x}(1 + x + x²/2) = 0.05 (≈ 6.2958).
-pub fn triple_pole_settling_product() -> f64 {
-    // The residual decreases strictly for x > 0: bisection on [0, 50].
-    let residual = |x: f64| (-x).exp() * (1.0 + x + 0.5 * x * x) - SETTLING_FRACTION;
-    let (mut lo, mut hi) = (0.0_f64, 50.0_f64);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if residual(mid) > 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
+/// K = [k1, k2, k3] of [PT 48] (see [`Gains::k`]).
+pub fn gains(g: &Gains) -> [f64; 3] {
+    g.k()
 }
 
-/// K = [k1, k2, k3] of [PT 48]: the error dynamics [PT 49] ξ̃' = (A − BK)ξ̃ of the
-/// triple integrator have the characteristic polynomial
-/// s³ + k3·s² + k2·s + k1 = Π(s − p_i).
-///
-/// A settling time t_s places a triple pole at −λ, λ = 6.2958…/t_s (5 %
-/// criterion), so K = [λ³, 3λ², 3λ].
-pub fn gains(g: &Gains) -> [f64; 3] {
-    let [p1, p2, p3] = match *g {
-        Gains::SettlingTime(ts) => {
-            let lambda = triple_pole_settling_product() / ts;
-            [-lambda; 3]
-        }
-        Gains::Poles(p) => p,
-    };
-    [
-        -(p1 * p2 * p3),
-        p1 * p2 + p1 * p3 + p2 * p3,
-        -(p1 + p2 + p3),
-    ]
-}
+pub use crate::description::triple_pole_settling_product;
 
 /// One designed operation: its reference, feasibility and table.
 #[derive(Debug, Clone)]

@@ -1,11 +1,12 @@
 //! The rules between sections, checked once both sides are read: the gap
 //! over the stroke, the drive against the coil, the trajectory's input
 //! against the supply, the controller against its trajectory and core, and
-//! the controller's estimator against `[observer]`.
+//! the controller's estimator against `[observer]`; and one warning: the
+//! tracking law's steady error where the spring differs from the description.
 
 use super::sect::{Res, Sect};
 use crate::description::{
-    BacksteppingKeys, Law, ModelSurface, SetPoint, Shape, Supply, Trajectory,
+    BacksteppingKeys, Gains, Law, ModelSurface, Operation, SetPoint, Shape, Supply, Trajectory,
 };
 use crate::description::{Coil, Controller, Core, Drive, Estimator, Gap, Mechanics, Observer};
 
@@ -260,6 +261,87 @@ fn check_set_point(
 
 /// `controller.estimator = "ekf"` on a soft-landing law: accepted (the
 /// emitted code has both filters), with the evidence against it.
+/// The stiffness error the spring warning assumes (the sensorless studies'
+/// plants: ±10 % on k_s).
+pub const STIFFNESS_ERROR: f64 = 0.1;
+/// The steady error, as a fraction of the stroke, above which it warns: on
+/// the 30 generated devices of tests/tests/sensorless_devices.rs the
+/// perfectly observed loop opened ≥ 10× softer than switching on every
+/// device below 2.2 % and below 10× on 8 of the 10 above 2.3 % (the others
+/// 10.7× and one whose switching never lands).
+pub const STEADY_ERROR_FRACTION: f64 = 0.02;
+
+/// `[controller]` feedback linearization whose gains leave the armature
+/// far from its stop at rest where the spring differs from the description
+/// by [`STIFFNESS_ERROR`]: the law's model then misses the acceleration by
+/// Δk_s·z/m at the stop z, and the gains K turn that into a steady position
+/// error (k3/k1)·Δk_s·z/m ([`Gains::position_per_acceleration`]). The creep
+/// after t_f has to close it (and cannot beyond its 5 % of the stroke);
+/// above [`STEADY_ERROR_FRACTION`] of the stroke the armature hovers short of
+/// the stop or lands hard. On four generated devices of tests/tests/sensorless_devices.rs
+/// the formula gives 25–155 µm where the perfectly observed loop stood
+/// 21–127 µm short of z_max at t_f on the plant with k_s ×1.1.
+///
+/// [`Gains::position_per_acceleration`]: crate::description::Gains::position_per_acceleration
+pub(super) fn spring_warning(
+    s: &Sect,
+    c: &Controller,
+    trajectory: Option<&Trajectory>,
+    m: &Mechanics,
+) -> Option<crate::description::DescriptionError> {
+    let Law::FeedbackLinearization(gains) = c.law else {
+        return None;
+    };
+    let stroke = m.z_max - m.z_min;
+    let ends = trajectory.map_or(&[Operation::Closing, Operation::Opening][..], |t| {
+        &t.operations[..]
+    });
+    let (error, stop, name) = ends
+        .iter()
+        .map(|op| match op {
+            Operation::Closing => (m.z_min, "z_min"),
+            Operation::Opening => (m.z_max, "z_max"),
+        })
+        .map(|(z, name)| {
+            let per_acceleration = gains.position_per_acceleration().abs();
+            (
+                per_acceleration * STIFFNESS_ERROR * m.stiffness * z.abs() / m.mass,
+                z,
+                name,
+            )
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0))?;
+    if !(error > STEADY_ERROR_FRACTION * stroke) {
+        return None;
+    }
+    let (key, faster) = match gains {
+        Gains::SettlingTime(ts) => (
+            "settling_time",
+            format!(
+                "a settling time ≤ {:.3e} s keeps it within {} % of the stroke",
+                ts * (STEADY_ERROR_FRACTION * stroke / error).sqrt(),
+                STEADY_ERROR_FRACTION * 100.0
+            ),
+        ),
+        Gains::Poles(_) => (
+            "poles",
+            "faster poles make it smaller (∝ k3/k1)".to_string(),
+        ),
+    };
+    let msg = format!(
+        "a {} % error in mechanics.stiffness leaves the armature about {:.3e} m ({:.1} % of \
+         the stroke) from {name} = {stop:e} m at rest: the gains' steady error \
+         (k3/k1)·Δk_s·z/m of [PT 48]; the creep after t_f must close it (up to 5 % of the \
+         stroke), so the armature may hover short of the stop. {faster}; a faster loop \
+         amplifies a sensorless observer's noise (docs/validation/sensorless.md, \
+         \"On devices nobody tuned it for\")",
+        STIFFNESS_ERROR * 100.0,
+        error,
+        100.0 * error / stroke,
+    );
+    Some(s.err(key, msg, "a spring mismatch leaves a steady error"))
+}
+
 pub(super) fn estimator_warning(
     s: &Sect,
     c: &Controller,
