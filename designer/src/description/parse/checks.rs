@@ -311,6 +311,7 @@ pub(super) fn spring_warning(
             )
         })
         .max_by(|a, b| a.0.total_cmp(&b.0))?;
+    // (a NaN error: no warning)
     if !(error > STEADY_ERROR_FRACTION * stroke) {
         return None;
     }
