@@ -259,15 +259,13 @@ fn check_set_point(
     Ok(())
 }
 
-/// `controller.estimator = "ekf"` on a soft-landing law: accepted (the
-/// emitted code has both filters), with the evidence against it.
 /// The stiffness error the spring warning assumes (the sensorless studies'
 /// plants: ±10 % on k_s).
 pub const STIFFNESS_ERROR: f64 = 0.1;
 /// The steady error, as a fraction of the stroke, above which it warns: on
 /// the 30 generated devices of tests/tests/sensorless_devices.rs the
 /// perfectly observed loop opened ≥ 10× softer than switching on every
-/// device below 2.2 % and below 10× on 8 of the 10 above 2.3 % (the others
+/// device up to 2.2 % and below 10× on 8 of the 10 above 2.3 % (the others
 /// 10.7× and one whose switching never lands).
 pub const STEADY_ERROR_FRACTION: f64 = 0.02;
 
@@ -343,6 +341,8 @@ pub(super) fn spring_warning(
     Some(s.err(key, msg, "a spring mismatch leaves a steady error"))
 }
 
+/// `controller.estimator = "ekf"` on a soft-landing law: accepted (the
+/// emitted code has both filters), with the evidence against it.
 pub(super) fn estimator_warning(
     s: &Sect,
     c: &Controller,
