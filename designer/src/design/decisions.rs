@@ -4,6 +4,7 @@
 //! (perfect-tracking-soft-landing [PT §3.2] and [PT §4]). Code generation only renders
 //! a [`ControllerDesign`]; the runtime's `control` module applies it.
 
+pub use crate::description::triple_pole_settling_product;
 use crate::description::{Gains, Operation};
 use crate::model::Model;
 
@@ -34,8 +35,6 @@ const FLUX_SAMPLES: usize = 64;
 pub fn gains(g: &Gains) -> [f64; 3] {
     g.k()
 }
-
-pub use crate::description::triple_pole_settling_product;
 
 /// One designed operation: its reference, feasibility and table.
 #[derive(Debug, Clone)]
