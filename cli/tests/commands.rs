@@ -106,6 +106,33 @@ fn has_field_state(d: &Description) -> bool {
 // check
 // ---------------------------------------------------------------------------
 
+/// A description the parser accepts but warns about passes `check` (exit 0,
+/// the summary on stdout) with the warning on stderr, naming the file and
+/// the key: here feedback linearization too slow for a stiffened spring.
+#[test]
+fn check_prints_warnings_on_stderr_and_succeeds() {
+    let text = std::fs::read_to_string(example_path("perfect-tracking-valve.toml")).unwrap();
+    // k_s ×160 at the example's 1 ms settling time: (3/λ²)·0.1·k_s·z_max/m = 30 µm
+    let text = support::replaced_once(&text, "stiffness = 50.0", "stiffness = 8000.0");
+    let dir = TempDir::new("check-warning");
+    let path = dir.write("stiff-valve.toml", text);
+    let run = rd!("check", &path);
+    let out = run.ok();
+    let ctx = run.context();
+    assert!(out.contains("valid actuator description"), "{ctx}");
+    let warning = run
+        .stderr
+        .lines()
+        .find(|l| l.starts_with("warning: "))
+        .unwrap_or_else(|| panic!("no warning\n{ctx}"));
+    assert!(
+        warning.contains("stiff-valve.toml:")
+            && warning.contains("controller.settling_time")
+            && warning.contains("mechanics.stiffness"),
+        "{ctx}"
+    );
+}
+
 #[test]
 fn check_summarises_every_example_deterministically() {
     for path in example_paths() {
