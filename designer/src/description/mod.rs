@@ -12,7 +12,7 @@ mod parse;
 pub mod schema;
 
 pub use error::DescriptionError;
-pub use gains::triple_pole_settling_product;
+pub use gains::{settling_time_within, triple_pole_settling_product};
 pub use parse::{parse_file, parse_str};
 
 /// A whole, validated actuator description. All quantities SI.
