@@ -81,6 +81,20 @@ impl Device {
     }
 }
 
+/// When the armature of `d`, held at `u` from rest at z_max without flux,
+/// leaves z_max (within `horizon` [s]): the shortest pre-movement a device
+/// study can give it.
+pub fn lift_off(d: &Description, u: f64, horizon: f64) -> Option<f64> {
+    use designer::sim::{EventKind, Limit, Options};
+    let mut model = designer::model::Model::build(d);
+    let run =
+        designer::replay::replay(&mut model, &u, &[0.0, horizon], &Options::default()).ok()?;
+    run.trajectory
+        .events
+        .iter()
+        .find_map(|e| matches!(e.kind, EventKind::LiftOff { limit: Limit::Max }).then_some(e.t))
+}
+
 const GAPS: [GapKind; 5] = [
     GapKind::Linear,
     GapKind::McLyman,

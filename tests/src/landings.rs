@@ -47,6 +47,15 @@ impl Landings {
         }
     }
 
+    /// The table cells "closing × (worst–best) | opening × (worst–best) |
+    /// runs < 10×" of the sensorless studies' tables.
+    pub fn softness_cells(&self) -> String {
+        format!(
+            "{:.1}–{:.0} | {:.1}–{:.0} | {} of {}",
+            self.worst[0], self.best[0], self.worst[1], self.best[1], self.below_ten, self.runs
+        )
+    }
+
     /// The figures over the runs of both.
     pub fn merged(self, other: Landings) -> Landings {
         Landings {

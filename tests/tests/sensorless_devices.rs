@@ -20,7 +20,7 @@ use designer::description::{Core, Description, Gains, Law, Shape};
 use designer::design::Design;
 use designer::model::{anhysteretic_field, MU0};
 use designer::sim::Options;
-use reldesign_tests::devices::{device, Device};
+use reldesign_tests::devices::{device, lift_off, Device};
 use reldesign_tests::landings::{landings, Landings};
 use support::replaced_once;
 
@@ -81,7 +81,9 @@ impl Valve {
                 settling_time,
                 creep_speed: c.creep_speed.expect("a creep speed"),
                 stroke: d.mechanics.z_max - d.mechanics.z_min,
-                operating_point: operating_point(&d),
+                operating_point: operating_point(
+                    &Design::new(&d).unwrap_or_else(|e| panic!("{VALVE}: {e}")),
+                ),
                 description: d,
             }
         })
@@ -170,15 +172,14 @@ fn jiles_atherton(d: &Description) -> &designer::description::JilesAtherton {
     }
 }
 
-/// The largest flux the references of the design `d` need [Wb] and the
+/// The largest flux the references of `design` need [Wb] and the
 /// anhysteretic field of its core there [A/m].
-fn operating_point(d: &Description) -> (f64, f64) {
-    let design = Design::new(d).unwrap_or_else(|e| panic!("{}: {e}", d.name));
+fn operating_point(design: &Design) -> (f64, f64) {
     let flux = (design.controller.as_ref().expect("a controller").operations)
         .iter()
         .map(|o| o.feasibility.max_flux)
         .fold(0.0, f64::max);
-    let ja = jiles_atherton(d);
+    let ja = jiles_atherton(&design.description);
     (flux, anhysteretic_field(ja, flux / ja.area))
 }
 
@@ -272,19 +273,6 @@ fn plants(device: &Device) -> Vec<Description> {
         .collect()
 }
 
-/// When the armature, held at `u` from rest at z_max without flux, leaves
-/// z_max (within `horizon`).
-fn lift_off(d: &Description, u: f64, horizon: f64) -> Option<f64> {
-    use designer::sim::{EventKind, Limit};
-    let mut model = designer::model::Model::build(d);
-    let run =
-        designer::replay::replay(&mut model, &u, &[0.0, horizon], &Options::default()).ok()?;
-    run.trajectory
-        .events
-        .iter()
-        .find_map(|e| matches!(e.kind, EventKind::LiftOff { limit: Limit::Max }).then_some(e.t))
-}
-
 /// The shortest motion time of [`MOTION_TIMES`] whose design the designer
 /// accepts (the feasibility check at u_bound), and that design with the
 /// filter's `noise` scaled to the device.
@@ -302,14 +290,12 @@ fn shortest_design(device: &Device, noise: FilterNoise) -> Option<(f64, Descript
     MOTION_TIMES.into_iter().find_map(|tau| {
         let takeoff = (tau / valve.tau * valve.takeoff).max(1.5 * reach);
         let d = sensorless_design(device, tau, takeoff, noise, saturation);
-        if Design::new(&d).is_err() {
-            return None;
-        }
+        let design = Design::new(&d).ok()?;
         Some(match noise.by {
             ScaleBy::Saturation => (tau, d),
             ScaleBy::OperatingPoint => {
                 let ((flux, field), (valve_flux, valve_field)) =
-                    (operating_point(&d), valve.operating_point);
+                    (operating_point(&design), valve.operating_point);
                 let scales = Scales {
                     flux: flux / valve_flux,
                     field: field / valve_field,
@@ -417,7 +403,7 @@ fn print_table(rows: &[Option<Row>]) {
     for row in rows.iter().flatten() {
         let (r, perfect) = (&row.sensorless, &row.perfect);
         println!(
-            "| {} | {:?} | {:?} | {:.0} ms | {:.0} µs | {:.0} / {:.0} | {:.1}–{:.0} | {:.1}–{:.0} | {} of {} | {} | {} | {} |",
+            "| {} | {:?} | {:?} | {:.0} ms | {:.0} µs | {:.0} / {:.0} | {} | {} | {} | {} |",
             row.device.name.trim_start_matches("device_"),
             row.device.class,
             row.device.gap,
@@ -425,12 +411,7 @@ fn print_table(rows: &[Option<Row>]) {
             row.sample_period * 1e6,
             perfect.worst[0],
             perfect.worst[1],
-            r.worst[0],
-            r.best[0],
-            r.worst[1],
-            r.best[1],
-            r.below_ten,
-            r.runs,
+            r.softness_cells(),
             r.unscored,
             r.bouncing,
             if row.warned { "yes" } else { "–" },
@@ -485,26 +466,17 @@ fn generated_devices_land_sensorless_with_the_recipe() {
 #[test]
 #[ignore = "the tables of docs/validation/sensorless.md: 3 min in release"]
 fn study_tables() {
-    let cases = [
-        (TUNING_FAMILY, "tuning", VALVE_NOISE, "the valve's"),
-        (TUNING_FAMILY, "tuning", TUNED_NOISE, "tuned"),
-        (
-            TUNING_FAMILY,
-            "tuning",
-            OPERATING_NOISE,
-            "the valve's at the operating point",
-        ),
-        (HELD_OUT_FAMILY, "held out", VALVE_NOISE, "the valve's"),
-        (HELD_OUT_FAMILY, "held out", TUNED_NOISE, "tuned"),
-        (
-            HELD_OUT_FAMILY,
-            "held out",
-            OPERATING_NOISE,
-            "the valve's at the operating point",
-        ),
+    let families = [(TUNING_FAMILY, "tuning"), (HELD_OUT_FAMILY, "held out")];
+    let noises = [
+        (VALVE_NOISE, "the valve's"),
+        (TUNED_NOISE, "tuned"),
+        (OPERATING_NOISE, "the valve's at the operating point"),
     ];
+    let cases = families
+        .into_iter()
+        .flat_map(|f| noises.into_iter().map(move |n| (f, n)));
     let mut below = Vec::new();
-    for (family, what, noise, name) in cases {
+    for ((family, what), (noise, name)) in cases {
         println!("family {family} ({what}), {name} filter noises {noise:?}:\n");
         let rows = study(family, 15, noise, 0..5);
         print_table(&rows);

@@ -119,15 +119,10 @@ fn table_against_the_sample_period() {
             for estimator in ["ukf", "ekf"] {
                 let r = row(file, estimator, ts, 0..5);
                 println!(
-                    "| {name} | {} µs | {} | {:.1}–{:.0} | {:.1}–{:.0} | {} of {} | {} | {} | {:.1} |",
+                    "| {name} | {} µs | {} | {} | {} | {} | {:.1} |",
                     ts * 1e6,
                     estimator.to_uppercase(),
-                    r.worst[0],
-                    r.best[0],
-                    r.worst[1],
-                    r.best[1],
-                    r.below_ten,
-                    r.runs,
+                    r.softness_cells(),
                     r.bounces,
                     r.bouncing,
                     r.highest * 1e6

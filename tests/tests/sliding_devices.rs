@@ -15,7 +15,7 @@ use designer::closed_loop::{run_loop, switching_baseline};
 use designer::description::Description;
 use designer::design::{Analysis, Design, ErrorBounds};
 use designer::sim::Options;
-use reldesign_tests::devices::devices;
+use reldesign_tests::devices::{devices, lift_off};
 
 /// The device with the paper's design scaled to the motion time `tau`, the
 /// motion starting at `takeoff`.
@@ -60,19 +60,6 @@ fn with_supply(mut d: Description, u: f64) -> Description {
         t.u_bound = u;
     }
     d
-}
-
-/// When the armature, held at `u` from rest at z_max without flux, leaves
-/// z_max (within `horizon`).
-fn lift_off(d: &Description, u: f64, horizon: f64) -> Option<f64> {
-    use designer::sim::{EventKind, Limit};
-    let mut model = designer::model::Model::build(d);
-    let run =
-        designer::replay::replay(&mut model, &u, &[0.0, horizon], &Options::default()).ok()?;
-    run.trajectory
-        .events
-        .iter()
-        .find_map(|e| matches!(e.kind, EventKind::LiftOff { limit: Limit::Max }).then_some(e.t))
 }
 
 /// At T_s = τ/4000 (the paper's "almost perfect" rate relative to its
