@@ -671,9 +671,10 @@ impl LoopRun {
 
     /// [`OperationOutcome::highest_bounce`] of `operation` within (from, to].
     fn highest_bounce(&self, operation: Operation, from: f64, to: f64) -> f64 {
-        let (destination, stop) = match operation {
-            Operation::Closing => (Limit::Min, self.stops[0]),
-            Operation::Opening => (Limit::Max, self.stops[1]),
+        let destination = destination(operation);
+        let stop = match destination {
+            Limit::Min => self.stops[0],
+            Limit::Max => self.stops[1],
         };
         highest_bounce(&self.trajectory, destination, stop, from, to)
     }
@@ -717,13 +718,18 @@ pub(crate) fn end_stops(description: &Description) -> [f64; 2] {
     [description.mechanics.z_min, description.mechanics.z_max]
 }
 
+/// The end stop `operation` lands on.
+fn destination(operation: Operation) -> Limit {
+    match operation {
+        Operation::Closing => Limit::Min,
+        Operation::Opening => Limit::Max,
+    }
+}
+
 /// The first impact's velocity at `operation`'s end stop in (from, to], and
 /// the number of bouncing impacts there.
 fn impacts(tr: &Trajectory, operation: Operation, from: f64, to: f64) -> (Option<f64>, usize) {
-    let destination = match operation {
-        Operation::Closing => Limit::Min,
-        Operation::Opening => Limit::Max,
-    };
+    let destination = destination(operation);
     let mut first = None;
     let mut bounces = 0;
     for e in tr.events.iter().filter(|e| e.t > from && e.t <= to) {
