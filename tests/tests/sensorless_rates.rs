@@ -22,11 +22,13 @@
 //! ```
 //!
 //! CI runs the 10 µs UKF row of the first design and the 50 µs row of the
-//! second on one seed.
+//! second on one seed. `observer_lags_the_armature_at_the_stops` (ignored)
+//! measures what limits the landing speed: the filter's lag at the stops on
+//! the design's own model without noise.
 
 use designer::closed_loop::resample_observer;
-use designer::description::{parse_str, Description};
-use designer::sim::Options;
+use designer::description::{parse_str, Description, Operation};
+use designer::sim::{EventKind, Limit, Options};
 use reldesign_tests::landings::{landings, Landings};
 use reldesign_tests::root;
 use reldesign_tests::sensorless::mismatched_plant;
@@ -148,4 +150,62 @@ fn ja_design_at_50_us_on_held_out_seeds() {
         r.worst[0], r.worst[1], r.below_ten, r.runs
     );
     assert!(r.below_ten <= 9, "{r:?}");
+}
+
+/// The observer at the stops, without any mismatch: the Jiles–Atherton
+/// design at 50 µs on its own model (the reversal rule "reversible", the
+/// design's k_s and R) with no measurement noise, so that what remains is
+/// the filter itself. At the first impact of each operation the estimate
+/// lags the armature: measured 4.6 µm and 11 mm/s at the closing
+/// (impact at 19.7 mm/s, 70× softer than switching), 15 µm and 11 mm/s at
+/// the opening (39.5 mm/s, 19×). The law tracks the estimate, so the
+/// armature runs ahead of the reference by that lag and lands at about the
+/// reference's speed that far from the stop. docs/validation/sensorless.md,
+/// "What keeps the landings above 2 mm/s".
+#[test]
+#[ignore = "a characterisation of the observer: 0.1 s in release"]
+fn observer_lags_the_armature_at_the_stops() {
+    let d = design(JILES_ATHERTON, "ukf", 50e-6);
+    let design = designer::design::Design::new(&d).unwrap();
+    let quiet = designer::closed_loop::Noise {
+        seed: 0,
+        sigma: Some([0.0, 0.0]),
+    };
+    let run =
+        designer::closed_loop::run_loop(&design, None, 50e-6, None, quiet, &Options::default())
+            .unwrap();
+    let estimates = run.estimates.as_ref().expect("an observer drives the law");
+    let t = d.trajectory.as_ref().unwrap();
+    for &(operation, start) in &run.operations {
+        // the stop the operation lands on, and the direction towards it
+        let (stop, towards) = match operation {
+            Operation::Closing => (Limit::Min, -1.0),
+            Operation::Opening => (Limit::Max, 1.0),
+        };
+        let (at, v_before) = run
+            .trajectory
+            .events
+            .iter()
+            .filter(|e| e.t > start + t.takeoff)
+            .find_map(|e| match e.kind {
+                EventKind::Impact {
+                    limit, v_before, ..
+                } if limit == stop => Some((e.t, v_before)),
+                _ => None,
+            })
+            .expect("the armature lands");
+        // the last sample before the impact
+        let i = run.trajectory.t.partition_point(|&s| s < at) - 1;
+        let (x, e) = (run.trajectory.x[i], estimates[i]);
+        let lag = [(x[0] - e.z) * towards, (x[1] - e.v) * towards];
+        println!(
+            "{operation:?}: impact {:.1} mm/s at {:+.2} ms from t_f; the estimate {:.2} µm and {:.1} mm/s behind",
+            v_before.abs() * 1e3,
+            (at - start - t.landing) * 1e3,
+            lag[0] * 1e6,
+            lag[1] * 1e3
+        );
+        assert!(lag[0] > 1e-6 && lag[1] > 5e-3, "{operation:?}: {lag:?}");
+        assert!(v_before.abs() > 10e-3, "{operation:?}: {v_before}");
+    }
 }
