@@ -81,6 +81,10 @@ pub struct FitOptions {
     /// Stops the fit before its next trial step once raised (its report
     /// then has the status [`lm::Status::Stopped`]).
     pub stop: Option<lm::Stop>,
+    /// Gives each start up that is still above a cost after some
+    /// iterations ([`lm::GiveUp`], in the solver's ½‖r‖²: half the report's
+    /// `cost`).
+    pub give_up: Option<lm::GiveUp>,
 }
 
 /// How the fit's Jacobian is computed.
@@ -107,6 +111,7 @@ impl Default for FitOptions {
             max_steps_per_sample: 200,
             sensitivities: Sensitivities::Analytic,
             stop: None,
+            give_up: None,
         }
     }
 }
@@ -527,6 +532,7 @@ pub fn fit(
         ftol: options.ftol,
         fd_step: options.fd_step,
         stop: options.stop.clone(),
+        give_up: options.give_up,
         ..lm::Options::default()
     };
     let starts = options.starts.max(1);

@@ -48,6 +48,27 @@ pub struct Options {
     /// Stops the solver before its next trial step once raised (from
     /// another thread: a start whose result is no longer needed).
     pub stop: Option<Stop>,
+    /// Gives up a start that is still far above a cost known to be
+    /// reachable ([`Status::GaveUp`]).
+    pub give_up: Option<GiveUp>,
+}
+
+/// After `after` accepted iterations, a cost (½‖r‖²) above `above` ends
+/// the minimisation ([`Status::GaveUp`]): a start that cannot come near a
+/// fit found elsewhere is not worth its remaining iterations.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GiveUp {
+    pub after: usize,
+    pub above: f64,
+}
+
+impl GiveUp {
+    /// Whether a cost of `cost` after `iterations` accepted iterations gives up
+    /// (a NaN cost does).
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // deliberate: NaN gives up
+    pub fn gives_up(&self, iterations: usize, cost: f64) -> bool {
+        iterations == self.after && !(cost <= self.above)
+    }
 }
 
 /// A flag that stops a running minimisation ([`Status::Stopped`]).
@@ -82,6 +103,7 @@ impl Default for Options {
             initial_damping: 1e-3,
             max_rejections: 30,
             stop: None,
+            give_up: None,
         }
     }
 }
@@ -103,6 +125,8 @@ pub enum Status {
     JacobianFailed,
     /// [`Options::stop`] was raised.
     Stopped,
+    /// [`Options::give_up`]: still too far from a fit found elsewhere.
+    GaveUp,
 }
 
 impl Status {
@@ -480,6 +504,12 @@ where
                 if small_decrease {
                     break Status::CostConverged;
                 }
+                if options
+                    .give_up
+                    .is_some_and(|g| g.gives_up(iterations, pt.cost))
+                {
+                    break Status::GaveUp;
+                }
             }
             Outcome::Stop(status) => break status,
         }
@@ -753,6 +783,55 @@ mod tests {
         // a flag is equal to its clones only
         assert_eq!(options.stop, Some(stop.clone()));
         assert_ne!(options.stop, Some(Stop::default()));
+    }
+
+    #[test]
+    fn a_start_above_the_give_up_cost_after_its_iterations_ends_there() {
+        let bounds = [(-5.0, 5.0), (-5.0, 5.0)];
+        let mut costs = Vec::new();
+        let full = minimize(
+            rosenbrock,
+            &[-1.2, 1.0],
+            &bounds,
+            &Options::default(),
+            &mut |it| costs.push(it.cost),
+        )
+        .unwrap();
+        assert!(full.status.converged() && full.iterations > 3, "{full:?}");
+        let with = |above: f64| Options {
+            give_up: Some(GiveUp { after: 3, above }),
+            ..Options::default()
+        };
+        // still above after 3 iterations: ends there, at that point
+        let rep = minimize(
+            rosenbrock,
+            &[-1.2, 1.0],
+            &bounds,
+            &with(0.5 * costs[2]),
+            &mut quiet,
+        )
+        .unwrap();
+        assert_eq!((rep.status, rep.iterations), (Status::GaveUp, 3));
+        assert_eq!(rep.cost, costs[2]);
+        assert!(!rep.status.converged());
+        // at or below it: runs on as without the rule, bit for bit
+        let rep = minimize(
+            rosenbrock,
+            &[-1.2, 1.0],
+            &bounds,
+            &with(costs[2]),
+            &mut quiet,
+        )
+        .unwrap();
+        assert_eq!((rep.status, rep.iterations), (full.status, full.iterations));
+        assert_eq!(rep.theta, full.theta);
+        // a NaN cost gives up; other iterations never do
+        let g = GiveUp {
+            after: 3,
+            above: 1.0,
+        };
+        assert!(g.gives_up(3, f64::NAN) && g.gives_up(3, 1.5));
+        assert!(!g.gives_up(2, 1.5) && !g.gives_up(4, 1.5) && !g.gives_up(3, 1.0));
     }
 
     #[test]

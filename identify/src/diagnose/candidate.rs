@@ -8,6 +8,7 @@
 //! extension with the best the baseline itself can do.
 
 use crate::description::{Core, Description, Gap, JilesAtherton, Reversal};
+use crate::lm::GiveUp;
 use crate::model::MU0;
 use crate::FitParam;
 
@@ -30,6 +31,8 @@ pub struct Candidate {
     pub params: Vec<FitParam>,
     /// Starts of the multi-start fit (1 = the starting point only).
     pub starts: usize,
+    /// Where a start is given up ([`GiveUp`]; the second hysteresis start).
+    pub give_up: Option<GiveUp>,
 }
 
 /// Why a cause cannot extend this baseline (it is already in the model).
@@ -137,6 +140,7 @@ pub fn candidate(
         start,
         params,
         starts,
+        give_up: None,
     })
 }
 
@@ -194,6 +198,7 @@ pub fn hysteresis_from_saturation(
         start,
         params,
         starts: 1,
+        give_up: None,
     })
 }
 

@@ -18,6 +18,8 @@
 //! measured current kept) onto the values through the Jacobian's
 //! pseudo-inverse: δθ = J⁺·δr, linearised as the fit is.
 
+use rayon::prelude::*;
+
 use super::candidate::Candidate;
 use super::{rank, Cause};
 use crate::{FitOptions, FitReport, Measured};
@@ -51,7 +53,7 @@ pub(super) fn with_edges(
 }
 
 /// The polish's integration tolerance, stopping rule, iterations and
-/// integration steps: tighter than the ranking's fits (ftol 1e-5, replays at
+/// integration steps: tighter than the ranking's fits (ftol 1e-3, replays at
 /// 1e-8), which stop where the named values still move by more than their
 /// standard errors.
 const RTOL: f64 = 1e-10;
@@ -118,8 +120,8 @@ pub(super) fn propagated_variances(
     let (jacobian, r0) = crate::linearisation(d, own, &c.params, options).ok()?;
     let pinv = jacobian.pseudo_inverse(1e-12).ok()?;
     let (sigma_v, sigma_i) = (rank::noise_std(&own.v), rank::noise_std(&own.i));
-    let mut sum = vec![0.0; pinv.nrows()];
-    for draw in 0..DRAWS as u64 {
+    // the draws in parallel, summed in their order (the same sum every run)
+    let draw = |draw: u64| -> Option<Vec<f64>> {
         let seed = PROPAGATION_SEED.wrapping_add(2 * draw);
         let v = rank::with_noise(&own.v, sigma_v, seed);
         let noisy = Measured {
@@ -138,9 +140,16 @@ pub(super) fn propagated_variances(
             return None;
         }
         let dr = nalgebra::DVector::from_iterator(r.len(), r.iter().zip(&r0).map(|(a, b)| a - b));
-        let dtheta = &pinv * dr;
-        for (s, x) in sum.iter_mut().zip(dtheta.iter()) {
-            *s += x * x;
+        Some((&pinv * dr).iter().map(|x| x * x).collect())
+    };
+    let draws: Vec<Vec<f64>> = (0..DRAWS as u64)
+        .into_par_iter()
+        .map(draw)
+        .collect::<Option<_>>()?;
+    let mut sum = vec![0.0; pinv.nrows()];
+    for squares in &draws {
+        for (s, x) in sum.iter_mut().zip(squares) {
+            *s += x;
         }
     }
     Some(sum.into_iter().map(|s| s / DRAWS as f64).collect())
