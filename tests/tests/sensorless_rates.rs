@@ -195,7 +195,11 @@ fn observer_lags_the_armature_at_the_stops() {
             })
             .expect("the armature lands");
         // the last sample before the impact
-        let i = run.trajectory.t.partition_point(|&s| s < at) - 1;
+        let i = run
+            .trajectory
+            .t
+            .partition_point(|&s| s < at)
+            .saturating_sub(1);
         let (x, e) = (run.trajectory.x[i], estimates[i]);
         let lag = [(x[0] - e.z) * towards, (x[1] - e.v) * towards];
         println!(
