@@ -53,9 +53,9 @@ pub(super) fn with_edges(
 }
 
 /// The polish's integration tolerance, stopping rule, iterations and
-/// integration steps: tighter than the ranking's fits (ftol 1e-3, replays at
-/// 1e-8), which stop where the named values still move by more than their
-/// standard errors.
+/// integration steps: tighter than the ranking's fits (ftol 1e-5, 1e-3 for
+/// the hysteresis candidate; replays at 1e-8), which stop where the named
+/// values still move by more than their standard errors.
 const RTOL: f64 = 1e-10;
 const FTOL: f64 = 1e-10;
 const ITERATIONS: usize = 100;
