@@ -186,7 +186,7 @@ fn observer_lags_the_armature_at_the_stops() {
             .trajectory
             .events
             .iter()
-            .filter(|e| e.t > start + t.takeoff)
+            .filter(|e| e.t > start + t.takeoff && e.t <= start + run.operation_length)
             .find_map(|e| match e.kind {
                 EventKind::Impact {
                     limit, v_before, ..

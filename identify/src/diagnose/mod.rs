@@ -452,8 +452,8 @@ fn diagnose_step(
 
 /// The hysteresis candidate's fits for the ranking stop once an iteration
 /// gains less than this share of the objective (the other candidates' at
-/// [`fit_options`]' 1e-5). The named cause is fitted again to its optimum
-/// ([`polish`]). At 1e-5 the Jiles–Atherton fit ran its 40 iterations on
+/// [`fit_options`]' 1e-5). A named core is fitted again from there by the
+/// polish ([`polish`], up to its iteration cap). At 1e-5 the Jiles–Atherton fit ran its 40 iterations on
 /// the benchmark's `none` record, gaining 0.01 % a step at 10⁴ times the
 /// other candidates' objective (2.5 s of the record's 3.0). Not for every
 /// candidate: a saturating core stopped at 1e-3 lost the ranking to the
@@ -464,7 +464,6 @@ const RANKING_FTOL_HYSTERESIS: f64 = 1e-3;
 /// The fits' settings: the ranking is by the current's error, so the fits
 /// fit that (and z when measured), not the flux integrated from v − R·i,
 /// which a drifting resistance would corrupt.
-
 fn fit_options(options: &Options) -> FitOptions {
     FitOptions {
         max_iterations: options.max_iterations,

@@ -21,7 +21,11 @@ pub(super) const GIVE_UP_AFTER: usize = 5;
 pub(super) const GIVE_UP_FACTOR: f64 = 10.0;
 
 /// `seeded`, the start from a saturating core whose fit's objective (the
-/// report's `cost`) is `saturation_cost`, with the give-up rule.
+/// report's `cost`) is `saturation_cost`, with the give-up rule. (The two
+/// objectives weigh the samples with the resistance each fit starts from:
+/// close, against the factor of 10.) A start that gave up still counts as
+/// the candidate's where its BIC is the better one: an upper bound of what
+/// that start would reach.
 pub(super) fn giving_up(seeded: Candidate, saturation_cost: f64) -> Candidate {
     Candidate {
         give_up: Some(GiveUp {
