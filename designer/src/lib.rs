@@ -15,6 +15,7 @@
 //! - [`sim`]: the hybrid-automaton simulator (knows nothing of magnetics).
 
 pub mod backstepping_loop;
+pub mod bisect;
 pub mod closed_loop;
 pub mod description;
 pub mod design;

@@ -3,6 +3,7 @@
 //! model's acceleration is off (a spring that differs from the description).
 
 use super::Gains;
+use crate::bisect::bisect;
 
 /// 5 % settling-time criterion of a triple real pole.
 const SETTLING_FRACTION: f64 = 0.05;
@@ -12,16 +13,7 @@ const SETTLING_FRACTION: f64 = 0.05;
 pub fn triple_pole_settling_product() -> f64 {
     // The residual decreases strictly for x > 0: bisection on [0, 50].
     let residual = |x: f64| (-x).exp() * (1.0 + x + 0.5 * x * x) - SETTLING_FRACTION;
-    let (mut lo, mut hi) = (0.0_f64, 50.0_f64);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if residual(mid) > 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
+    bisect(0.0, 50.0, |x| residual(x) > 0.0)
 }
 
 impl Gains {

@@ -8,6 +8,7 @@
 //! ½·R_gap'(z_min)·φ² < −F(z_min, 0) (jiles-atherton-actuator-model [JA 49–50]).
 //! The Jiles–Atherton core is evaluated on its anhysteretic curve.
 
+use crate::bisect::bisect;
 use crate::description::{Core, Description, Drive};
 use crate::sim::State;
 use crate::sym::Tape;
@@ -167,6 +168,7 @@ impl CoreCurve<'_> {
 
 /// H on the anhysteretic curve for flux density B: solves
 /// M = M_sat·L((B − μ0(1 − α)M)/b) by bisection (the right side decreases in M).
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // deliberate: a NaN residual keeps the upper half
 pub fn anhysteretic_field(ja: &crate::description::JilesAtherton, b_c: f64) -> f64 {
     let langevin = |x: f64| {
         if x.abs() < 1e-4 {
@@ -176,16 +178,7 @@ pub fn anhysteretic_field(ja: &crate::description::JilesAtherton, b_c: f64) -> f
         }
     };
     let residual = |m: f64| m - ja.m_sat * langevin((b_c - MU0 * (1.0 - ja.alpha) * m) / ja.b);
-    let (mut lo, mut hi) = (-ja.m_sat, ja.m_sat);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if residual(mid) > 0.0 {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    b_c / MU0 - 0.5 * (lo + hi)
+    b_c / MU0 - bisect(-ja.m_sat, ja.m_sat, |m| !(residual(m) > 0.0))
 }
 
 /// The flux φ ≥ 0 with mmf(φ) = ampere_turns (mmf increasing), by bisection.
@@ -196,14 +189,5 @@ fn steady_flux(mmf: impl Fn(f64) -> f64, ampere_turns: f64, limit: Option<f64>) 
             hi *= 2.0;
         }
     }
-    let mut lo = 0.0;
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if mmf(mid) < ampere_turns {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
+    bisect(0.0, hi, |phi| mmf(phi) < ampere_turns)
 }
