@@ -297,16 +297,7 @@ fn diagnose_step(
         .into_iter()
         .partition(|c| c.cause == Cause::Hysteresis);
     let fit_one = |c: &Candidate, stop: Option<&Stop>| {
-        let options = FitOptions {
-            stop: stop.cloned(),
-            give_up: c.give_up,
-            ftol: match c.cause {
-                Cause::Hysteresis => RANKING_FTOL_HYSTERESIS,
-                _ => fit_options.ftol,
-            },
-            ..fit_options.clone()
-        };
-        score(c, &fit_data, &options, n_eff)
+        score(c, &fit_data, &ranking_options(c, stop, &fit_options), n_eff)
     };
     let mut ranking = fit_all(baseline, &others, hysteresis.first(), &fit_one);
     ranking.sort_by(|a, b| a.bic.total_cmp(&b.bic).then(a.cause.cmp(&b.cause)));
@@ -453,13 +444,29 @@ fn diagnose_step(
 /// The hysteresis candidate's fits for the ranking stop once an iteration
 /// gains less than this share of the objective (the other candidates' at
 /// [`fit_options`]' 1e-5). A named core is fitted again from there by the
-/// polish ([`polish`], up to its iteration cap). At 1e-5 the Jiles–Atherton fit ran its 40 iterations on
-/// the benchmark's `none` record, gaining 0.01 % a step at 10⁴ times the
-/// other candidates' objective (2.5 s of the record's 3.0). Not for every
-/// candidate: a saturating core stopped at 1e-3 lost the ranking to the
-/// Jiles–Atherton core on a saturation record of the CI set, which it wins
-/// at 1e-5 (`causes_are_found_on_generated_devices`).
+/// polish ([`polish`], up to its iteration cap). At 1e-5 the Jiles–Atherton
+/// fit ran its 40 iterations on the benchmark's `none` record, gaining
+/// 0.01 % a step at 10⁴ times the other candidates' objective (2.5 s of the
+/// record's 3.0). Not for every candidate: a saturating core stopped at
+/// 1e-3 lost the ranking to the Jiles–Atherton core on a saturation record
+/// of the CI set, which it wins at 1e-5
+/// (`causes_are_found_on_generated_devices`).
 const RANKING_FTOL_HYSTERESIS: f64 = 1e-3;
+
+/// The settings of `c`'s fit for the ranking: `base` with the run's `stop`,
+/// the candidate's give-up rule and, for the hysteresis candidate,
+/// [`RANKING_FTOL_HYSTERESIS`].
+fn ranking_options(c: &Candidate, stop: Option<&Stop>, base: &FitOptions) -> FitOptions {
+    FitOptions {
+        stop: stop.cloned(),
+        give_up: c.give_up,
+        ftol: match c.cause {
+            Cause::Hysteresis => RANKING_FTOL_HYSTERESIS,
+            _ => base.ftol,
+        },
+        ..base.clone()
+    }
+}
 
 /// The fits' settings: the ranking is by the current's error, so the fits
 /// fit that (and z when measured), not the flux integrated from v − R·i,
@@ -855,4 +862,42 @@ pub fn impacts(replay: &SimOutputs, z_min: f64, z_max: f64) -> Vec<f64> {
         .filter(|(w, _)| !near(w[0]) && near(w[1]))
         .map(|(_, t)| *t)
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lm::GiveUp;
+
+    #[test]
+    fn ranking_fits_loosen_only_the_hysteresis_candidate_and_carry_its_give_up() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/semera-valve.toml");
+        let start = crate::description::parse_file(std::path::Path::new(path)).expect("example");
+        let give_up = GiveUp {
+            after: 5,
+            above: 1.0,
+        };
+        let candidate = |cause, give_up| Candidate {
+            cause,
+            start: start.clone(),
+            params: Vec::new(),
+            starts: 1,
+            give_up,
+        };
+        let base = fit_options(&Options::default());
+        let stop = Stop::default();
+        let o = ranking_options(
+            &candidate(Cause::Hysteresis, Some(give_up)),
+            Some(&stop),
+            &base,
+        );
+        assert_eq!(
+            (o.ftol, o.give_up),
+            (RANKING_FTOL_HYSTERESIS, Some(give_up))
+        );
+        assert_eq!(o.stop, Some(stop));
+        let o = ranking_options(&candidate(Cause::Saturation, None), None, &base);
+        assert_eq!((o.ftol, o.give_up, o.stop), (base.ftol, None, None));
+        assert_eq!(base.ftol, 1e-5);
+    }
 }
