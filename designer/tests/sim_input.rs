@@ -169,3 +169,34 @@ fn constant_inputs() {
     assert_eq!(s.value(-4.0), 3.0);
     assert!(s.breakpoints().is_empty());
 }
+
+/// Lookups remember where the last one ended (a hint tried before a binary
+/// search): the answers must be those of a fresh signal, whatever the order
+/// of the times (forward, backward, jumps, repeated, outside, NaN).
+#[test]
+fn lookups_do_not_depend_on_the_previous_ones() {
+    let t = [0.0, 1.0, 1.0, 2.0, 3.0, 3.0, 3.0, 4.5, 6.0, 7.0];
+    let u = [0.0, 1.0, 5.0, 5.0, 2.0, 7.0, 1.0, 1.0, -3.0, 4.0];
+    let s = pl(&t, &u);
+    let mut times: Vec<f64> = (-4..=32).map(|k| k as f64 * 0.25).collect();
+    let backward: Vec<f64> = times.iter().rev().copied().collect();
+    times.extend(backward);
+    times.extend([3.0, 3.0, 1.0, 6.0, -1.0, 9.0, 1.0, 2.0]);
+    // a pseudo-random walk over the range
+    let mut x = 12345u64;
+    for _ in 0..200 {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        times.push(-1.0 + 9.0 * ((x >> 11) as f64 / (1u64 << 53) as f64));
+    }
+    times.extend([f64::NAN, 0.5, f64::INFINITY, 2.5, f64::NEG_INFINITY, 4.0]);
+    for &at in &times {
+        let fresh = pl(&t, &u);
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits();
+        assert!(same(s.value(at), fresh.value(at)), "value at {at}");
+        let (got, want) = (s.next_breakpoint(at), fresh.next_breakpoint(at));
+        assert!(same(got, want), "next breakpoint after {at}");
+        assert_eq!(s.piece(at), fresh.piece(at), "piece at {at}");
+    }
+}

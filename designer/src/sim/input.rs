@@ -86,6 +86,51 @@ pub struct PiecewiseLinear {
     t: Vec<f64>,
     u: Vec<f64>,
     breakpoints: Vec<f64>,
+    /// Where the last searches of `t` and of `breakpoints` ended: a
+    /// simulation asks at times that mostly stay in one segment or move to
+    /// the next ([`Hint`]).
+    hints: [Hint; 2],
+}
+
+/// The index a search of a sorted slice last returned, tried first (then
+/// the next one) before a binary search: the same answer as
+/// `partition_point`, without its ~16 cache-missing probes per call on a
+/// 40 000-sample record. Atomic (relaxed) so that threads may share an
+/// input; any stored value is only a guess, checked before it is used.
+#[derive(Debug, Default)]
+struct Hint(std::sync::atomic::AtomicUsize);
+
+impl Hint {
+    /// `sorted.partition_point(|&s| s <= t)`.
+    fn partition_after(&self, sorted: &[f64], t: f64) -> usize {
+        use std::sync::atomic::Ordering::Relaxed;
+        let is_it = |i: usize| {
+            i <= sorted.len()
+                && (i == 0 || sorted[i - 1] <= t)
+                && sorted.get(i).is_none_or(|&s| !(s <= t))
+        };
+        let h = self.0.load(Relaxed);
+        let i = match (is_it(h), is_it(h + 1)) {
+            (true, _) => h,
+            (false, true) => h + 1,
+            _ => sorted.partition_point(|&s| s <= t),
+        };
+        self.0.store(i, Relaxed);
+        i
+    }
+}
+
+impl Clone for Hint {
+    fn clone(&self) -> Self {
+        Hint(self.0.load(std::sync::atomic::Ordering::Relaxed).into())
+    }
+}
+
+/// A hint is not part of the signal.
+impl PartialEq for Hint {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 impl PiecewiseLinear {
@@ -110,7 +155,12 @@ impl PiecewiseLinear {
             }
         }
         let breakpoints = find_breakpoints(&t, &u);
-        Ok(Self { t, u, breakpoints })
+        Ok(Self {
+            t,
+            u,
+            breakpoints,
+            hints: Default::default(),
+        })
     }
 
     /// A constant signal.
@@ -226,7 +276,7 @@ impl PiecewiseLinear {
 
     /// Index of the last sample with `t[j] ≤ t` (`None` before the first).
     fn last_at_or_before(&self, t: f64) -> Option<usize> {
-        self.t.partition_point(|&s| s <= t).checked_sub(1)
+        self.hints[0].partition_after(&self.t, t).checked_sub(1)
     }
 
     /// Value on segment `j` (`t[j] ≤ t < t[j+1]`, or the constant ends).
@@ -253,7 +303,7 @@ impl Input for PiecewiseLinear {
     }
 
     fn next_breakpoint(&self, t: f64) -> f64 {
-        let i = self.breakpoints.partition_point(|&b| b <= t);
+        let i = self.hints[1].partition_after(&self.breakpoints, t);
         self.breakpoints.get(i).copied().unwrap_or(f64::INFINITY)
     }
 
