@@ -25,12 +25,14 @@
 //! tolerance ([`FitOptions::rtol`]) so that a relative step of
 //! [`FitOptions::fd_step`] sees a smooth function.
 //! Several starts ([`FitOptions::starts`]) are drawn deterministically from
-//! the bounds (log-uniform for positive parameters spanning a decade or more);
-//! the best fit is kept.
+//! the bounds (log-uniform for positive parameters spanning a decade or more)
+//! and fitted in parallel; the best fit is kept (the first on a tie, as if
+//! they had run one after the other).
 
 use std::cell::{Cell, RefCell};
 
 use nalgebra::DMatrix;
+use rayon::prelude::*;
 
 use crate::description::{Core, Description, Drive};
 use crate::model::{Model, ModelPlant};
@@ -116,7 +118,8 @@ impl Default for FitOptions {
     }
 }
 
-/// Reported after every iteration of every start.
+/// Reported after every iteration of every start (the starts run in
+/// parallel: their reports interleave).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitProgress {
     /// 0-based start index.
@@ -503,30 +506,6 @@ pub fn fit(
     let paths: Vec<&str> = params.iter().map(|p| p.path.as_str()).collect();
     let analytic = options.sensitivities == Sensitivities::Analytic
         && sensitivity::check(description, &paths).is_ok();
-    // The analytic Jacobian reuses the replay of the residuals at the same
-    // θ (the solver asks for J at the point it just evaluated and accepted).
-    let last: RefCell<Option<(Vec<f64>, Trajectory)>> = RefCell::new(None);
-    let jacobian_replays = Cell::new(0);
-    let keeping = |theta: &[f64]| {
-        let d = with_values(description, params, theta).ok()?;
-        let replay = replay(&d, data, &setup.objective.budget).ok()?;
-        let r = setup.objective.residuals_of(&d, &outputs(&d, &replay));
-        *last.borrow_mut() = Some((theta.to_vec(), replay.trajectory));
-        Some(r)
-    };
-    let jacobian = |theta: &[f64]| {
-        let d = with_values(description, params, theta).ok()?;
-        let kept = last.borrow_mut().take().filter(|(t, _)| t == theta);
-        let trajectory = match kept {
-            Some((_, trajectory)) => trajectory,
-            None => {
-                jacobian_replays.set(jacobian_replays.get() + 1);
-                replay(&d, data, &setup.objective.budget).ok()?.trajectory
-            }
-        };
-        // none (or not finite): `lm` differences the residual instead
-        setup.objective.jacobian(&d, &paths, &trajectory)
-    };
     let lm_options = lm::Options {
         max_iterations: options.max_iterations,
         ftol: options.ftol,
@@ -536,13 +515,9 @@ pub fn fit(
         ..lm::Options::default()
     };
     let starts = options.starts.max(1);
-    let mut best: Option<(usize, lm::Report)> = None;
-    let (mut iterations, mut simulations, mut differenced) = (0, 0, 0);
-    let mut last_error = None;
-    for (k, x0) in start_points(start0, params, starts, options.seed)
-        .iter()
-        .enumerate()
-    {
+    // The starts in parallel (each on its own replays), reduced in their
+    // order below: the same best start, sums and report every run.
+    let solve = |(k, x0): (usize, &Vec<f64>)| {
         let mut monitor = |it: &lm::Iteration| {
             progress(FitProgress {
                 start: k,
@@ -551,12 +526,47 @@ pub fn fit(
                 objective: 2.0 * it.cost,
             })
         };
+        // The analytic Jacobian reuses the replay of the residuals at the
+        // same θ (the solver asks for J at the point it just evaluated and
+        // accepted).
+        let last: RefCell<Option<(Vec<f64>, Trajectory)>> = RefCell::new(None);
+        let jacobian_replays = Cell::new(0);
+        let keeping = |theta: &[f64]| {
+            let d = with_values(description, params, theta).ok()?;
+            let replay = replay(&d, data, &setup.objective.budget).ok()?;
+            let r = setup.objective.residuals_of(&d, &outputs(&d, &replay));
+            *last.borrow_mut() = Some((theta.to_vec(), replay.trajectory));
+            Some(r)
+        };
+        let jacobian = |theta: &[f64]| {
+            let d = with_values(description, params, theta).ok()?;
+            let kept = last.borrow_mut().take().filter(|(t, _)| t == theta);
+            let trajectory = match kept {
+                Some((_, trajectory)) => trajectory,
+                None => {
+                    jacobian_replays.set(jacobian_replays.get() + 1);
+                    replay(&d, data, &setup.objective.budget).ok()?.trajectory
+                }
+            };
+            // none (or not finite): `lm` differences the residual instead
+            setup.objective.jacobian(&d, &paths, &trajectory)
+        };
         let result = match analytic {
             true => {
                 lm::minimize_with_jacobian(keeping, jacobian, x0, bounds, &lm_options, &mut monitor)
             }
             false => lm::minimize(residual, x0, bounds, &lm_options, &mut monitor),
         };
+        (result, jacobian_replays.get())
+    };
+    let points = start_points(start0, params, starts, options.seed);
+    let results: Vec<_> = points.par_iter().enumerate().map(solve).collect();
+    let mut best: Option<(usize, lm::Report)> = None;
+    let (mut iterations, mut simulations, mut differenced) = (0, 0, 0);
+    let mut jacobian_replays = 0;
+    let mut last_error = None;
+    for (k, (result, replays)) in results.into_iter().enumerate() {
+        jacobian_replays += replays;
         match result {
             Ok(report) => {
                 iterations += report.iterations;
@@ -594,7 +604,7 @@ pub fn fit(
         nrmse_position: errors.position,
         cost: 2.0 * report.cost,
         iterations,
-        simulations: simulations + 1 + jacobian_replays.get(),
+        simulations: simulations + 1 + jacobian_replays,
         sensitivities: match analytic {
             true => Sensitivities::Analytic,
             false => Sensitivities::FiniteDifference,

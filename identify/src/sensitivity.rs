@@ -163,6 +163,8 @@ struct Work {
     a: [Vec<f64>; 2],
     b: [Vec<f64>; 2],
     rhs: nalgebra::OMatrix<f64, nalgebra::Const<{ 2 * MAX_DIM }>, nalgebra::Dyn>,
+    /// The same for three states.
+    rhs3: nalgebra::OMatrix<f64, nalgebra::Const<6>, nalgebra::Dyn>,
 }
 
 impl Work {
@@ -171,6 +173,7 @@ impl Work {
             a: [vec![0.0; d * d], vec![0.0; d * d]],
             b: [vec![0.0; d * p], vec![0.0; d * p]],
             rhs: nalgebra::OMatrix::zeros_generic(nalgebra::Const, nalgebra::Dyn(p)),
+            rhs3: nalgebra::OMatrix::zeros_generic(nalgebra::Const, nalgebra::Dyn(p)),
         }
     }
 }
@@ -406,9 +409,8 @@ impl Field {
         work: &mut Work,
     ) -> bool {
         let (d, p, h) = (self.d, self.p, t1 - t0);
-        // (Radau IIA) c = (1/3, 1), A = [[5/12, −1/12], [3/4, 1/4]]
+        // (Radau IIA) c = (1/3, 1), A = [`RADAU`]
         const C1: f64 = 1.0 / 3.0;
-        const RADAU: [[f64; 2]; 2] = [[5.0 / 12.0, -1.0 / 12.0], [0.75, 0.25]];
         self.eval(t0, x0, piece.value(t0));
         let f0 = self.linearisation(stuck, &mut work.a[0], &mut work.b[0]);
         self.eval(t1, x1, piece.value(t1));
@@ -437,44 +439,19 @@ impl Field {
         if !(finite(a1) && finite(a2) && finite(b1) && finite(b2)) {
             return false;
         }
-        // [Z1; Z2] = S + h·RADAU·[A1·Z1 + B1; A2·Z2 + B2]: unused rows of the
-        // padded system are identity.
-        let stage = [&*a1, &*a2];
-        let m = nalgebra::SMatrix::<f64, { 2 * MAX_DIM }, { 2 * MAX_DIM }>::from_fn(|r, c| {
-            let (bi, i, bk, k) = (r / MAX_DIM, r % MAX_DIM, c / MAX_DIM, c % MAX_DIM);
-            let identity = if r == c { 1.0 } else { 0.0 };
-            match i < d && k < d {
-                true => identity - h * RADAU[bi][bk] * stage[bk][i * d + k],
-                false => identity,
-            }
-        });
-        let Some(lu) = Some(m.lu()).filter(|lu| lu.is_invertible()) else {
-            return false;
-        };
-        let forcing = [&*b1, &*b2];
-        let rhs = &mut work.rhs;
-        for j in 0..p {
-            for r in 0..2 * MAX_DIM {
-                let (bi, i) = (r / MAX_DIM, r % MAX_DIM);
-                rhs[(r, j)] = match i < d {
-                    true => {
-                        s[i * p + j]
-                            + h * (RADAU[bi][0] * forcing[0][i * p + j]
-                                + RADAU[bi][1] * forcing[1][i * p + j])
-                    }
-                    false => 0.0,
-                };
-            }
+        let (stage, forcing): ([&[f64]; 2], [&[f64]; 2]) = ([a1, a2], [b1, b2]);
+        // the three-state models (a saturating core) in 6×6, not padded to 8×8
+        match d {
+            3 => radau_stages::<3, 6>(h, (d, p), stage, forcing, s, &mut work.rhs3),
+            _ => radau_stages::<MAX_DIM, { 2 * MAX_DIM }>(
+                h,
+                (d, p),
+                stage,
+                forcing,
+                s,
+                &mut work.rhs,
+            ),
         }
-        if !lu.solve_mut(rhs) {
-            return false;
-        }
-        for j in 0..p {
-            for i in 0..d {
-                s[i * p + j] = rhs[(MAX_DIM + i, j)];
-            }
-        }
-        true
     }
 
     /// The saltation update at an impact, a stick or a lift-off.
@@ -527,6 +504,61 @@ impl Field {
             EventKind::LiftOff { .. } => {}
         }
     }
+}
+
+/// (Radau IIA) A = [[5/12, −1/12], [3/4, 1/4]]
+const RADAU: [[f64; 2]; 2] = [[5.0 / 12.0, -1.0 / 12.0], [0.75, 0.25]];
+
+/// The stage system of [`Field::radau`], [Z1; Z2] = S + h·RADAU·[A1·Z1 +
+/// B1; A2·Z2 + B2] (A_k = f_x, B_k = f_θ at the stages, row-major, d×d and
+/// d×p), solved in blocks of `B` ≥ d rows (`N` = 2·`B`; a block's rows from
+/// d on are identity), and S ← Z2. False (S untouched) where the system is
+/// singular.
+fn radau_stages<const B: usize, const N: usize>(
+    h: f64,
+    (d, p): (usize, usize),
+    stage: [&[f64]; 2],
+    forcing: [&[f64]; 2],
+    s: &mut [f64],
+    rhs: &mut nalgebra::OMatrix<f64, nalgebra::Const<N>, nalgebra::Dyn>,
+) -> bool
+where
+    nalgebra::Const<N>: nalgebra::DimMin<nalgebra::Const<N>, Output = nalgebra::Const<N>>,
+{
+    debug_assert!(N == 2 * B && d <= B);
+    let m = nalgebra::SMatrix::<f64, N, N>::from_fn(|r, c| {
+        let (bi, i, bk, k) = (r / B, r % B, c / B, c % B);
+        let identity = if r == c { 1.0 } else { 0.0 };
+        match i < d && k < d {
+            true => identity - h * RADAU[bi][bk] * stage[bk][i * d + k],
+            false => identity,
+        }
+    });
+    let Some(lu) = Some(m.lu()).filter(|lu| lu.is_invertible()) else {
+        return false;
+    };
+    for j in 0..p {
+        for r in 0..N {
+            let (bi, i) = (r / B, r % B);
+            rhs[(r, j)] = match i < d {
+                true => {
+                    s[i * p + j]
+                        + h * (RADAU[bi][0] * forcing[0][i * p + j]
+                            + RADAU[bi][1] * forcing[1][i * p + j])
+                }
+                false => 0.0,
+            };
+        }
+    }
+    if !lu.solve_mut(rhs) {
+        return false;
+    }
+    for j in 0..p {
+        for i in 0..d {
+            s[i * p + j] = rhs[(B + i, j)];
+        }
+    }
+    true
 }
 
 /// An upper bound on the spectral radius of the d×d matrix `a` (row-major,

@@ -260,16 +260,18 @@ fn diagnose_step(
         })
     };
     let replay = |d: &Description| replay_own(d, data);
-    let baseline_replay = replay(baseline)?;
     let current_noise = rank::noise_std(&data.i);
     let voltage_noise = rank::noise_std(&data.v);
     let renoised = Measured {
         v: rank::with_noise(&data.v, voltage_noise, VOLTAGE_NOISE_SEED),
         ..data.clone()
     };
+    let (baseline_replay, renoised_replay) =
+        rayon::join(|| replay(baseline), || replay_own(baseline, &renoised));
+    let baseline_replay = baseline_replay?;
     let voltage_floor = rank::voltage_floor(
         &baseline_replay.current,
-        &replay_own(baseline, &renoised)?.current,
+        &renoised_replay?.current,
         &data.i,
         &weights,
     );
