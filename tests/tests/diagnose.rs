@@ -315,7 +315,14 @@ fn write_long_case() {
             - 1;
         assert!(rows >= LONG_SAMPLES, "{cause}: only {rows} samples");
         let name = format!("{}-{cause}-long", SEMERA.trim_end_matches(".toml"));
-        reldesign_tests::hidden::write_case(&std::path::Path::new(&dir).join(name), &case);
+        let case_dir = std::path::Path::new(&dir).join(name);
+        reldesign_tests::hidden::write_case(&case_dir, &case);
+        // the hidden values, for the benchmark to report how near it came
+        let hidden: String = (case.drawn.iter())
+            .map(|(key, value)| format!("{key} {value:e}\n"))
+            .collect();
+        let path = case_dir.join("hidden.txt");
+        std::fs::write(&path, hidden).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     }
 }
 
