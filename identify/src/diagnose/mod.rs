@@ -373,7 +373,15 @@ fn diagnose_step(
                 );
                 refit = refit.or(refitted);
                 let named = named.unwrap_or_else(|| fit.clone());
-                let extended_replay = replay_own(&named.description, &own)?;
+                // The replay over the whole record and the propagation (on
+                // the fitted part) side by side; the propagation is wasted
+                // where the replay then rejects the cause (rare).
+                let own_fitted = own.head(fitted_samples);
+                let (extended_replay, propagated) = rayon::join(
+                    || replay_own(&named.description, &own),
+                    || polish::propagated_variances(candidate, &named, &own_fitted, &fit_options),
+                );
+                let extended_replay = extended_replay?;
                 // A cause that does not improve the whole record is never
                 // named (whatever its held-out part).
                 let whole = whole_gain(&extended_replay);
@@ -385,12 +393,6 @@ fn diagnose_step(
                     });
                     continue;
                 }
-                let propagated = polish::propagated_variances(
-                    candidate,
-                    &named,
-                    &own.head(fitted_samples),
-                    &fit_options,
-                );
                 chosen = Some((
                     scored.cause,
                     named,
