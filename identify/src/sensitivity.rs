@@ -692,7 +692,55 @@ pub fn forward<I: Input + ?Sized>(
 
 #[cfg(test)]
 mod tests {
-    use super::spectral_bound;
+    use super::{radau_stages, spectral_bound, MAX_DIM};
+
+    /// The stage system of a three-state model solved as 6×6 gives the bits
+    /// the 8×8 padded one gave (finite, normal pivots: the padding's rows
+    /// never pivot, and their zeros add nothing), on pseudo-random stiff
+    /// and mild systems with zeros and ties among the entries.
+    #[test]
+    fn the_three_state_stage_system_is_the_padded_one() {
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let mut uniform = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (d, p) = (3, 5);
+        for case in 0..2_000 {
+            let mut entry = |scale: f64| match (uniform() * 6.0) as usize {
+                0 => 0.0,
+                1 => 1.0,
+                _ => scale * (2.0 * uniform() - 1.0),
+            };
+            let scale = [1.0, 1e3, 1e8][case % 3];
+            let a: [Vec<f64>; 2] =
+                std::array::from_fn(|_| (0..d * d).map(|_| entry(scale)).collect());
+            let b: [Vec<f64>; 2] =
+                std::array::from_fn(|_| (0..d * p).map(|_| entry(1.0)).collect());
+            let s0: Vec<f64> = (0..d * p).map(|_| entry(1.0)).collect();
+            let h = 40e-6;
+            let stage = [a[0].as_slice(), a[1].as_slice()];
+            let forcing = [b[0].as_slice(), b[1].as_slice()];
+            let (mut s6, mut s8) = (s0.clone(), s0.clone());
+            let mut rhs6 = nalgebra::OMatrix::<f64, nalgebra::Const<6>, nalgebra::Dyn>::zeros(p);
+            let mut rhs8 =
+                nalgebra::OMatrix::<f64, nalgebra::Const<{ 2 * MAX_DIM }>, nalgebra::Dyn>::zeros(p);
+            let ok6 = radau_stages::<3, 6>(h, (d, p), stage, forcing, &mut s6, &mut rhs6);
+            let ok8 = radau_stages::<MAX_DIM, { 2 * MAX_DIM }>(
+                h,
+                (d, p),
+                stage,
+                forcing,
+                &mut s8,
+                &mut rhs8,
+            );
+            assert_eq!(ok6, ok8, "case {case}");
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&s6), bits(&s8), "case {case}");
+        }
+    }
 
     /// At least the spectral radius (within 2× of it for these), the same
     /// for the matrix in other units (D·A·D⁻¹), ∞ when not finite.
