@@ -10,7 +10,7 @@ use designer::description::{parse_file, Description};
 use reldesign_identify::gap_fit::{fit_gap, reluctance_and_slope, GapModel, GapTable};
 use reldesign_identify::{
     current_wnrmse, fit, params, reduced_parameters, simulate_outputs, FitOptions, FitParam,
-    Measured, Sensitivities,
+    FitReport, Measured, Sensitivities,
 };
 use support::example_path;
 
@@ -451,4 +451,53 @@ fn gap_fit_recovers_mclyman_area_and_winding_length() {
     assert!((fit.values[0].1 / area - 1.0).abs() < 0.01, "{fit:?}");
     assert!((fit.values[1].1 / lw - 1.0).abs() < 0.1, "{fit:?}");
     assert!(fit.nrmse_r < 3e-3 && fit.nrmse_r_prime.is_none());
+}
+
+/// The starts of a multi-start fit run in parallel: the report must be the
+/// one the starts give one after the other, whatever the threads' timing
+/// (one thread, and more threads than starts, give the same bits).
+#[test]
+fn parallel_starts_give_the_same_report_on_any_number_of_threads() {
+    let truth = example("semera-valve.toml");
+    let (t, v) = square(30.0, 0.0, 20e-3, 20e-6, 600);
+    let data = synthetic(&truth, t, v, 17);
+    let changes = [("coil.resistance", 1.2), ("core.phi_sat", 0.8)];
+    let start = perturbed(&truth, &changes);
+    let fitted: Vec<FitParam> = changes
+        .iter()
+        .map(|(p, _)| bounds(&truth, p, 3.0, 3.0))
+        .collect();
+    let options = FitOptions {
+        starts: 4,
+        ..FitOptions::default()
+    };
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| fit(&start, &data, &fitted, &options, &|_| {}).unwrap())
+    };
+    let (one, many) = (on(1), on(6));
+    let bits = |r: &FitReport| -> Vec<u64> {
+        let values = r.values.iter().map(|(_, v)| v.to_bits());
+        values
+            .chain([r.cost.to_bits(), r.wnrmse_current.to_bits()])
+            .collect()
+    };
+    assert_eq!(bits(&one), bits(&many));
+    assert_eq!(
+        (one.best_start, one.iterations, one.simulations, one.status),
+        (
+            many.best_start,
+            many.iterations,
+            many.simulations,
+            many.status
+        )
+    );
+    assert!(
+        one.iterations > 4,
+        "every start iterates: {}",
+        one.iterations
+    );
 }
