@@ -1,5 +1,6 @@
 //! Piecewise-linear inputs: values, jumps, breakpoints and builders.
 
+use designer::random::SplitMix64;
 use designer::sim::{Input, InputError, PiecewiseLinear};
 
 fn pl(t: &[f64], u: &[f64]) -> PiecewiseLinear {
@@ -183,13 +184,8 @@ fn lookups_do_not_depend_on_the_previous_ones() {
     times.extend(backward);
     times.extend([3.0, 3.0, 1.0, 6.0, -1.0, 9.0, 1.0, 2.0]);
     // a pseudo-random walk over the range
-    let mut x = 12345u64;
-    for _ in 0..200 {
-        x = x
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        times.push(-1.0 + 9.0 * ((x >> 11) as f64 / (1u64 << 53) as f64));
-    }
+    let mut rng = SplitMix64::new(12345);
+    times.extend((0..200).map(|_| -1.0 + 9.0 * rng.uniform()));
     times.extend([f64::NAN, 0.5, f64::INFINITY, 2.5, f64::NEG_INFINITY, 4.0]);
     for &at in &times {
         let fresh = pl(&t, &u);

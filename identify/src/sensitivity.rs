@@ -700,13 +700,8 @@ mod tests {
     /// and mild systems with zeros and ties among the entries.
     #[test]
     fn the_three_state_stage_system_is_the_padded_one() {
-        let mut x = 0x2545_F491_4F6C_DD1Du64;
-        let mut uniform = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            (x >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = designer::random::SplitMix64::new(29);
+        let mut uniform = || rng.uniform();
         let (d, p) = (3, 5);
         for case in 0..2_000 {
             let mut entry = |scale: f64| match (uniform() * 6.0) as usize {

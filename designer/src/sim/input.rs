@@ -407,19 +407,15 @@ fn find_breakpoints(t: &[f64], u: &[f64]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::Hint;
+    use crate::random::SplitMix64;
 
     /// `partition_after` is `partition_point` whatever the hint holds
     /// (stale, out of range) and whatever the query (duplicates, ±0, ±∞,
     /// NaN): a pseudo-random sweep.
     #[test]
     fn a_hinted_search_is_partition_point() {
-        let mut x = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut rng = SplitMix64::new(17);
+        let mut next = || rng.next_u64();
         let specials = [0.0, -0.0, f64::INFINITY, f64::NEG_INFINITY, f64::NAN];
         for _ in 0..2_000 {
             let n = (next() % 12) as usize;
