@@ -32,6 +32,10 @@
 //! - **Restitution.** γ enters only the bounce's reset v⁺ = −γ·v⁻, so its
 //!   column has f_θ = 0 and gains R_θ = ∂x⁺/∂γ = (0, −v⁻, 0, …) at each
 //!   bounce (not at an impact that sticks: v⁺ = 0 whatever γ).
+//! - **Input steps.** The instant t_s of a step of u from u⁻ to u⁺ (a
+//!   voltage edge between samples, fitted by `edge_fit`) has f_θ = 0;
+//!   moving it later by δ holds u⁻ over [t_s, t_s + δ], so S jumps there
+//!   by f(x, u⁻) − f(x, u⁺) ([`forward_with_steps`]).
 //! - **Jiles–Atherton core.** Its field switches with δ = sign φ̇ [JA 26],
 //!   but it is continuous there: Ḣ_c = dH_c/dB_c(δ)·φ̇/A_c [JA 33] is 0 on
 //!   both sides of φ̇ = 0, so the saltation term (f⁺ − f⁻)·τ vanishes and S
@@ -91,6 +95,21 @@ pub enum Theta {
     Field(Id),
     /// The restitution γ: only the bounce's reset v⁺ = −γ·v⁻.
     Restitution,
+    /// The instant of a step of the input ([`InputStep`]): f_θ = 0, and S
+    /// jumps at the step.
+    StepInstant,
+}
+
+/// A step of the input from `before` to `after` at `t`, whose instant is a
+/// fitted parameter (a voltage edge between two samples, `edges`). Moving
+/// it later by δ holds `before` over [t, t + δ], so x after it moves by
+/// (f(x, before) − f(x, after))·δ: ∂x/∂t jumps by f⁻ − f⁺ at t and then
+/// follows Ṡ = f_x·S.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InputStep {
+    pub t: f64,
+    pub before: f64,
+    pub after: f64,
 }
 
 /// The model symbol behind a fit path (the schema's), or why there is none.
@@ -187,7 +206,7 @@ impl Field {
         let zero = model.graph.constant(0.0);
         let diff = |model: &mut Model, e: Id, th: &Theta| match *th {
             Theta::Field(th) => model.graph.diff(e, th),
-            Theta::Restitution => zero,
+            Theta::Restitution | Theta::StepInstant => zero,
         };
         for &fi in &f {
             for th in theta {
@@ -604,7 +623,21 @@ pub fn forward<I: Input + ?Sized>(
     trajectory: &Trajectory,
     input: &I,
 ) -> Result<OutputSensitivities, Unsupported> {
-    let theta = symbols(model, paths)?;
+    forward_with_steps(model, paths, &[], trajectory, input)
+}
+
+/// [`forward`] with one more column per step of `steps` (in order of time,
+/// each a breakpoint of `input`): the sensitivities to its instant.
+pub fn forward_with_steps<I: Input + ?Sized>(
+    model: &mut Model,
+    paths: &[&str],
+    steps: &[InputStep],
+    trajectory: &Trajectory,
+    input: &I,
+) -> Result<OutputSensitivities, Unsupported> {
+    let mut theta = symbols(model, paths)?;
+    let first_step = theta.len();
+    theta.extend(steps.iter().map(|_| Theta::StepInstant));
     let field = Field::new(model, &theta);
     let tr = trajectory;
     let (n, d, p) = (tr.t.len(), field.d, field.p);
@@ -632,12 +665,16 @@ pub fn forward<I: Input + ?Sized>(
     let events = &tr.events;
     let mut next = events.iter().take_while(|e| e.t <= tr.t[0]).count();
     let mut work = Work::new(d, p);
+    // the next step whose jump is still to be applied
+    let mut step = steps.iter().take_while(|e| e.t < tr.t[0]).count();
     for k in 0..n - 1 {
         let t1 = tr.t[k + 1];
         let mut x = tr.x[k];
         let mut mode = tr.mode[k];
         let mut a = tr.t[k];
-        let smooth = events.get(next).is_none_or(|e| e.t > t1) && input.next_breakpoint(a) >= t1;
+        let smooth = events.get(next).is_none_or(|e| e.t > t1)
+            && input.next_breakpoint(a) >= t1
+            && steps.get(step).is_none_or(|e| e.t >= t1);
         let stuck = mode != Mode::Free;
         if smooth
             && field.radau(
@@ -658,10 +695,22 @@ pub fn forward<I: Input + ?Sized>(
         // Pieces of the interval between the input's breakpoints and the
         // events, each integrated with its own affine piece of u.
         loop {
+            while let Some(e) = steps.get(step).filter(|e| e.t <= a) {
+                let stuck = mode != Mode::Free;
+                let (before, after) = (
+                    field.f(a, &x, e.before, stuck),
+                    field.f(a, &x, e.after, stuck),
+                );
+                for i in 0..d {
+                    s[i * p + first_step + step] += before[i] - after[i];
+                }
+                step += 1;
+            }
             let event = events.get(next).filter(|e| e.t <= t1);
             let b = input
                 .next_breakpoint(a)
                 .min(event.map_or(t1, |e| e.t))
+                .min(steps.get(step).map_or(t1, |e| e.t.max(a)))
                 .min(t1);
             if b > a {
                 let piece = input.piece(a);
