@@ -222,7 +222,7 @@ pub fn simulate_outputs(d: &Description, data: &Measured) -> Result<SimOutputs, 
 
 /// Accuracy and effort of one replay.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Budget {
+pub(crate) struct Budget {
     rtol: f64,
     max_steps_per_sample: usize,
 }
@@ -245,7 +245,7 @@ fn simulate_with(
 }
 
 /// The signals of one replay of `d`.
-fn outputs(d: &Description, replay: &Replay) -> SimOutputs {
+pub(crate) fn outputs(d: &Description, replay: &Replay) -> SimOutputs {
     let tr = &replay.trajectory;
     let field = matches!(d.core, Core::JilesAtherton(_));
     SimOutputs {
@@ -260,7 +260,11 @@ fn outputs(d: &Description, replay: &Replay) -> SimOutputs {
 }
 
 /// The measured voltage replayed through `d` from rest.
-fn replay(d: &Description, data: &Measured, budget: &Budget) -> Result<Replay, FitError> {
+pub(crate) fn replay(
+    d: &Description,
+    data: &Measured,
+    budget: &Budget,
+) -> Result<Replay, FitError> {
     if d.supply.drive == Drive::Current {
         return Err(FitError::CurrentDrive {
             model: d.source.file_name.clone(),
@@ -288,7 +292,7 @@ fn replay(d: &Description, data: &Measured, budget: &Budget) -> Result<Replay, F
 }
 
 /// The measured references of [JA 80] and their weights.
-struct Objective<'a> {
+pub(crate) struct Objective<'a> {
     data: &'a Measured,
     weights: Vec<f64>,
     /// √(Σ w·i²)
@@ -297,7 +301,7 @@ struct Objective<'a> {
     flux: Option<FluxReference>,
     /// Stroke·√n, when the position is used.
     position_norm: Option<f64>,
-    budget: Budget,
+    pub(crate) budget: Budget,
 }
 
 /// The φ of the flux term: measured, or integrated from v − R·i with the
@@ -309,10 +313,10 @@ enum FluxReference {
 }
 
 /// The errors of one replay.
-struct Errors {
-    current: f64,
-    flux: Option<f64>,
-    position: Option<f64>,
+pub(crate) struct Errors {
+    pub(crate) current: f64,
+    pub(crate) flux: Option<f64>,
+    pub(crate) position: Option<f64>,
 }
 
 impl<'a> Objective<'a> {
@@ -373,7 +377,7 @@ impl<'a> Objective<'a> {
     }
 
     /// [`residuals`](Self::residuals) of the signals `out` of `d`.
-    fn residuals_of(&self, d: &Description, out: &SimOutputs) -> Vec<f64> {
+    pub(crate) fn residuals_of(&self, d: &Description, out: &SimOutputs) -> Vec<f64> {
         let sw: Vec<f64> = self.weights.iter().map(|w| w.sqrt()).collect();
         let mut r: Vec<f64> = (0..self.data.len())
             .map(|k| sw[k] * (out.current[k] - self.data.i[k]) / self.current_norm)
@@ -396,9 +400,25 @@ impl<'a> Objective<'a> {
         paths: &[&str],
         trajectory: &Trajectory,
     ) -> Option<DMatrix<f64>> {
-        let input = super::edges::replay_input(self.data).ok()?;
-        let s = sensitivity::forward(&mut Model::build(d), paths, trajectory, &input).ok()?;
-        let (n, p) = (self.data.len(), paths.len());
+        self.jacobian_with_steps(d, paths, &[], self.data, trajectory)
+    }
+
+    /// [`jacobian`](Self::jacobian) with one more column per step of
+    /// `steps` (∂r/∂t of its instant), `driven` the record whose edges
+    /// drove the replay.
+    pub(crate) fn jacobian_with_steps(
+        &self,
+        d: &Description,
+        paths: &[&str],
+        steps: &[sensitivity::InputStep],
+        driven: &Measured,
+        trajectory: &Trajectory,
+    ) -> Option<DMatrix<f64>> {
+        let input = super::edges::replay_input(driven).ok()?;
+        let mut model = Model::build(d);
+        let s =
+            sensitivity::forward_with_steps(&mut model, paths, steps, trajectory, &input).ok()?;
+        let (n, p) = (self.data.len(), paths.len() + steps.len());
         let sw: Vec<f64> = self.weights.iter().map(|w| w.sqrt()).collect();
         let mut blocks = vec![DMatrix::from_fn(n, p, |k, j| {
             sw[k] * s.current[(k, j)] / self.current_norm
@@ -406,8 +426,12 @@ impl<'a> Objective<'a> {
         if let Some((phi, norm)) = self.flux_reference(d) {
             let x = &trajectory.x;
             let mut block = DMatrix::zeros(n, p);
-            for (j, path) in paths.iter().enumerate() {
-                let dphi = self.flux_reference_derivative(d, path, &phi);
+            for j in 0..p {
+                // (the reference does not depend on the edges' instants)
+                let dphi = match paths.get(j) {
+                    Some(path) => self.flux_reference_derivative(d, path, &phi),
+                    None => vec![0.0; n],
+                };
                 // ∂‖φ_ref‖_w = Σ w·φ_ref·∂φ_ref / ‖φ_ref‖_w
                 let dnorm = (0..n)
                     .map(|k| self.weights[k] * phi[k] * dphi[k])
@@ -457,8 +481,10 @@ impl<'a> Objective<'a> {
         }
     }
 
-    fn errors(&self, d: &Description) -> Result<Errors, FitError> {
-        let out = simulate_with(d, self.data, &self.budget)?;
+    /// The errors of `d` replayed on `driven` (the record, its edges
+    /// perhaps moved).
+    pub(crate) fn errors(&self, d: &Description, driven: &Measured) -> Result<Errors, FitError> {
+        let out = simulate_with(d, driven, &self.budget)?;
         Ok(Errors {
             current: wnrmse(&out.current, &self.data.i, &self.weights),
             flux: self
@@ -480,7 +506,7 @@ impl<'a> Objective<'a> {
 }
 
 /// `d` with the parameters `paths` set to `theta`.
-fn with_values(
+pub(crate) fn with_values(
     d: &Description,
     paths: &[FitParam],
     theta: &[f64],
@@ -506,14 +532,7 @@ pub fn fit(
     let paths: Vec<&str> = params.iter().map(|p| p.path.as_str()).collect();
     let analytic = options.sensitivities == Sensitivities::Analytic
         && sensitivity::check(description, &paths).is_ok();
-    let lm_options = lm::Options {
-        max_iterations: options.max_iterations,
-        ftol: options.ftol,
-        fd_step: options.fd_step,
-        stop: options.stop.clone(),
-        give_up: options.give_up,
-        ..lm::Options::default()
-    };
+    let lm_options = lm_options(options);
     let starts = options.starts.max(1);
     // The starts in parallel (each on its own replays), reduced in their
     // order below: the same best start, sums and report every run.
@@ -584,7 +603,7 @@ pub fn fit(
         message: last_error.map_or_else(String::new, |e: LmError| e.to_string()),
     })?;
     let fitted = with_values(description, params, &report.theta)?;
-    let errors = setup.objective.errors(&fitted)?;
+    let errors = setup.objective.errors(&fitted, data)?;
     let names: Vec<String> = params.iter().map(|p| p.path.clone()).collect();
     Ok(FitReport {
         sensitivity: Sensitivity::from_jacobian(
@@ -613,6 +632,18 @@ pub fn fit(
         best_start,
         differenced_jacobians: differenced,
     })
+}
+
+/// The solver's settings of a fit.
+pub(crate) fn lm_options(options: &FitOptions) -> lm::Options {
+    lm::Options {
+        max_iterations: options.max_iterations,
+        ftol: options.ftol,
+        fd_step: options.fd_step,
+        stop: options.stop.clone(),
+        give_up: options.give_up,
+        ..lm::Options::default()
+    }
 }
 
 /// The sensitivity report of `params` at the description's values (no fit).
@@ -684,14 +715,14 @@ pub fn residuals_at(
 }
 
 /// The checked start values, the objective [JA 80] and the box of one fit.
-struct Setup<'a> {
-    x0: Vec<f64>,
-    objective: Objective<'a>,
-    bounds: Vec<(f64, f64)>,
+pub(crate) struct Setup<'a> {
+    pub(crate) x0: Vec<f64>,
+    pub(crate) objective: Objective<'a>,
+    pub(crate) bounds: Vec<(f64, f64)>,
 }
 
 impl<'a> Setup<'a> {
-    fn new(
+    pub(crate) fn new(
         description: &Description,
         data: &'a Measured,
         params: &[FitParam],

@@ -17,6 +17,8 @@
 //! - [`em_fit`]: the fit of [JA 80] by replaying the measured voltage.
 //! - [`sensitivity`]: forward parameter sensitivities of a replay (the
 //!   fit's analytic Jacobian).
+//! - [`edge_fit`]: the fit with the voltage edges' instants among its
+//!   parameters.
 //! - [`identifiability`]: what the data can and cannot separate (SVD of the
 //!   scaled Jacobian), and the reduced model's parameters [JA 55], [JA 57], [JA 60].
 //! - [`gap_fit`]: the gap model fitted to a reluctance table [JA 75–77].
@@ -27,6 +29,7 @@
 use designer::{description, model, record, replay, sim, sym};
 
 pub mod diagnose;
+pub mod edge_fit;
 pub mod edges;
 pub mod edit;
 pub mod em_fit;
