@@ -52,8 +52,9 @@ pub(super) fn refit(steps: &mut [Diagnosis], data: &Measured, options: &FitOptio
     ) else {
         return false;
     };
-    let (polished, own) = polish::with_edges(Some(&candidate), &start, &data, k, options);
-    let fit = polished.unwrap_or(start);
+    let polished = polish::with_edges(Some(&candidate), &start, &data, k, options);
+    let (own, linearisation) = (polished.own, polished.linearisation);
+    let fit = polished.fit.unwrap_or(start);
     // (the fits saw the fitted part only: the rest may not replay)
     let Ok(replay) = crate::simulate_outputs(&fit.description, &own) else {
         return false;
@@ -62,7 +63,9 @@ pub(super) fn refit(steps: &mut [Diagnosis], data: &Measured, options: &FitOptio
     if !(error < last.whole.extended_wnrmse) {
         return false;
     }
-    last.propagated = polish::propagated_variances(Some(&candidate), &fit, &own.head(k), options);
+    let linearisation = linearisation.as_ref();
+    last.propagated =
+        polish::propagated_variances(Some(&candidate), &fit, &own.head(k), linearisation, options);
     last.whole = Gain::new(last.whole.baseline_wnrmse, error);
     last.held_out = (k < data.t.len()).then(|| {
         let base = &last.baseline_replay.current[k..];

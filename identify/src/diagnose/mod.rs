@@ -351,13 +351,13 @@ fn diagnose_step(
                 })
             }
             _ => {
-                // The named extension places the record's edges for itself,
-                // as the baseline did (eddy currents change the current's
-                // jump at a step), is fitted again on them, and is replayed
-                // on them for the report.
+                // The named extension is fitted again, the edges' instants
+                // with its values (eddy currents change the current's jump
+                // at a step), and is replayed for the report on the edges
+                // it places, as the baseline was.
                 let candidate = all_candidates.iter().find(|c| c.cause == scored.cause);
                 let refit_now = recalibrate && refit.is_none();
-                let ((named, own), refitted) = rayon::join(
+                let (polished, refitted) = rayon::join(
                     || polish::with_edges(candidate, fit, data, fitted_samples, &fit_options),
                     || {
                         refit_now.then(|| {
@@ -372,14 +372,25 @@ fn diagnose_step(
                     },
                 );
                 refit = refit.or(refitted);
-                let named = named.unwrap_or_else(|| fit.clone());
+                let own = polished.own;
+                let named = polished.fit.unwrap_or_else(|| fit.clone());
+                let linearisation = polished.linearisation.as_ref();
                 // The replay over the whole record and the propagation (on
                 // the fitted part) side by side; the propagation is wasted
                 // where the replay then rejects the cause (rare).
                 let own_fitted = own.head(fitted_samples);
                 let (extended_replay, propagated) = rayon::join(
                     || replay_own(&named.description, &own),
-                    || polish::propagated_variances(candidate, &named, &own_fitted, &fit_options),
+                    || {
+                        let (c, named) = (candidate, &named);
+                        polish::propagated_variances(
+                            c,
+                            named,
+                            &own_fitted,
+                            linearisation,
+                            &fit_options,
+                        )
+                    },
                 );
                 let extended_replay = extended_replay?;
                 // A cause that does not improve the whole record is never
