@@ -40,6 +40,13 @@ use crate::Measured;
 /// which answers the voltage at once, would jump.
 const INSIDE: f64 = 1e-3;
 
+/// The most edges whose instants are fitted: one column of the Jacobian
+/// each (a record of thousands of steps, e.g. a slow PWM, would make it
+/// hundreds of MB). Beyond, every edge stays where it was placed and only
+/// the values are fitted. (The diagnose benchmark's 44 309-sample records
+/// hold 17 in their fitted part.)
+pub const MAX_FITTED_EDGES: usize = 64;
+
 /// The placed edges of a record, and which of them are fitted.
 struct Instants<'a> {
     data: &'a Measured,
@@ -52,9 +59,12 @@ struct Instants<'a> {
 impl<'a> Instants<'a> {
     fn of(data: &'a Measured) -> Instants<'a> {
         let placed = data.edges.clone().unwrap_or_default();
-        let free = (0..placed.len())
+        let mut free: Vec<usize> = (0..placed.len())
             .filter(|&n| placed[n].located && placed[n].k + 1 < data.len())
             .collect();
+        if free.len() > MAX_FITTED_EDGES {
+            free.clear();
+        }
         Instants { data, placed, free }
     }
 
@@ -124,8 +134,8 @@ pub struct EdgeFit {
 }
 
 /// Fits `params` of `description` and the instants of `data`'s located
-/// edges together (one start: the description's values and the placed
-/// instants).
+/// edges together (at most [`MAX_FITTED_EDGES`]). One start, whatever
+/// `options.starts`: the description's values and the placed instants.
 pub fn fit_with_edges(
     description: &Description,
     data: &Measured,

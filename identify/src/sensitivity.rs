@@ -626,8 +626,10 @@ pub fn forward<I: Input + ?Sized>(
     forward_with_steps(model, paths, &[], trajectory, input)
 }
 
-/// [`forward`] with one more column per step of `steps` (in order of time,
-/// each a breakpoint of `input`): the sensitivities to its instant.
+/// [`forward`] with one more column per step of `steps`: the sensitivities
+/// to its instant. The steps must be in order of time and each a
+/// breakpoint of `input` where it steps from `before` to `after` (else the
+/// jumps are applied late, or where the trajectory has none).
 pub fn forward_with_steps<I: Input + ?Sized>(
     model: &mut Model,
     paths: &[&str],
@@ -635,6 +637,10 @@ pub fn forward_with_steps<I: Input + ?Sized>(
     trajectory: &Trajectory,
     input: &I,
 ) -> Result<OutputSensitivities, Unsupported> {
+    debug_assert!(
+        steps.windows(2).all(|w| w[0].t <= w[1].t),
+        "steps out of order"
+    );
     let mut theta = symbols(model, paths)?;
     let first_step = theta.len();
     theta.extend(steps.iter().map(|_| Theta::StepInstant));

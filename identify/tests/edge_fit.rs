@@ -142,3 +142,29 @@ fn edges_the_current_could_not_place_stay_where_they_are() {
         .filter(|e| (e.tau - data.t[e.k] - 0.5 * DT).abs() > 1e-3 * DT);
     assert_eq!(moved.count(), 8);
 }
+
+/// Beyond `MAX_FITTED_EDGES` (a slow PWM) the instants stay where they were
+/// placed and only the values are fitted: the Jacobian keeps its size.
+#[test]
+fn many_edges_are_held_where_they_were_placed() {
+    use reldesign_identify::edge_fit::MAX_FITTED_EDGES;
+    let mut data = measured();
+    let n = data.len();
+    data.v = (0..n)
+        .map(|k| if (k / 20) % 2 == 0 { 24.0 } else { 0.0 })
+        .collect();
+    data.edges = Some(
+        (1..n / 20)
+            .map(|m| Edge {
+                k: 20 * m - 1,
+                tau: data.t[20 * m - 1] + 0.5 * DT,
+                located: true,
+            })
+            .collect(),
+    );
+    assert!(data.edges.as_ref().unwrap().len() > MAX_FITTED_EDGES);
+    let (start, fitted) = params();
+    let joint = fit_with_edges(&start, &data, &fitted, &no_flux()).unwrap();
+    assert_eq!(joint.jacobian.ncols(), 2);
+    assert_eq!(Some(&joint.edges), data.edges.as_ref());
+}

@@ -176,11 +176,13 @@ pub struct Diagnosis {
     /// (every candidate's replay uses them; the extended model's final
     /// replay places its own).
     pub edges: Vec<Edge>,
-    /// The named cause's fit, polished on the record's edges as the
-    /// extension places them (None for `none`).
+    /// The named cause's fit, polished with the instants of the record's
+    /// edges fitted beside its values (None for `none`).
     pub named_fit: Option<FitReport>,
-    /// Variances of the named values from the voltage noise and the edge
-    /// placement (`polish::propagated_variances`), in the fit's order.
+    /// Variances of the named values from the voltage and current noise
+    /// drawn again, the edges at their fitted instants (or, where the polish
+    /// failed, the voltage noise and the edges placed again)
+    /// (`polish::propagated_variances`), in the fit's order.
     pub propagated: Option<Vec<f64>>,
     /// The named cause's candidate: what its fit varied, within which bounds
     /// (None for `none`).
