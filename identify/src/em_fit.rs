@@ -376,6 +376,12 @@ impl<'a> Objective<'a> {
         Ok(self.residuals_of(d, &simulate_with(d, self.data, &self.budget)?))
     }
 
+    /// The |φ̇| weights of the current's residuals and their norm √(Σ w·i²):
+    /// the current's row k of the residuals is √w_k·(i_sim − i_k)/norm.
+    pub(crate) fn current_weights(&self) -> (&[f64], f64) {
+        (&self.weights, self.current_norm)
+    }
+
     /// [`residuals`](Self::residuals) of the signals `out` of `d`.
     pub(crate) fn residuals_of(&self, d: &Description, out: &SimOutputs) -> Vec<f64> {
         let sw: Vec<f64> = self.weights.iter().map(|w| w.sqrt()).collect();

@@ -264,7 +264,7 @@ fn full_matrix() {
 /// Misses the whole matrix allows: the one nested confusion it has
 /// (a saturation on the perfect-tracking valve's pulses with `z`, answered
 /// hysteresis: docs/validation/diagnose.md). Every recovered value lies
-/// within 3 standard errors (measured: at most 2.4; one at 3.1 before the
+/// within 3 standard errors (measured: at most 2.3; one at 3.1 before the
 /// polish fitted the edges' instants).
 const FULL_MATRIX_MISSES: usize = 1;
 

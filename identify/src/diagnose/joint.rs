@@ -65,7 +65,7 @@ pub(super) fn refit(steps: &mut [Diagnosis], data: &Measured, options: &FitOptio
     }
     let linearisation = linearisation.as_ref();
     last.propagated =
-        polish::propagated_variances(Some(&candidate), &fit, &own.head(k), linearisation, options);
+        polish::propagated(Some(&candidate), &fit, &own.head(k), linearisation, options);
     last.whole = Gain::new(last.whole.baseline_wnrmse, error);
     last.held_out = (k < data.t.len()).then(|| {
         let base = &last.baseline_replay.current[k..];

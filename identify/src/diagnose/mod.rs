@@ -179,11 +179,9 @@ pub struct Diagnosis {
     /// The named cause's fit, polished with the instants of the record's
     /// edges fitted beside its values (None for `none`).
     pub named_fit: Option<FitReport>,
-    /// Variances of the named values from the voltage and current noise
-    /// drawn again, the edges at their fitted instants (or, where the polish
-    /// failed, the voltage noise and the edges placed again)
-    /// (`polish::propagated_variances`), in the fit's order.
-    pub propagated: Option<Vec<f64>>,
+    /// What the named values' standard errors take from beyond the
+    /// residual scale (`polish::propagated`).
+    pub propagated: Option<Propagated>,
     /// The named cause's candidate: what its fit varied, within which bounds
     /// (None for `none`).
     pub named_candidate: Option<Candidate>,
@@ -385,13 +383,7 @@ fn diagnose_step(
                     || replay_own(&named.description, &own),
                     || {
                         let (c, named) = (candidate, &named);
-                        polish::propagated_variances(
-                            c,
-                            named,
-                            &own_fitted,
-                            linearisation,
-                            &fit_options,
-                        )
+                        polish::propagated(c, named, &own_fitted, linearisation, &fit_options)
                     },
                 );
                 let extended_replay = extended_replay?;
@@ -766,6 +758,19 @@ fn eligible(ranking: &[Scored], noise_floor: f64, floor_factor: f64) -> Vec<&Sco
         .collect()
 }
 
+/// Variances of the named values (in the fit's order) that the fit's
+/// residual scale does not give.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Propagated {
+    /// From the voltage noise the replay integrates, drawn again (and,
+    /// where the polish failed, from the edges placed again on currents
+    /// with fresh noise).
+    pub drawn: Vec<f64>,
+    /// From the current's white noise where the fit weighs it, with the
+    /// edges' instants fitted (None where the polish failed).
+    pub current: Option<Vec<f64>>,
+}
+
 /// One fitted parameter of the named cause's extension.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FittedParameter {
@@ -777,7 +782,8 @@ pub struct FittedParameter {
     /// σ = ‖r‖/√(n − p) (the noise as the data show it), widened by √τ_int,
     /// the integrated autocorrelation time of the weighted current residual
     /// (residuals that are not white carry fewer independent samples than
-    /// there are).
+    /// there are), or the current's noise where the fit weighs it if larger,
+    /// and the voltage noise's part in quadrature ([`Propagated`]).
     pub std_error: f64,
     /// The baseline description's value (None where the baseline's model has
     /// no such key, e.g. `core.m_sat` of a new Jiles–Atherton core).
@@ -801,13 +807,10 @@ impl Diagnosis {
             .map(|(j, (path, value))| FittedParameter {
                 path: path.clone(),
                 value: *value,
-                std_error: (widen * value.abs() * rel.get(j).copied().unwrap_or(f64::INFINITY))
-                    .hypot(
-                        self.propagated
-                            .as_ref()
-                            .and_then(|v| v.get(j))
-                            .map_or(0.0, |v| v.sqrt()),
-                    ),
+                std_error: self.std_error(
+                    j,
+                    widen * value.abs() * rel.get(j).copied().unwrap_or(f64::INFINITY),
+                ),
                 baseline: crate::params::get(baseline, path).ok(),
             })
             .collect()
@@ -815,6 +818,17 @@ impl Diagnosis {
 }
 
 impl Diagnosis {
+    /// The standard error of the `j`-th named value whose residual-scale
+    /// standard error is `white`: the larger of it and the current's noise
+    /// where the fit weighs it (both hold that noise), and the drawn part in
+    /// quadrature.
+    fn std_error(&self, j: usize, white: f64) -> f64 {
+        let sd = |v: Option<&Vec<f64>>| v.and_then(|v| v.get(j)).map_or(0.0, |v| v.sqrt());
+        let p = self.propagated.as_ref();
+        let current = sd(p.and_then(|p| p.current.as_ref()));
+        white.max(current).hypot(sd(p.map(|p| &p.drawn)))
+    }
+
     /// √τ_int of the |φ̇|-weighted current residual of the extended model
     /// over the fitted samples: the residuals of a model that misses the data
     /// slightly are correlated over many samples, and carry τ_int times fewer

@@ -15,26 +15,23 @@
 //! third a round, −0.47 % from the hidden value after three rounds; fitted
 //! together, +0.011 %.)
 //!
-//! The standard errors: the fit's are marginal over the edges' instants
-//! (the current's noise moves both). What the residual scale does not hold
-//! is propagated ([`propagated_variances`]): the voltage noise the replay
-//! integrates, and the current's noise where the fit weighs it (most after
-//! the edges, where |φ̇| is large: a residual scale averaged over the record
-//! underrates it there). Each draw adds fresh noise of the record's own σ_v
-//! and σ_i and maps the change of the residuals at the named values onto
-//! the values and instants through the joint Jacobian's pseudo-inverse:
-//! δθ = J⁺·δr, linearised as the fit is. The current's noise is then in
-//! both terms, which `Diagnosis::parameters` adds in quadrature: counted
-//! twice, on the safe side (81 % of the diagnose matrix's values within one
-//! standard error, where 68 % would be calibrated). White's
-//! heteroscedasticity-consistent estimate from the residuals in place of
-//! both was tried: 94 % within one (it also holds the voltage noise the
-//! residuals carry, which the draws count again).
+//! The standard errors ([`propagated`]): the fit's are marginal over the
+//! edges' instants (the current's noise moves both). Beside them, the
+//! current's white noise where the fit weighs it ([`current_noise_variances`],
+//! analytic: most after the edges, where |φ̇| is large and a residual scale
+//! averaged over the record underrates it); `Diagnosis::parameters` takes
+//! the larger of the two, since both hold that noise (the residual scale
+//! also holds what the model misses). And what no residual holds, drawn
+//! ([`propagated_variances`]): the voltage noise the replay integrates.
+//! Each draw adds fresh noise of the record's own σ_v and maps the change of
+//! the residuals at the named values (the measured current kept) onto the
+//! values and instants through the joint Jacobian's pseudo-inverse:
+//! δθ = J⁺·δr, linearised as the fit is.
 
 use rayon::prelude::*;
 
 use super::candidate::Candidate;
-use super::{rank, Cause};
+use super::{rank, Cause, Propagated};
 use nalgebra::DMatrix;
 
 use crate::edge_fit::EdgeFit;
@@ -145,13 +142,62 @@ const DRAWS: usize = 4;
 /// Seed of the propagation's noise (fixed: the same record, the same report).
 const PROPAGATION_SEED: u64 = 0x0DDB_A11;
 
+/// What the named values' standard errors take from beyond the residual
+/// scale: the voltage noise drawn, and with the polish's linearisation the
+/// current's noise where the fit weighs it.
+pub(super) fn propagated(
+    candidate: Option<&Candidate>,
+    named: &FitReport,
+    own: &Measured,
+    linearisation: Option<&(Measured, DMatrix<f64>)>,
+    options: &FitOptions,
+) -> Option<Propagated> {
+    let drawn = propagated_variances(candidate, named, own, linearisation, options)?;
+    let current = linearisation.and_then(|(fitted, jacobian)| {
+        current_noise_variances(candidate?, named, fitted, jacobian, options)
+    });
+    Some(Propagated { drawn, current })
+}
+
+/// Variance of each named value from the current's white noise of the
+/// record's σ_i, where the fit weighs it: the current's rows of the
+/// residuals are √w_k·(i_sim − i_k)/‖i‖_w, so Var θ_j = σ_i²/‖i‖_w²·Σ_k
+/// (J⁺)_jk²·w_k, J the joint Jacobian at `fitted` (its rows the current's
+/// first). The fit weighs the samples after the edges most (|φ̇| is large
+/// there), where the residual scale, averaged over the record, underrates
+/// the noise.
+fn current_noise_variances(
+    candidate: &Candidate,
+    named: &FitReport,
+    fitted: &Measured,
+    jacobian: &DMatrix<f64>,
+    options: &FitOptions,
+) -> Option<Vec<f64>> {
+    let setup = crate::em_fit::Setup::new(&named.description, fitted, &candidate.params, options);
+    let setup = setup.ok()?;
+    let (weights, norm) = setup.objective.current_weights();
+    let pinv = values_pseudo_inverse(jacobian, &named.values)?;
+    if pinv.ncols() < weights.len() {
+        return None;
+    }
+    let scale = (rank::noise_std(&fitted.i) / norm).powi(2);
+    let variance = |j: usize| -> f64 {
+        let sum: f64 = (weights.iter().enumerate())
+            .map(|(k, w)| pinv[(j, k)].powi(2) * w)
+            .sum();
+        scale * sum
+    };
+    Some((0..pinv.nrows()).map(variance).collect())
+}
+
 /// Variance of each named value from the voltage noise and, where the edges
 /// were not fitted with the values (`linearisation` None: the polish
-/// failed), the edge placement, in the order of `named.values` (None: not
-/// computable). With the polish's linearisation the edges stay at their
-/// fitted instants, the current's noise is drawn too, and each draw's change
-/// of the residuals is mapped onto the values and the instants together.
-pub(super) fn propagated_variances(
+/// failed), the current's noise through the edges placed again, in the
+/// order of `named.values` (None: not computable). With the polish's
+/// linearisation the edges stay at their fitted instants and each draw's
+/// change of the residuals is mapped onto the values and the instants
+/// together.
+fn propagated_variances(
     candidate: Option<&Candidate>,
     named: &FitReport,
     own: &Measured,
@@ -179,20 +225,12 @@ pub(super) fn propagated_variances(
     let draw = |draw: u64| -> Option<Vec<f64>> {
         let seed = PROPAGATION_SEED.wrapping_add(2 * draw);
         let v = rank::with_noise(&own.v, sigma_v, seed);
-        let i = rank::with_noise(&own.i, sigma_i, seed + 1);
         let perturbed = match jacobian {
-            // the current's noise too: the fit weighs the samples after
-            // the edges most, where |φ̇| is large, and a residual scale
-            // averaged over the record underrates what noise does there
-            Some(_) => Measured {
-                v,
-                i,
-                ..own.clone()
-            },
+            Some(_) => Measured { v, ..own.clone() },
             None => {
                 let noisy = Measured {
                     v: v.clone(),
-                    i,
+                    i: rank::with_noise(&own.i, sigma_i, seed + 1),
                     edges: None,
                     ..own.clone()
                 };
