@@ -1,7 +1,7 @@
 //! The fit of [JA 80] with the instants of the record's voltage edges among
 //! its parameters.
 //!
-//! An edge's instant τ is placed with a model ([`edges::located`]) and the
+//! An edge's instant τ is placed with a model ([`crate::edges::located`]) and the
 //! model's values are fitted on the placed edges: the two depend on each
 //! other. Alternating them converges slowly where they are coupled (on the
 //! hidden-fringing benchmark record the winding length still moves by 33
@@ -13,7 +13,9 @@
 //! ([`sensitivity::forward_with_steps`]: x jumps by (f⁻ − f⁺)·δτ there).
 //!
 //! An edge is parametrised by where it falls in its sample interval,
-//! y = 1 + (τ − t_k)/Δt in [1, 2] (of order one, for the solver's scaling).
+//! y = 1 + (τ − t_k)/Δt (of order one, for the solver's scaling), kept
+//! [`INSIDE`] of a sample from either end: at t_k itself the replay would
+//! step the input at the sample, a cost with a step at the bound.
 //! Edges placed at the midpoint (`located == false`: the current could not
 //! place them) stay there.
 //!
@@ -26,19 +28,13 @@ use std::cell::{Cell, RefCell};
 use nalgebra::DMatrix;
 
 use crate::description::Description;
-use crate::edges::Edge;
+use crate::edges::{Edge, INSIDE};
 use crate::em_fit::{self, FitError, FitOptions, FitParam, FitReport, Sensitivities};
 use crate::identifiability::Sensitivity;
 use crate::lm;
 use crate::sensitivity::{self, InputStep};
 use crate::sim::Trajectory;
 use crate::Measured;
-
-/// How far inside its interval an edge stays (fraction of a sample): at
-/// t_k itself the input's value at the sample would be the step's after
-/// value (the right limit), and with eddy currents the current there,
-/// which answers the voltage at once, would jump.
-const INSIDE: f64 = 1e-3;
 
 /// The most edges whose instants are fitted: one column of the Jacobian
 /// each (a record of thousands of steps, e.g. a slow PWM, would make it

@@ -42,6 +42,12 @@ const EDGE_SPAN_FRACTION: f64 = 0.05;
 /// and the neighbouring steps are below this fraction of it (a step, not
 /// a fast ramp or a PWM burst).
 const FLAT_FRACTION: f64 = 0.2;
+/// How far inside its sample interval a placed edge stays (fraction of a
+/// sample): at t_k itself the replayed input's value at that sample would be
+/// the step's after value (the right limit at a jump), and with eddy
+/// currents the current there, which answers the voltage at once, would
+/// jump a sample early.
+pub const INSIDE: f64 = 1e-3;
 /// τ is kept when its standard error is below this fraction of a sample:
 /// the midpoint's own error, uniform over ±½ sample, has an RMS of
 /// 1/√12 ≈ 0.29 sample, so a kept τ is at least twice as good.
@@ -267,7 +273,7 @@ fn place(plant: &ModelPlant, data: &Measured, at: &Replayed, end: usize) -> Opti
     let centre = coarse.clamp(h, 1.0 - h);
     let fine = [centre - h, centre, centre + h];
     let costs: Option<Vec<f64>> = fine.iter().map(|&f| cost(f)).collect();
-    let frac = parabola_minimum(&fine, &costs?)?.clamp(0.0, 1.0);
+    let frac = parabola_minimum(&fine, &costs?)?.clamp(INSIDE, 1.0 - INSIDE);
     Some(t0 + frac * dt)
 }
 
@@ -380,7 +386,7 @@ fn locate(data: &Measured, k: usize, lo: usize, hi: usize, gain: f64) -> Edge {
     }
     Edge {
         k,
-        tau: (mid + x * dt).clamp(t0, t1),
+        tau: (mid + x * dt).clamp(t0 + INSIDE * dt, t1 - INSIDE * dt),
         located: true,
     }
 }
@@ -516,6 +522,33 @@ mod tests {
         assert_eq!(input.value(tau - 0.01 * dt), 0.0);
         assert_eq!(input.value(tau + 0.01 * dt), 12.0);
         assert_eq!(input.value(data.t[50]), 0.0);
+    }
+
+    /// A step right after a sample (or right before the next) stays
+    /// [`INSIDE`] the interval: the replay's input at either sample is that
+    /// sample's own voltage.
+    #[test]
+    fn an_edge_at_a_sample_stays_inside_its_interval() {
+        use crate::sim::Input;
+        let dt = 40e-6;
+        for frac in [1e-9, 1.0 - 1e-9] {
+            let data = rl_record(50.0 * dt + frac * dt, dt);
+            let e = edges(&data, CurrentJump::NONE);
+            assert_eq!(e.len(), 1, "{frac}: {e:?}");
+            let (t0, t1) = (data.t[e[0].k], data.t[e[0].k + 1]);
+            let inside = INSIDE * dt * (1.0 - 1e-9);
+            assert!(
+                e[0].tau >= t0 + inside && e[0].tau <= t1 - inside,
+                "{frac}: {e:?}"
+            );
+            let input = replay_input(&Measured {
+                edges: Some(e.clone()),
+                ..data.clone()
+            })
+            .unwrap();
+            assert_eq!(input.value(t0), data.v[e[0].k], "{frac}");
+            assert_eq!(input.value(t1), data.v[e[0].k + 1], "{frac}");
+        }
     }
 
     #[test]
