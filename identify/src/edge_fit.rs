@@ -10,7 +10,7 @@
 //! second and third). Here the Levenberg–Marquardt solver moves both at
 //! once: each placed edge's instant is one more parameter, its column of
 //! the Jacobian the sensitivity to the instant of a step of the input
-//! ([`sensitivity::forward_with_steps`]: x jumps by (f⁻ − f⁺)·δτ there).
+//! ([`crate::sensitivity::forward_with_steps`]: x jumps by (f⁻ − f⁺)·δτ there).
 //!
 //! An edge is parametrised by where it falls in its sample interval,
 //! y = 1 + (τ − t_k)/Δt (of order one, for the solver's scaling), kept
@@ -23,8 +23,6 @@
 //! samples' trapezoid, which knows nothing of the edges: it pulls the
 //! instants towards the midpoints. The diagnosis fits the current alone.
 
-use std::cell::{Cell, RefCell};
-
 use nalgebra::DMatrix;
 
 use crate::description::Description;
@@ -32,8 +30,7 @@ use crate::edges::{Edge, INSIDE};
 use crate::em_fit::{self, FitError, FitOptions, FitParam, FitReport, Sensitivities};
 use crate::identifiability::Sensitivity;
 use crate::lm;
-use crate::sensitivity::{self, InputStep};
-use crate::sim::Trajectory;
+use crate::sensitivity::InputStep;
 use crate::Measured;
 
 /// The most edges whose instants are fitted: one column of the Jacobian
@@ -146,8 +143,7 @@ pub fn fit_with_edges(
         .chain(instants.free.iter().map(|_| (1.0 + INSIDE, 2.0 - INSIDE)))
         .collect();
     let paths: Vec<&str> = params.iter().map(|q| q.path.as_str()).collect();
-    let analytic = options.sensitivities == Sensitivities::Analytic
-        && sensitivity::check(description, &paths).is_ok();
+    let analytic = em_fit::analytic_jacobian(description, &paths, options);
     let budget = setup.objective.budget;
     let split = |y: &[f64]| -> Option<(Description, Measured)> {
         let d = em_fit::with_values(description, params, &y[..p]).ok()?;
@@ -166,28 +162,22 @@ pub fn fit_with_edges(
                 .residuals_of(&d, &em_fit::outputs(&d, &replay)),
         )
     };
-    // As in `em_fit::fit`: the Jacobian reuses the replay of the point the
-    // solver just evaluated.
-    let last: RefCell<Option<(Vec<f64>, Trajectory)>> = RefCell::new(None);
-    let jacobian_replays = Cell::new(0);
+    let kept = em_fit::KeptReplay::default();
     let keeping = |y: &[f64]| {
         let (d, _, replay) = replayed(y)?;
         let r = setup
             .objective
             .residuals_of(&d, &em_fit::outputs(&d, &replay));
-        *last.borrow_mut() = Some((y.to_vec(), replay.trajectory));
+        kept.keep(y, replay.trajectory);
         Some(r)
     };
     let jacobian = |y: &[f64]| {
         let (d, driven) = split(y)?;
-        let kept = last.borrow_mut().take().filter(|(at, _)| at == y);
-        let trajectory = match kept {
-            Some((_, trajectory)) => trajectory,
-            None => {
-                jacobian_replays.set(jacobian_replays.get() + 1);
-                em_fit::replay(&d, &driven, &budget).ok()?.trajectory
-            }
-        };
+        let trajectory = kept.at(y, || {
+            em_fit::replay(&d, &driven, &budget)
+                .ok()
+                .map(|r| r.trajectory)
+        })?;
         let steps = instants.steps(driven.edges.as_deref()?);
         let mut j =
             (setup.objective).jacobian_with_steps(&d, &paths, &steps, &driven, &trajectory)?;
@@ -227,7 +217,7 @@ pub fn fit_with_edges(
         nrmse_position: errors.position,
         cost: 2.0 * report.cost,
         iterations: report.iterations,
-        simulations: report.evaluations + 1 + jacobian_replays.get(),
+        simulations: report.evaluations + 1 + kept.replays(),
         sensitivities: match analytic {
             true => Sensitivities::Analytic,
             false => Sensitivities::FiniteDifference,

@@ -536,8 +536,7 @@ pub fn fit(
     let (start0, bounds) = (&setup.x0, &setup.bounds);
     let residual = |theta: &[f64]| setup.residuals(description, params, theta);
     let paths: Vec<&str> = params.iter().map(|p| p.path.as_str()).collect();
-    let analytic = options.sensitivities == Sensitivities::Analytic
-        && sensitivity::check(description, &paths).is_ok();
+    let analytic = analytic_jacobian(description, &paths, options);
     let lm_options = lm_options(options);
     let starts = options.starts.max(1);
     // The starts in parallel (each on its own replays), reduced in their
@@ -551,28 +550,21 @@ pub fn fit(
                 objective: 2.0 * it.cost,
             })
         };
-        // The analytic Jacobian reuses the replay of the residuals at the
-        // same θ (the solver asks for J at the point it just evaluated and
-        // accepted).
-        let last: RefCell<Option<(Vec<f64>, Trajectory)>> = RefCell::new(None);
-        let jacobian_replays = Cell::new(0);
+        let kept = KeptReplay::default();
         let keeping = |theta: &[f64]| {
             let d = with_values(description, params, theta).ok()?;
             let replay = replay(&d, data, &setup.objective.budget).ok()?;
             let r = setup.objective.residuals_of(&d, &outputs(&d, &replay));
-            *last.borrow_mut() = Some((theta.to_vec(), replay.trajectory));
+            kept.keep(theta, replay.trajectory);
             Some(r)
         };
         let jacobian = |theta: &[f64]| {
             let d = with_values(description, params, theta).ok()?;
-            let kept = last.borrow_mut().take().filter(|(t, _)| t == theta);
-            let trajectory = match kept {
-                Some((_, trajectory)) => trajectory,
-                None => {
-                    jacobian_replays.set(jacobian_replays.get() + 1);
-                    replay(&d, data, &setup.objective.budget).ok()?.trajectory
-                }
-            };
+            let trajectory = kept.at(theta, || {
+                replay(&d, data, &setup.objective.budget)
+                    .ok()
+                    .map(|r| r.trajectory)
+            })?;
             // none (or not finite): `lm` differences the residual instead
             setup.objective.jacobian(&d, &paths, &trajectory)
         };
@@ -582,7 +574,7 @@ pub fn fit(
             }
             false => lm::minimize(residual, x0, bounds, &lm_options, &mut monitor),
         };
-        (result, jacobian_replays.get())
+        (result, kept.replays())
     };
     let points = start_points(start0, params, starts, options.seed);
     let results: Vec<_> = points.par_iter().enumerate().map(solve).collect();
@@ -638,6 +630,49 @@ pub fn fit(
         best_start,
         differenced_jacobians: differenced,
     })
+}
+
+/// Whether the fit of `paths` of `d` takes the analytic Jacobian (asked for,
+/// and every parameter has a sensitivity).
+pub(crate) fn analytic_jacobian(d: &Description, paths: &[&str], options: &FitOptions) -> bool {
+    options.sensitivities == Sensitivities::Analytic && sensitivity::check(d, paths).is_ok()
+}
+
+/// The replay of the point the solver last evaluated, for the analytic
+/// Jacobian it asks for next at the same point (it asks for J where it has
+/// just evaluated and accepted); any other point is replayed again, and
+/// counted.
+#[derive(Default)]
+pub(crate) struct KeptReplay {
+    last: RefCell<Option<(Vec<f64>, Trajectory)>>,
+    replays: Cell<usize>,
+}
+
+impl KeptReplay {
+    /// Keeps the trajectory replayed at `at`.
+    pub(crate) fn keep(&self, at: &[f64], trajectory: Trajectory) {
+        *self.last.borrow_mut() = Some((at.to_vec(), trajectory));
+    }
+
+    /// The trajectory kept at `at`, or else `replay`'s.
+    pub(crate) fn at(
+        &self,
+        at: &[f64],
+        replay: impl FnOnce() -> Option<Trajectory>,
+    ) -> Option<Trajectory> {
+        match self.last.borrow_mut().take().filter(|(kept, _)| kept == at) {
+            Some((_, trajectory)) => Some(trajectory),
+            None => {
+                self.replays.set(self.replays.get() + 1);
+                replay()
+            }
+        }
+    }
+
+    /// Replays made for a Jacobian (none kept at its point).
+    pub(crate) fn replays(&self) -> usize {
+        self.replays.get()
+    }
 }
 
 /// The solver's settings of a fit.
