@@ -22,7 +22,7 @@
 //! averaged over the record underrates it); `Diagnosis::parameters` takes
 //! the larger of the two, since both hold that noise (the residual scale
 //! also holds what the model misses). And what no residual holds, drawn
-//! ([`propagated_variances`]): the voltage noise the replay integrates.
+//! ([`drawn_variances`]): the voltage noise the replay integrates.
 //! Each draw adds fresh noise of the record's own σ_v and maps the change of
 //! the residuals at the named values (the measured current kept) onto the
 //! values and instants through the joint Jacobian's pseudo-inverse:
@@ -143,8 +143,11 @@ const DRAWS: usize = 4;
 const PROPAGATION_SEED: u64 = 0x0DDB_A11;
 
 /// What the named values' standard errors take from beyond the residual
-/// scale: the voltage noise drawn, and with the polish's linearisation the
-/// current's noise where the fit weighs it.
+/// scale (None: not computable). With the polish's linearisation (the
+/// joint Jacobian at the fitted edges): the voltage noise drawn, the edges
+/// held at their fitted instants, and the current's noise where the fit
+/// weighs it. Without (the polish failed): the voltage noise and the edges
+/// placed again on currents with fresh noise, drawn together.
 pub(super) fn propagated(
     candidate: Option<&Candidate>,
     named: &FitReport,
@@ -152,31 +155,63 @@ pub(super) fn propagated(
     linearisation: Option<&(Measured, DMatrix<f64>)>,
     options: &FitOptions,
 ) -> Option<Propagated> {
-    let drawn = propagated_variances(candidate, named, own, linearisation, options)?;
-    let current = linearisation.and_then(|(fitted, jacobian)| {
-        current_noise_variances(candidate?, named, fitted, jacobian, options)
-    });
-    Some(Propagated { drawn, current })
+    let c = candidate?;
+    let d = &named.description;
+    match linearisation {
+        Some((fitted, jacobian)) => {
+            let pinv = values_pseudo_inverse(jacobian, &named.values)?;
+            let r0 = crate::residuals_at(d, fitted, &c.params, options).ok()?;
+            let voltage = |v: Vec<f64>, _| Measured {
+                v,
+                ..fitted.clone()
+            };
+            let drawn = drawn_variances(c, d, fitted, (&pinv, &r0), options, voltage)?;
+            let current = current_noise_variances(c, named, fitted, &pinv, options);
+            Some(Propagated { drawn, current })
+        }
+        None => {
+            let (jacobian, r0) = crate::linearisation(d, own, &c.params, options).ok()?;
+            let pinv = jacobian.pseudo_inverse(1e-12).ok()?;
+            let sigma_i = rank::noise_std(&own.i);
+            let placed_again = |v: Vec<f64>, seed: u64| {
+                let noisy = Measured {
+                    v: v.clone(),
+                    i: rank::with_noise(&own.i, sigma_i, seed + 1),
+                    edges: None,
+                    ..own.clone()
+                };
+                Measured {
+                    v,
+                    edges: Some(crate::edges::located(d, &noisy)),
+                    ..own.clone()
+                }
+            };
+            let drawn = drawn_variances(c, d, own, (&pinv, &r0), options, placed_again)?;
+            Some(Propagated {
+                drawn,
+                current: None,
+            })
+        }
+    }
 }
 
 /// Variance of each named value from the current's white noise of the
 /// record's σ_i, where the fit weighs it: the current's rows of the
 /// residuals are √w_k·(i_sim − i_k)/‖i‖_w, so Var θ_j = σ_i²/‖i‖_w²·Σ_k
-/// (J⁺)_jk²·w_k, J the joint Jacobian at `fitted` (its rows the current's
-/// first). The fit weighs the samples after the edges most (|φ̇| is large
-/// there), where the residual scale, averaged over the record, underrates
-/// the noise.
+/// (J⁺)_jk²·w_k, `pinv` the values' rows of the joint Jacobian's
+/// pseudo-inverse at `fitted` (its columns the current's rows first). The
+/// fit weighs the samples after the edges most (|φ̇| is large there), where
+/// the residual scale, averaged over the record, underrates the noise.
 fn current_noise_variances(
     candidate: &Candidate,
     named: &FitReport,
     fitted: &Measured,
-    jacobian: &DMatrix<f64>,
+    pinv: &DMatrix<f64>,
     options: &FitOptions,
 ) -> Option<Vec<f64>> {
     let setup = crate::em_fit::Setup::new(&named.description, fitted, &candidate.params, options);
     let setup = setup.ok()?;
     let (weights, norm) = setup.objective.current_weights();
-    let pinv = values_pseudo_inverse(jacobian, &named.values)?;
     if pinv.ncols() < weights.len() {
         return None;
     }
@@ -190,63 +225,29 @@ fn current_noise_variances(
     Some((0..pinv.nrows()).map(variance).collect())
 }
 
-/// Variance of each named value from the voltage noise and, where the edges
-/// were not fitted with the values (`linearisation` None: the polish
-/// failed), the current's noise through the edges placed again, in the
-/// order of `named.values` (None: not computable). With the polish's
-/// linearisation the edges stay at their fitted instants and each draw's
-/// change of the residuals is mapped onto the values and the instants
-/// together.
-fn propagated_variances(
-    candidate: Option<&Candidate>,
-    named: &FitReport,
+/// Variance of each named value over [`DRAWS`] draws of fresh voltage noise
+/// of `own`'s σ_v, `perturbed(v, seed)` the record of each draw: the change
+/// of the residuals from `r0` mapped onto the values by `pinv`, δθ = J⁺·δr
+/// (None: a draw not computable).
+fn drawn_variances(
+    c: &Candidate,
+    d: &crate::description::Description,
     own: &Measured,
-    linearisation: Option<&(Measured, DMatrix<f64>)>,
+    (pinv, r0): (&DMatrix<f64>, &[f64]),
     options: &FitOptions,
+    perturbed: impl Fn(Vec<f64>, u64) -> Measured + Sync,
 ) -> Option<Vec<f64>> {
-    let c = candidate?;
-    let (own, jacobian) = match linearisation {
-        Some((fitted, jacobian)) => (fitted, Some(jacobian)),
-        None => (own, None),
-    };
-    let d = &named.description;
-    let (pinv, r0) = match jacobian {
-        Some(j) => (
-            values_pseudo_inverse(j, &named.values)?,
-            crate::residuals_at(d, own, &c.params, options).ok()?,
-        ),
-        None => {
-            let (jacobian, r0) = crate::linearisation(d, own, &c.params, options).ok()?;
-            (jacobian.pseudo_inverse(1e-12).ok()?, r0)
-        }
-    };
-    let (sigma_v, sigma_i) = (rank::noise_std(&own.v), rank::noise_std(&own.i));
+    let sigma_v = rank::noise_std(&own.v);
     // the draws in parallel, summed in their order (the same sum every run)
     let draw = |draw: u64| -> Option<Vec<f64>> {
         let seed = PROPAGATION_SEED.wrapping_add(2 * draw);
-        let v = rank::with_noise(&own.v, sigma_v, seed);
-        let perturbed = match jacobian {
-            Some(_) => Measured { v, ..own.clone() },
-            None => {
-                let noisy = Measured {
-                    v: v.clone(),
-                    i: rank::with_noise(&own.i, sigma_i, seed + 1),
-                    edges: None,
-                    ..own.clone()
-                };
-                Measured {
-                    v,
-                    edges: Some(crate::edges::located(d, &noisy)),
-                    ..own.clone()
-                }
-            }
-        };
+        let perturbed = perturbed(rank::with_noise(&own.v, sigma_v, seed), seed);
         let r = crate::residuals_at(d, &perturbed, &c.params, options).ok()?;
         if r.len() != r0.len() || r.len() != pinv.ncols() {
             return None;
         }
-        let dr = nalgebra::DVector::from_iterator(r.len(), r.iter().zip(&r0).map(|(a, b)| a - b));
-        Some((&pinv * dr).iter().map(|x| x * x).collect())
+        let dr = nalgebra::DVector::from_iterator(r.len(), r.iter().zip(r0).map(|(a, b)| a - b));
+        Some((pinv * dr).iter().map(|x| x * x).collect())
     };
     let draws: Vec<Vec<f64>> = (0..DRAWS as u64)
         .into_par_iter()
