@@ -165,10 +165,20 @@ pub struct OutputSensitivities {
 /// order (row-major blocks: f_x[i·d + k], f_θ[i·p + j]).
 struct Field {
     tape: Tape,
-    scratch: RefCell<Vec<f64>>,
+    /// The tape's scratch for the replay's samples, and one for the points
+    /// between them (Radau's stage, RK4's, events, steps): consecutive
+    /// evaluations at one sample (the end of an interval, its current's
+    /// row, the start of the next) then run the tape once
+    /// ([`Tape::eval`] skips what did not change).
+    at_samples: RefCell<Vec<f64>>,
+    between: RefCell<Vec<f64>>,
     out: RefCell<Vec<f64>>,
     d: usize,
     p: usize,
+    /// The columns of S that can be nonzero: the parameters', and those of
+    /// the steps whose jump is applied (a step's column is zero before its
+    /// instant, and its f_θ is zero: the flow leaves it zero).
+    live: std::cell::Cell<usize>,
     /// The column of the restitution γ, if fitted.
     restitution: Option<usize>,
     z_min: f64,
@@ -225,19 +235,30 @@ impl Field {
         let tape = model.compile(&exprs);
         let m = &model.description.mechanics;
         Field {
-            scratch: RefCell::new(tape.scratch()),
+            at_samples: RefCell::new(tape.scratch()),
+            between: RefCell::new(tape.scratch()),
             out: RefCell::new(vec![0.0; exprs.len()]),
             tape,
             d,
             p,
+            live: std::cell::Cell::new(p),
             restitution: theta.iter().position(|th| *th == Theta::Restitution),
             z_min: m.z_min,
             z_max: m.z_max,
         }
     }
 
-    /// Evaluates the tape at (t, x, u), z held inside the stops.
+    /// Evaluates the tape at a sample (t, x, u), z held inside the stops.
     fn eval(&self, t: f64, x: &[f64], u: f64) {
+        self.eval_on(&self.at_samples, t, x, u);
+    }
+
+    /// [`eval`](Self::eval) at a point between the samples.
+    fn eval_between(&self, t: f64, x: &[f64], u: f64) {
+        self.eval_on(&self.between, t, x, u);
+    }
+
+    fn eval_on(&self, scratch: &RefCell<Vec<f64>>, t: f64, x: &[f64], u: f64) {
         let mut inputs = [0.0; MAX_DIM + 2];
         inputs[..self.d].copy_from_slice(&x[..self.d]);
         inputs[0] = x[0].clamp(self.z_min, self.z_max);
@@ -246,14 +267,14 @@ impl Field {
         let n = self.d + 2;
         self.tape.eval(
             &inputs[..n],
-            &mut self.scratch.borrow_mut(),
+            &mut scratch.borrow_mut(),
             &mut self.out.borrow_mut(),
         );
     }
 
     /// The field at (t, x, u), mechanical rows zero when `stuck`.
     fn f(&self, t: f64, x: &[f64], u: f64, stuck: bool) -> [f64; MAX_DIM] {
-        self.eval(t, x, u);
+        self.eval_between(t, x, u);
         let out = self.out.borrow();
         std::array::from_fn(|i| match i < self.d && !(stuck && i < 2) {
             true => out[i],
@@ -273,7 +294,7 @@ impl Field {
         ds: &mut [f64],
     ) {
         let (d, p) = (self.d, self.p);
-        self.eval(t, x, u);
+        self.eval_between(t, x, u);
         let out = self.out.borrow();
         let (f, rest) = out.split_at(d);
         let (fx, rest) = rest.split_at(d * d);
@@ -281,7 +302,8 @@ impl Field {
         for i in 0..d {
             let frozen = stuck && i < 2;
             dx[i] = if frozen { 0.0 } else { f[i] };
-            for j in 0..p {
+            // (the other columns' rates stay zero)
+            for j in 0..self.live.get() {
                 ds[i * p + j] = match frozen {
                     true => 0.0,
                     false => {
@@ -427,7 +449,7 @@ impl Field {
         stuck: bool,
         work: &mut Work,
     ) -> bool {
-        let (d, p, h) = (self.d, self.p, t1 - t0);
+        let (d, p, h, live) = (self.d, self.p, t1 - t0, self.live.get());
         // (Radau IIA) c = (1/3, 1), A = [`RADAU`]
         const C1: f64 = 1.0 / 3.0;
         self.eval(t0, x0, piece.value(t0));
@@ -440,7 +462,7 @@ impl Field {
             false => 0.0,
         });
         let tm = t0 + C1 * h;
-        self.eval(tm, &xm, piece.value(tm));
+        self.eval_between(tm, &xm, piece.value(tm));
         let [a1, a2] = &mut work.a;
         let [b1, b2] = &mut work.b;
         let fm = self.linearisation(stuck, a1, b1);
@@ -461,10 +483,10 @@ impl Field {
         let (stage, forcing): ([&[f64]; 2], [&[f64]; 2]) = ([a1, a2], [b1, b2]);
         // the three-state models (a saturating core) in 6×6, not padded to 8×8
         match d {
-            3 => radau_stages::<3, 6>(h, (d, p), stage, forcing, s, &mut work.rhs3),
+            3 => radau_stages::<3, 6>(h, (d, p, live), stage, forcing, s, &mut work.rhs3),
             _ => radau_stages::<MAX_DIM, { 2 * MAX_DIM }>(
                 h,
-                (d, p),
+                (d, p, live),
                 stage,
                 forcing,
                 s,
@@ -535,7 +557,7 @@ const RADAU: [[f64; 2]; 2] = [[5.0 / 12.0, -1.0 / 12.0], [0.75, 0.25]];
 /// singular.
 fn radau_stages<const B: usize, const N: usize>(
     h: f64,
-    (d, p): (usize, usize),
+    (d, p, live): (usize, usize, usize),
     stage: [&[f64]; 2],
     forcing: [&[f64]; 2],
     s: &mut [f64],
@@ -556,7 +578,7 @@ where
     let Some(lu) = Some(m.lu()).filter(|lu| lu.is_invertible()) else {
         return false;
     };
-    for j in 0..p {
+    for j in 0..live {
         for r in 0..N {
             let (bi, i) = (r / B, r % B);
             rhs[(r, j)] = match i < d {
@@ -569,10 +591,10 @@ where
             };
         }
     }
-    if !lu.solve_mut(rhs) {
+    if !lu.solve_mut(&mut rhs.columns_mut(0, live)) {
         return false;
     }
-    for j in 0..p {
+    for j in 0..live {
         for i in 0..d {
             s[i * p + j] = rhs[(B + i, j)];
         }
@@ -673,6 +695,7 @@ pub fn forward_with_steps<I: Input + ?Sized>(
     let mut work = Work::new(d, p);
     // the next step whose jump is still to be applied
     let mut step = steps.iter().take_while(|e| e.t < tr.t[0]).count();
+    field.live.set(first_step + step);
     for k in 0..n - 1 {
         let t1 = tr.t[k + 1];
         let mut x = tr.x[k];
@@ -711,6 +734,7 @@ pub fn forward_with_steps<I: Input + ?Sized>(
                     s[i * p + first_step + step] += before[i] - after[i];
                 }
                 step += 1;
+                field.live.set(first_step + step);
             }
             let event = events.get(next).filter(|e| e.t <= t1);
             let b = input
@@ -777,10 +801,10 @@ mod tests {
             let mut rhs6 = nalgebra::OMatrix::<f64, nalgebra::Const<6>, nalgebra::Dyn>::zeros(p);
             let mut rhs8 =
                 nalgebra::OMatrix::<f64, nalgebra::Const<{ 2 * MAX_DIM }>, nalgebra::Dyn>::zeros(p);
-            let ok6 = radau_stages::<3, 6>(h, (d, p), stage, forcing, &mut s6, &mut rhs6);
+            let ok6 = radau_stages::<3, 6>(h, (d, p, p), stage, forcing, &mut s6, &mut rhs6);
             let ok8 = radau_stages::<MAX_DIM, { 2 * MAX_DIM }>(
                 h,
-                (d, p),
+                (d, p, p),
                 stage,
                 forcing,
                 &mut s8,
