@@ -87,6 +87,9 @@ pub struct FitOptions {
     /// iterations ([`lm::GiveUp`], in the solver's ½‖r‖²: half the report's
     /// `cost`).
     pub give_up: Option<lm::GiveUp>,
+    /// Fits only this one of the `starts` (0: the description's values),
+    /// drawn as always: the same fit as that start's among all of them.
+    pub only_start: Option<usize>,
 }
 
 /// How the fit's Jacobian is computed.
@@ -114,6 +117,7 @@ impl Default for FitOptions {
             sensitivities: Sensitivities::Analytic,
             stop: None,
             give_up: None,
+            only_start: None,
         }
     }
 }
@@ -577,12 +581,15 @@ pub fn fit(
         (result, kept.replays())
     };
     let points = start_points(start0, params, starts, options.seed);
-    let results: Vec<_> = points.par_iter().enumerate().map(solve).collect();
+    let results: Vec<_> = (points.par_iter().enumerate())
+        .filter(|(k, _)| options.only_start.is_none_or(|only| only == *k))
+        .map(|(k, x0)| (k, solve((k, x0))))
+        .collect();
     let mut best: Option<(usize, lm::Report)> = None;
     let (mut iterations, mut simulations, mut differenced) = (0, 0, 0);
     let mut jacobian_replays = 0;
     let mut last_error = None;
-    for (k, (result, replays)) in results.into_iter().enumerate() {
+    for (k, (result, replays)) in results {
         jacobian_replays += replays;
         match result {
             Ok(report) => {

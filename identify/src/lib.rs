@@ -17,6 +17,8 @@
 //! - [`em_fit`]: the fit of [JA 80] by replaying the measured voltage.
 //! - [`sensitivity`]: forward parameter sensitivities of a replay (the
 //!   fit's analytic Jacobian).
+//! - [`staged_fit`]: a fit's starts on the record's first pulses, the
+//!   best then on the whole (the diagnosis's ranking).
 //! - [`edge_fit`]: the fit with the voltage edges' instants among its
 //!   parameters.
 //! - [`identifiability`]: what the data can and cannot separate (SVD of the
@@ -39,6 +41,7 @@ pub mod lm;
 pub mod measured;
 pub use designer::description::params;
 pub mod sensitivity;
+pub mod staged_fit;
 pub mod weighted;
 
 pub use em_fit::{

@@ -8,8 +8,9 @@ use std::time::Instant;
 
 use designer::description::{parse_file, Description};
 use reldesign_identify::gap_fit::{fit_gap, reluctance_and_slope, GapModel, GapTable};
+use reldesign_identify::staged_fit::{first_pulses, fit_staged};
 use reldesign_identify::{
-    current_wnrmse, fit, params, reduced_parameters, simulate_outputs, FitOptions, FitParam,
+    current_wnrmse, edges, fit, params, reduced_parameters, simulate_outputs, FitOptions, FitParam,
     FitReport, Measured, Sensitivities,
 };
 use support::example_path;
@@ -500,4 +501,111 @@ fn parallel_starts_give_the_same_report_on_any_number_of_threads() {
         "every start iterates: {}",
         one.iterations
     );
+}
+
+/// A record of `periods` square-wave periods of the saturating valve at
+/// 20 µs, 400 samples each, its edges located by the truth.
+fn pulses(periods: usize, seed: u64) -> (Description, Measured) {
+    let truth = example("semera-valve.toml");
+    let (t, v) = square(30.0, 0.0, 8e-3, 20e-6, 400 * periods);
+    let mut data = synthetic(&truth, t, v, seed);
+    data.edges = Some(edges::located(&truth, &data));
+    (truth, data)
+}
+
+/// The first stage of a staged fit ends just before a voltage edge, past a
+/// quarter of the record, with two whole pulses (four edges) before it;
+/// none without located edges or where the record is too short.
+#[test]
+fn the_first_pulses_end_before_an_edge_past_a_quarter_of_the_record() {
+    let (_, data) = pulses(24, 3);
+    let n = data.len();
+    let end = first_pulses(&data).expect("a long record of pulses has first pulses");
+    let edges = data.edges.as_ref().unwrap();
+    assert!(n / 4 <= end && 2 * end <= n, "{end} of {n}");
+    assert!(
+        edges.iter().any(|e| e.k + 1 == end),
+        "{end}: not before an edge"
+    );
+    assert!(edges.iter().filter(|e| e.k + 1 < end).count() >= 4);
+    // the edge before it is before the quarter: the first edge past it
+    let before = edges.iter().filter(|e| e.k + 1 < end).last().unwrap();
+    assert!(before.k < n / 4, "{} ≥ {}", before.k, n / 4);
+
+    let unlocated = Measured {
+        edges: None,
+        ..data.clone()
+    };
+    assert_eq!(first_pulses(&unlocated), None);
+    let (_, short) = pulses(8, 3);
+    assert_eq!(first_pulses(&short), None, "3200 samples: one stage");
+}
+
+/// A staged fit races the starts on the first pulses and fits the winner
+/// alone on the whole record: its report is that start's one-stage fit bit
+/// for bit (`only_start`), at the whole record's best cost (here one of the
+/// three starts ends in a worse minimum, and two in the same one), with
+/// fewer replays of the whole record.
+#[test]
+fn a_staged_fit_gives_the_one_stage_fit_of_its_best_start() {
+    let (truth, data) = pulses(24, 11);
+    let changes = [
+        ("coil.resistance", 1.2),
+        ("core.phi_sat", 0.7),
+        ("core.r0", 1.4),
+    ];
+    let start = perturbed(&truth, &changes);
+    let fitted: Vec<FitParam> = changes
+        .iter()
+        .map(|(p, _)| bounds(&truth, p, 3.0, 3.0))
+        .collect();
+    let options = FitOptions {
+        starts: 3,
+        use_flux: false,
+        ..FitOptions::default()
+    };
+    let bits = |r: &FitReport| -> Vec<u64> {
+        let values = r.values.iter().map(|(_, v)| v.to_bits());
+        values
+            .chain([r.cost.to_bits(), r.wnrmse_current.to_bits()])
+            .collect()
+    };
+    let whole = fit(&start, &data, &fitted, &options, &|_| {}).unwrap();
+    let each: Vec<FitReport> = (0..3)
+        .map(|k| {
+            let only = FitOptions {
+                only_start: Some(k),
+                ..options.clone()
+            };
+            fit(&start, &data, &fitted, &only, &|_| {}).unwrap()
+        })
+        .collect();
+    let best = each.iter().map(|r| r.cost).fold(f64::INFINITY, f64::min);
+    let worst = each.iter().map(|r| r.cost).fold(0.0, f64::max);
+    assert!(
+        worst > 1.2 * best,
+        "a start the race must avoid: {worst:e} vs {best:e}"
+    );
+    assert_eq!(bits(&each[whole.best_start]), bits(&whole));
+    assert_eq!(each[whole.best_start].best_start, whole.best_start);
+
+    let staged = fit_staged(&start, &data, &fitted, &options).unwrap();
+    let alone = &each[staged.best_start];
+    assert_eq!(bits(&staged), bits(alone));
+    assert!(
+        staged.cost <= best * (1.0 + 1e-6),
+        "{:e} vs {best:e}",
+        staged.cost
+    );
+    eprintln!(
+        "best starts: one stage {}, staged {}; one stage {} iterations, {} replays; staged {} iterations, {} replays ({} of the whole record)",
+        whole.best_start,
+        staged.best_start,
+        whole.iterations,
+        whole.simulations,
+        staged.iterations,
+        staged.simulations,
+        alone.simulations
+    );
+    assert!(alone.simulations < whole.simulations);
 }

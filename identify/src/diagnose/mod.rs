@@ -622,7 +622,7 @@ fn score(c: &Candidate, data: &Measured, options: &FitOptions, n_eff: f64) -> Sc
         starts: c.starts,
         ..options.clone()
     };
-    let fit = crate::fit(&c.start, data, &c.params, &options, &|_| {});
+    let fit = crate::staged_fit::fit_staged(&c.start, data, &c.params, &options);
     let parameters = c.params.len();
     match fit {
         Ok(report) => {
