@@ -138,18 +138,34 @@ fn input_with(
     to: usize,
     edges: &[Edge],
 ) -> Result<PiecewiseLinear, InputError> {
+    let (t, sample) = knots_with(data, from, to, edges);
+    PiecewiseLinear::new(t, sample.iter().map(|&k| data.v[k]).collect())
+}
+
+/// The knots of [`replay_input`], and the sample whose voltage each one
+/// takes (a perturbation of the samples moves the input by the same
+/// knots: `sensitivity::InputPerturbations`).
+pub fn replay_knots(data: &Measured) -> (Vec<f64>, Vec<usize>) {
+    match data.len() {
+        0 => (Vec::new(), Vec::new()),
+        n => knots_with(data, 0, n - 1, data.edges.as_deref().unwrap_or(&[])),
+    }
+}
+
+/// The knots of [`input_with`] and their samples.
+fn knots_with(data: &Measured, from: usize, to: usize, edges: &[Edge]) -> (Vec<f64>, Vec<usize>) {
     let mut t = Vec::with_capacity(to + 1 - from + 2 * edges.len());
-    let mut v = Vec::with_capacity(to + 1 - from + 2 * edges.len());
+    let mut sample = Vec::with_capacity(t.capacity());
     let mut edges = edges.iter().skip_while(|e| e.k < from).peekable();
     for k in from..=to {
         t.push(data.t[k]);
-        v.push(data.v[k]);
+        sample.push(k);
         if let Some(e) = edges.next_if(|e| e.k == k && k < to) {
             t.extend([e.tau, e.tau]);
-            v.extend([data.v[k], data.v[k + 1]]);
+            sample.extend([k, k + 1]);
         }
     }
-    PiecewiseLinear::new(t, v)
+    (t, sample)
 }
 
 /// Samples after an edge that the placement compares: few, so that a

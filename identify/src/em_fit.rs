@@ -467,6 +467,45 @@ impl<'a> Objective<'a> {
         Some(jac)
     }
 
+    /// The residuals' linearised response to perturbations of the voltage's
+    /// samples (`columns`, one per sample of `driven` each), along the
+    /// replay of `d` on `driven`: one column per perturbation (None: not
+    /// computable, or the objective has the flux term, whose reference the
+    /// voltage moves too).
+    pub(crate) fn voltage_response(
+        &self,
+        d: &Description,
+        driven: &Measured,
+        columns: &[Vec<f64>],
+    ) -> Option<DMatrix<f64>> {
+        if self.flux_reference(d).is_some() {
+            return None;
+        }
+        let trajectory = replay(d, driven, &self.budget).ok()?.trajectory;
+        let input = super::edges::replay_input(driven).ok()?;
+        let (knots, sample) = super::edges::replay_knots(driven);
+        let perturbations = sensitivity::InputPerturbations {
+            knots: &knots,
+            sample: &sample,
+            columns,
+        };
+        let mut model = Model::build(d);
+        let s = sensitivity::input_response(&mut model, perturbations, &trajectory, &input).ok()?;
+        let (n, k) = (self.data.len(), columns.len());
+        let position = (self.position_norm.zip(self.data.z.as_ref())).map(|(norm, _)| s.z / norm);
+        let mut rows = DMatrix::zeros(n + position.as_ref().map_or(0, |z| z.nrows()), k);
+        for i in 0..n {
+            let sw = self.weights[i].sqrt() / self.current_norm;
+            for j in 0..k {
+                rows[(i, j)] = sw * s.current[(i, j)];
+            }
+        }
+        if let Some(z) = position {
+            rows.rows_mut(n, z.nrows()).copy_from(&z);
+        }
+        Some(rows)
+    }
+
     /// ∂φ_ref/∂θ for the parameter `path`: the integrated reference
     /// φ = ∫(v − R·i)/N depends on R and N, a flux linkage λ/N on N.
     fn flux_reference_derivative(&self, d: &Description, path: &str, phi: &[f64]) -> Vec<f64> {

@@ -36,6 +36,11 @@
 //!   voltage edge between samples, fitted by `edge_fit`) has f_θ = 0;
 //!   moving it later by δ holds u⁻ over [t_s, t_s + δ], so S jumps there
 //!   by f(x, u⁻) − f(x, u⁺) ([`forward_with_steps`]).
+//! - **Perturbations of the input** ([`input_response`]): a column per
+//!   perturbation δu(t) of the input (e.g. noise on the voltage's samples,
+//!   linear between the input's knots like u itself), f_θ = f_u·δu(t) and
+//!   i_θ = i_u·δu(t): the outputs' linear response, for the diagnosis's
+//!   propagation of the voltage noise.
 //! - **Jiles–Atherton core.** Its field switches with δ = sign φ̇ [JA 26],
 //!   but it is continuous there: Ḣ_c = dH_c/dB_c(δ)·φ̇/A_c [JA 33] is 0 on
 //!   both sides of φ̇ = 0, so the saltation term (f⁺ − f⁻)·τ vanishes and S
@@ -98,6 +103,45 @@ pub enum Theta {
     /// The instant of a step of the input ([`InputStep`]): f_θ = 0, and S
     /// jumps at the step.
     StepInstant,
+    /// A perturbation δu(t) of the input ([`InputPerturbations`]):
+    /// f_θ = f_u·δu(t), i_θ = i_u·δu(t).
+    Input,
+}
+
+/// Perturbations of a piecewise-linear input, one per column of
+/// [`input_response`]: the input runs linearly between its `knots` (a
+/// step is two knots at one instant), and column j moves its value at
+/// knot m by `columns[j][sample[m]]` (e.g. noise on the samples of a
+/// measured voltage, `sample[m]` the sample each knot's value comes from).
+#[derive(Debug, Clone, Copy)]
+pub struct InputPerturbations<'a> {
+    pub knots: &'a [f64],
+    pub sample: &'a [usize],
+    pub columns: &'a [Vec<f64>],
+}
+
+impl InputPerturbations<'_> {
+    /// δu of every column at `t` into `du`, on the input's piece that
+    /// starts at or before `from` (right-continuous there: across a step,
+    /// the piece after it; up to the end of a piece, its own value).
+    fn at(&self, from: f64, t: f64, du: &mut [f64]) {
+        let n = self.knots.len();
+        if n == 0 {
+            du.fill(0.0);
+            return;
+        }
+        let m = self.knots.partition_point(|&k| k <= from).clamp(1, n) - 1;
+        let next = (m + 1).min(n - 1);
+        let span = self.knots[next] - self.knots[m];
+        let a = match span > 0.0 {
+            true => ((t - self.knots[m]) / span).clamp(0.0, 1.0),
+            false => 0.0,
+        };
+        let (k0, k1) = (self.sample[m], self.sample[next]);
+        for (du, c) in du.iter_mut().zip(self.columns) {
+            *du = (1.0 - a) * c[k0] + a * c[k1];
+        }
+    }
 }
 
 /// A step of the input from `before` to `after` at `t`, whose instant is a
@@ -162,8 +206,9 @@ pub struct OutputSensitivities {
 }
 
 /// f, f_x, f_θ, i, i_x, i_θ of (x, u, t) on one tape, outputs in that
-/// order (row-major blocks: f_x[i·d + k], f_θ[i·p + j]).
-struct Field {
+/// order (row-major blocks: f_x[i·d + k], f_θ[i·p + j]), then f_u and i_u
+/// where columns perturb the input.
+struct Field<'a> {
     tape: Tape,
     /// The tape's scratch for the replay's samples, and one for the points
     /// between them (Radau's stage, RK4's, events, steps): consecutive
@@ -183,6 +228,13 @@ struct Field {
     restitution: Option<usize>,
     z_min: f64,
     z_max: f64,
+    /// The input's perturbations: its columns are the last ones.
+    perturbed: Option<InputPerturbations<'a>>,
+    /// δu of each perturbed column at the last [`Field::input_forcing`].
+    du: RefCell<Vec<f64>>,
+    /// Where the input's piece being integrated starts (δu follows that
+    /// piece up to its end, as u does).
+    piece_from: std::cell::Cell<f64>,
 }
 
 /// f_x and f_θ at the two stages of [`Field::radau`], and the right-hand
@@ -207,8 +259,12 @@ impl Work {
     }
 }
 
-impl Field {
-    fn new(model: &mut Model, theta: &[Theta]) -> Field {
+impl<'a> Field<'a> {
+    fn new(
+        model: &mut Model,
+        theta: &[Theta],
+        perturbed: Option<InputPerturbations<'a>>,
+    ) -> Field<'a> {
         let (d, p) = (model.dim(), theta.len());
         let f = model.f.clone();
         let mut exprs = f.clone();
@@ -216,7 +272,7 @@ impl Field {
         let zero = model.graph.constant(0.0);
         let diff = |model: &mut Model, e: Id, th: &Theta| match *th {
             Theta::Field(th) => model.graph.diff(e, th),
-            Theta::Restitution | Theta::StepInstant => zero,
+            Theta::Restitution | Theta::StepInstant | Theta::Input => zero,
         };
         for &fi in &f {
             for th in theta {
@@ -232,6 +288,12 @@ impl Field {
         for th in theta {
             exprs.push(diff(model, i, th));
         }
+        if perturbed.is_some() {
+            let u = model.input;
+            for &fi in f.iter().chain([&i]) {
+                exprs.push(model.graph.diff(fi, u));
+            }
+        }
         let tape = model.compile(&exprs);
         let m = &model.description.mechanics;
         Field {
@@ -245,6 +307,36 @@ impl Field {
             restitution: theta.iter().position(|th| *th == Theta::Restitution),
             z_min: m.z_min,
             z_max: m.z_max,
+            du: RefCell::new(vec![0.0; perturbed.map_or(0, |q| q.columns.len())]),
+            piece_from: std::cell::Cell::new(f64::NEG_INFINITY),
+            perturbed,
+        }
+    }
+
+    /// The first column that perturbs the input, and their number.
+    fn perturbed_columns(&self) -> (usize, usize) {
+        let k = self.perturbed.map_or(0, |q| q.columns.len());
+        (self.p - k, k)
+    }
+
+    /// f_u·δu(t) of the perturbed columns into their entries of the d×p
+    /// block `b` (rows of z and v left alone when `stuck`), f_u from the
+    /// last evaluation, which must be at `t`; δu(t) kept for
+    /// [`current`](Self::current).
+    fn input_forcing(&self, t: f64, stuck: bool, b: &mut [f64]) {
+        let Some(q) = self.perturbed else {
+            return;
+        };
+        let (d, p) = (self.d, self.p);
+        let (first, k) = self.perturbed_columns();
+        let mut du = self.du.borrow_mut();
+        q.at(self.piece_from.get(), t, &mut du);
+        let out = self.out.borrow();
+        let fu = &out[out.len() - d - 1..out.len() - 1];
+        for i in (0..d).filter(|&i| !(stuck && i < 2)) {
+            for j in 0..k {
+                b[i * p + first + j] += fu[i] * du[j];
+            }
         }
     }
 
@@ -312,6 +404,8 @@ impl Field {
                 };
             }
         }
+        drop(out);
+        self.input_forcing(t, stuck, ds);
     }
 
     /// ∂i/∂θ = i_x·S + i_θ at (t, x, u).
@@ -323,6 +417,15 @@ impl Field {
         let (ix, ith) = (&out[base..base + d], &out[base + d..base + d + p]);
         for j in 0..p {
             row[j] = ith[j] + (0..d).map(|k| ix[k] * s[k * p + j]).sum::<f64>();
+        }
+        if let Some(q) = self.perturbed {
+            let (first, k) = self.perturbed_columns();
+            let mut du = self.du.borrow_mut();
+            q.at(t, t, &mut du);
+            let iu = out[out.len() - 1];
+            for j in 0..k {
+                row[first + j] += iu * du[j];
+            }
         }
     }
 
@@ -361,6 +464,7 @@ impl Field {
         stuck: bool,
     ) -> Result<(), Unsupported> {
         let (d, n) = (self.d, self.d * self.p);
+        self.piece_from.set(a);
         let mut k = [[0.0; MAX_DIM]; 4];
         let mut ks = vec![vec![0.0; n]; 4];
         let (mut xt, mut st) = ([0.0; MAX_DIM], vec![0.0; n]);
@@ -452,10 +556,12 @@ impl Field {
         let (d, p, h, live) = (self.d, self.p, t1 - t0, self.live.get());
         // (Radau IIA) c = (1/3, 1), A = [`RADAU`]
         const C1: f64 = 1.0 / 3.0;
+        self.piece_from.set(t0);
         self.eval(t0, x0, piece.value(t0));
         let f0 = self.linearisation(stuck, &mut work.a[0], &mut work.b[0]);
         self.eval(t1, x1, piece.value(t1));
         let f1 = self.linearisation(stuck, &mut work.a[1], &mut work.b[1]);
+        self.input_forcing(t1, stuck, &mut work.b[1]);
         // cubic Hermite at σ = 1/3: h00 = 20/27, h10 = 4/27, h01 = 7/27, h11 = −2/27
         let xm: [f64; MAX_DIM] = std::array::from_fn(|i| match i < d {
             true => (20.0 * x0[i] + 7.0 * x1[i] + h * (4.0 * f0[i] - 2.0 * f1[i])) / 27.0,
@@ -466,6 +572,7 @@ impl Field {
         let [a1, a2] = &mut work.a;
         let [b1, b2] = &mut work.b;
         let fm = self.linearisation(stuck, a1, b1);
+        self.input_forcing(tm, stuck, b1);
         // The interpolant's slope at σ = 1/3, (4/3)(x1 − x0)/h − f1/3, must
         // be the field's there: else x moves faster than a cubic follows (a
         // transient within the interval) and RK4 integrates x instead.
@@ -664,9 +771,36 @@ pub fn forward_with_steps<I: Input + ?Sized>(
         "steps out of order"
     );
     let mut theta = symbols(model, paths)?;
-    let first_step = theta.len();
     theta.extend(steps.iter().map(|_| Theta::StepInstant));
-    let field = Field::new(model, &theta);
+    let field = Field::new(model, &theta, None);
+    along(&field, paths.len(), steps, trajectory, input)
+}
+
+/// The outputs' response to `perturbations` of the input along
+/// `trajectory`, a replay of `model` driven by `input`, linearised: column
+/// j of each output is its change per unit of the j-th perturbation (e.g.
+/// the current's answer to noise on the voltage's samples; checked against
+/// replays of the perturbed input in `identify/tests/sensitivity.rs`).
+pub fn input_response<I: Input + ?Sized>(
+    model: &mut Model,
+    perturbations: InputPerturbations,
+    trajectory: &Trajectory,
+    input: &I,
+) -> Result<OutputSensitivities, Unsupported> {
+    let theta = vec![Theta::Input; perturbations.columns.len()];
+    let field = Field::new(model, &theta, Some(perturbations));
+    along(&field, theta.len(), &[], trajectory, input)
+}
+
+/// The sensitivities of `field`'s columns along `trajectory` (driven by
+/// `input`), the columns of `steps` from `first_step` on.
+fn along<I: Input + ?Sized>(
+    field: &Field,
+    first_step: usize,
+    steps: &[InputStep],
+    trajectory: &Trajectory,
+    input: &I,
+) -> Result<OutputSensitivities, Unsupported> {
     let tr = trajectory;
     let (n, d, p) = (tr.t.len(), field.d, field.p);
     let mut out = OutputSensitivities {
