@@ -575,13 +575,22 @@ pub fn fit(
     options: &FitOptions,
     progress: &(dyn Fn(FitProgress) + Sync),
 ) -> Result<FitReport, FitError> {
+    let starts = options.starts.max(1);
+    if let Some(k) = options.only_start.filter(|&k| k >= starts) {
+        return Err(FitError::Solver {
+            file: data.file_name.clone(),
+            message: format!(
+                "start {k} asked for, of {starts} starts (0 to {})",
+                starts - 1
+            ),
+        });
+    }
     let setup = Setup::new(description, data, params, options)?;
     let (start0, bounds) = (&setup.x0, &setup.bounds);
     let residual = |theta: &[f64]| setup.residuals(description, params, theta);
     let paths: Vec<&str> = params.iter().map(|p| p.path.as_str()).collect();
     let analytic = analytic_jacobian(description, &paths, options);
     let lm_options = lm_options(options);
-    let starts = options.starts.max(1);
     // The starts in parallel (each on its own replays), reduced in their
     // order below: the same best start, sums and report every run.
     let solve = |(k, x0): (usize, &Vec<f64>)| {

@@ -18,7 +18,8 @@
 //! - [`sensitivity`]: forward parameter sensitivities of a replay (the
 //!   fit's analytic Jacobian).
 //! - [`staged_fit`]: a fit's starts on the record's first pulses, the
-//!   best then on the whole (the diagnosis's ranking).
+//!   best then on the whole (the diagnosis's ranking; its first pulses are
+//!   the polish's first stage too).
 //! - [`edge_fit`]: the fit with the voltage edges' instants among its
 //!   parameters.
 //! - [`identifiability`]: what the data can and cannot separate (SVD of the

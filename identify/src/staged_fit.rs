@@ -13,6 +13,12 @@
 //! optimum instead was tried: where the model is wrong its optimum on the
 //! first pulses is not the whole record's, and the fit crawled from there,
 //! e.g. fringing on a saturation record ran 40 more iterations.)
+//!
+//! The diagnosis's polish uses [`first_pulses`] too, and does continue from
+//! the first stage's optimum (`diagnose/polish.rs`): it fits the named
+//! cause, taken to be the right model there. Where it is not (an effect
+//! outside the vocabulary named anyway), the continuation may take longer,
+//! not end elsewhere: the second stage is a full fit on the whole record.
 
 use crate::description::Description;
 use crate::{fit, FitError, FitOptions, FitParam, FitReport, Measured};
@@ -43,27 +49,34 @@ pub fn first_pulses(data: &Measured) -> Option<usize> {
 /// [`crate::fit`] of `params` of `description` to `data` with
 /// `options.starts` starts, raced on [`first_pulses`]: only the start that
 /// fits those best is fitted on all of `data` (one stage where there is a
-/// single start or the record is too short). Iterations and replays count
-/// both stages.
+/// single start or the record is too short). Where either stage fails
+/// (the first pulses cannot be fitted, or the winner cannot be fitted on
+/// the whole record, where the one-stage fit would keep the next best
+/// start), all the starts are fitted on the whole record as in one stage.
+/// Iterations, replays and differenced Jacobians count every stage run.
 pub fn fit_staged(
     description: &Description,
     data: &Measured,
     params: &[FitParam],
     options: &FitOptions,
 ) -> Result<FitReport, FitError> {
+    let one_stage = || fit(description, data, params, options, &|_| {});
     let first_stage = (options.starts > 1 && options.only_start.is_none())
         .then(|| first_pulses(data))
         .flatten();
     let Some(end) = first_stage else {
-        return fit(description, data, params, options, &|_| {});
+        return one_stage();
     };
-    let first = fit(description, &data.head(end), params, options, &|_| {})?;
+    let Ok(first) = fit(description, &data.head(end), params, options, &|_| {}) else {
+        return one_stage();
+    };
     let only = FitOptions {
         only_start: Some(first.best_start),
         ..options.clone()
     };
-    let mut whole = fit(description, data, params, &only, &|_| {})?;
+    let mut whole = fit(description, data, params, &only, &|_| {}).or_else(|_| one_stage())?;
     whole.iterations += first.iterations;
     whole.simulations += first.simulations;
+    whole.differenced_jacobians += first.differenced_jacobians;
     Ok(whole)
 }

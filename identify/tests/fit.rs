@@ -539,6 +539,20 @@ fn the_first_pulses_end_before_an_edge_past_a_quarter_of_the_record() {
     assert_eq!(first_pulses(&unlocated), None);
     let (_, short) = pulses(8, 3);
     assert_eq!(first_pulses(&short), None, "3200 samples: one stage");
+    let with_edges = |edges: Vec<reldesign_identify::edges::Edge>| Measured {
+        edges: Some(edges),
+        ..data.clone()
+    };
+    assert_eq!(first_pulses(&with_edges(Vec::new())), None, "no edges");
+    assert_eq!(
+        first_pulses(&with_edges(edges[..4].to_vec())),
+        None,
+        "two pulses only"
+    );
+    // the first edge past the quarter with four before it lies past half
+    let mut late = edges[..4].to_vec();
+    late.extend(edges.iter().filter(|e| 10 * e.k > 6 * n).copied());
+    assert_eq!(first_pulses(&with_edges(late)), None, "past half");
 }
 
 /// A staged fit races the starts on the first pulses and fits the winner
@@ -592,6 +606,19 @@ fn a_staged_fit_gives_the_one_stage_fit_of_its_best_start() {
     let staged = fit_staged(&start, &data, &fitted, &options).unwrap();
     let alone = &each[staged.best_start];
     assert_eq!(bits(&staged), bits(alone));
+    // every stage counted: the race on the first pulses, then the winner
+    let end = first_pulses(&data).unwrap();
+    let race = fit(&start, &data.head(end), &fitted, &options, &|_| {}).unwrap();
+    assert_eq!(race.best_start, staged.best_start);
+    assert_eq!(staged.iterations, race.iterations + alone.iterations);
+    assert_eq!(staged.simulations, race.simulations + alone.simulations);
+    // a start that is not one of them is an error that says so
+    let beyond = FitOptions {
+        only_start: Some(3),
+        ..options.clone()
+    };
+    let err = fit(&start, &data, &fitted, &beyond, &|_| {}).unwrap_err();
+    assert!(err.to_string().contains("start 3"), "{err}");
     assert!(
         staged.cost <= best * (1.0 + 1e-6),
         "{:e} vs {best:e}",
@@ -607,5 +634,6 @@ fn a_staged_fit_gives_the_one_stage_fit_of_its_best_start() {
         staged.simulations,
         alone.simulations
     );
+    // the replays of the whole record the race saves
     assert!(alone.simulations < whole.simulations);
 }

@@ -9,7 +9,9 @@
 //! hidden-effect records 0.2–0.7 % off on noise-free data). The edges'
 //! instants depend on the model's values and the values on the instants:
 //! the polish fits both at once ([`crate::edge_fit`]), from the instants
-//! the ranking's model places. (It used to alternate three rounds of
+//! the ranking's model places: first on the record's first pulses, then on
+//! all the fitted samples from there (the first pulses' instants and
+//! values, R from the ranking's fit: [`polish`]). (It used to alternate three rounds of
 //! placement and fit, which had not converged where the two are coupled:
 //! on the benchmark's fringing record the winding length still moved by a
 //! third a round, −0.47 % from the hidden value after three rounds; fitted
@@ -58,7 +60,8 @@ pub(super) struct Polished {
 /// The named candidate fitted again from the ranking's fit, the instants of
 /// the record's edges with it ([`crate::edge_fit`]), starting from the
 /// instants the ranking's model places (the edges are a nuisance of the
-/// data that the model's values move, and the values move with the edges).
+/// data that the model's values move, and the values move with the edges;
+/// in two stages, see [`polish`]).
 pub(super) fn with_edges(
     candidate: Option<&Candidate>,
     fit: &FitReport,
@@ -114,7 +117,11 @@ const FTOL_HYSTERESIS: f64 = 1e-8;
 /// pulses is near the whole's, and the iterations far from it are paid on
 /// a quarter of the samples (on the benchmark's hysteresis record, 14 on
 /// the first pulses and 7 on the whole, against 15 on the whole; the same
-/// optimum to 1e-8).
+/// optimum to 1e-8). The second stage starts from the first's values with
+/// the ranking's R: the fit's |φ̇| weights follow its start's R, and with
+/// the first stage's the optimum moved by 0.3 standard errors (R, on the
+/// saturation record). Where either stage fails, or the record holds more
+/// located edges than [`crate::edge_fit::MAX_FITTED_EDGES`], one stage.
 fn polish(
     candidate: Option<&Candidate>,
     fit: &FitReport,
@@ -143,7 +150,13 @@ fn polish(
             .ok()
             .filter(|p| p.report.wnrmse_current.is_finite())
     };
+    // (more located edges than the joint fit takes: one stage, every edge
+    // held where it was placed, as the one-stage fit holds them)
+    let located = (own.edges.iter().flatten())
+        .filter(|e| e.located && e.k + 1 < own.len())
+        .count();
     let first = crate::staged_fit::first_pulses(own)
+        .filter(|_| located <= crate::edge_fit::MAX_FITTED_EDGES)
         .and_then(|end| Some((end, fitted(&fit.description, &own.head(end))?)));
     let Some((end, first)) = first else {
         return fitted(&fit.description, own);
@@ -153,15 +166,18 @@ fn polish(
     // R, and the one-stage fit's are those of `fit`).
     let mut edges = first.edges.clone();
     edges.extend((own.edges.iter().flatten()).filter(|e| e.k + 1 >= end));
-    let own = Measured {
+    let merged = Measured {
         edges: Some(edges),
         ..own.clone()
     };
     let mut start = first.report.description.clone();
     start.coil.resistance = fit.description.coil.resistance;
-    let mut whole = fitted(&start, &own)?;
+    let Some(mut whole) = fitted(&start, &merged) else {
+        return fitted(&fit.description, own);
+    };
     whole.report.iterations += first.report.iterations;
     whole.report.simulations += first.report.simulations;
+    whole.report.differenced_jacobians += first.report.differenced_jacobians;
     Some(whole)
 }
 
