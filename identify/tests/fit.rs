@@ -90,6 +90,16 @@ fn perturbed(d: &Description, changes: &[(&str, f64)]) -> Description {
     d
 }
 
+/// The start: `truth` with each of `changes` applied as a factor, and those
+/// parameters fitted within ×⅓–3 of the truth.
+fn started(truth: &Description, changes: &[(&str, f64)]) -> (Description, Vec<FitParam>) {
+    let fitted = changes
+        .iter()
+        .map(|(p, _)| bounds(truth, p, 3.0, 3.0))
+        .collect();
+    (perturbed(truth, changes), fitted)
+}
+
 fn bounds(d: &Description, path: &str, below: f64, above: f64) -> FitParam {
     let x = params::get(d, path).unwrap();
     FitParam {
@@ -111,11 +121,7 @@ fn saturating_valve_parameters_are_recovered_from_noisy_data() {
         ("core.r0", 1.5),
         ("gap.slope", 0.75),
     ];
-    let start = perturbed(&truth, &changes);
-    let fitted: Vec<FitParam> = changes
-        .iter()
-        .map(|(p, _)| bounds(&truth, p, 3.0, 3.0))
-        .collect();
+    let (start, fitted) = started(&truth, &changes);
     let floor = current_wnrmse(&truth, &data).unwrap();
     let before = current_wnrmse(&start, &data).unwrap();
     let clock = Instant::now();
@@ -208,11 +214,7 @@ fn ja_case(n: usize) -> (Description, Description, Measured, Vec<FitParam>) {
         ("core.kappa", 1.4),
         ("core.alpha", 1.25),
     ];
-    let start = perturbed(&truth, &changes);
-    let mut fitted: Vec<FitParam> = changes
-        .iter()
-        .map(|(p, _)| bounds(&truth, p, 3.0, 3.0))
-        .collect();
+    let (start, mut fitted) = started(&truth, &changes);
     fitted[2] = FitParam {
         path: "core.c".into(),
         lower: 0.3,
@@ -463,11 +465,7 @@ fn parallel_starts_give_the_same_report_on_any_number_of_threads() {
     let (t, v) = square(30.0, 0.0, 20e-3, 20e-6, 600);
     let data = synthetic(&truth, t, v, 17);
     let changes = [("coil.resistance", 1.2), ("core.phi_sat", 0.8)];
-    let start = perturbed(&truth, &changes);
-    let fitted: Vec<FitParam> = changes
-        .iter()
-        .map(|(p, _)| bounds(&truth, p, 3.0, 3.0))
-        .collect();
+    let (start, fitted) = started(&truth, &changes);
     let options = FitOptions {
         starts: 4,
         ..FitOptions::default()
@@ -568,11 +566,7 @@ fn a_staged_fit_gives_the_one_stage_fit_of_its_best_start() {
         ("core.phi_sat", 0.7),
         ("core.r0", 1.4),
     ];
-    let start = perturbed(&truth, &changes);
-    let fitted: Vec<FitParam> = changes
-        .iter()
-        .map(|(p, _)| bounds(&truth, p, 3.0, 3.0))
-        .collect();
+    let (start, fitted) = started(&truth, &changes);
     let options = FitOptions {
         starts: 3,
         use_flux: false,

@@ -298,17 +298,8 @@ fn step_errors(d: &Description, data: &Measured, paths: &[&str], h: f64) -> Vec<
     };
     (0..edges.len())
         .map(|n| {
-            let (plus, minus) = (moved(n, h), moved(n, -h));
-            let fd: Vec<f64> = plus
-                .iter()
-                .zip(&minus)
-                .map(|(a, b)| (a - b) / (2.0 * h))
-                .collect();
-            let scale = fd.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-            let err = fd
-                .iter()
-                .enumerate()
-                .fold(0.0f64, |a, (k, x)| a.max((s.current[(k, p + n)] - x).abs()));
+            let (scale, err) =
+                central_error(&moved(n, h), &moved(n, -h), h, |k| s.current[(k, p + n)]);
             eprintln!(
                 "edge {n}: ∂i/∂τ scale {scale:.3e}, error {:.2e}",
                 err / scale
@@ -316,6 +307,21 @@ fn step_errors(d: &Description, data: &Measured, paths: &[&str], h: f64) -> Vec<
             err / scale
         })
         .collect()
+}
+
+/// The central difference of the currents `plus` and `minus` (at ±`h`)
+/// against `analytic(k)` at each sample: the largest |difference| (the
+/// scale) and the largest |analytic − difference|.
+fn central_error(
+    plus: &[f64],
+    minus: &[f64],
+    h: f64,
+    analytic: impl Fn(usize) -> f64,
+) -> (f64, f64) {
+    (plus.iter().zip(minus).enumerate()).fold((0.0f64, 0.0f64), |(scale, err), (k, (a, b))| {
+        let fd = (a - b) / (2.0 * h);
+        (scale.max(fd.abs()), err.max((analytic(k) - fd).abs()))
+    })
 }
 
 /// An edge `frac` of a sample after sample `k` of `data`.
@@ -381,15 +387,10 @@ fn input_errors(d: &Description, data: &Measured, columns: &[Vec<f64>], h: f64) 
     };
     (columns.iter().enumerate())
         .map(|(j, e)| {
-            let (plus, minus) = (current(1.0, e), current(-1.0, e));
-            let fd: Vec<f64> = plus
-                .iter()
-                .zip(&minus)
-                .map(|(a, b)| (a - b) / (2.0 * h))
-                .collect();
-            let scale = fd.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let (scale, err) = central_error(&current(1.0, e), &current(-1.0, e), h, |k| {
+                s.current[(k, j)]
+            });
             assert!(scale > 0.0, "column {j} moves nothing");
-            let err = (0..fd.len()).fold(0.0f64, |m, k| m.max((s.current[(k, j)] - fd[k]).abs()));
             err / scale
         })
         .collect()
