@@ -40,6 +40,20 @@ use crate::Measured;
 /// hold 17 in their fitted part.)
 pub const MAX_FITTED_EDGES: usize = 64;
 
+/// Indices of `data`'s located edges whose interval lies inside the record.
+fn located_inside(data: &Measured) -> Vec<usize> {
+    let edges = data.edges.as_deref().unwrap_or_default();
+    (0..edges.len())
+        .filter(|&n| edges[n].located && edges[n].k + 1 < data.len())
+        .collect()
+}
+
+/// Whether [`fit_with_edges`] holds every edge of `data` where it was
+/// placed: more located edges than [`MAX_FITTED_EDGES`].
+pub fn holds_edges(data: &Measured) -> bool {
+    located_inside(data).len() > MAX_FITTED_EDGES
+}
+
 /// The placed edges of a record, and which of them are fitted.
 struct Instants<'a> {
     data: &'a Measured,
@@ -52,9 +66,7 @@ struct Instants<'a> {
 impl<'a> Instants<'a> {
     fn of(data: &'a Measured) -> Instants<'a> {
         let placed = data.edges.clone().unwrap_or_default();
-        let mut free: Vec<usize> = (0..placed.len())
-            .filter(|&n| placed[n].located && placed[n].k + 1 < data.len())
-            .collect();
+        let mut free = located_inside(data);
         if free.len() > MAX_FITTED_EDGES {
             free.clear();
         }

@@ -430,10 +430,7 @@ impl<'a> Objective<'a> {
             sensitivity::forward_with_steps(&mut model, paths, steps, trajectory, &input).ok()?;
         let (n, p) = (self.data.len(), paths.len() + steps.len());
         let sw: Vec<f64> = self.weights.iter().map(|w| w.sqrt()).collect();
-        let mut blocks = vec![DMatrix::from_fn(n, p, |k, j| {
-            sw[k] * s.current[(k, j)] / self.current_norm
-        })];
-        if let Some((phi, norm)) = self.flux_reference(d) {
+        let flux = self.flux_reference(d).map(|(phi, norm)| {
             let x = &trajectory.x;
             let mut block = DMatrix::zeros(n, p);
             for j in 0..p {
@@ -452,19 +449,37 @@ impl<'a> Objective<'a> {
                     block[(k, j)] = sw[k] * (s.phi[(k, j)] - dphi[k]) / norm - r * dnorm / norm;
                 }
             }
-            blocks.push(block);
-        }
+            block
+        });
+        Some(self.residual_rows(&s, flux))
+    }
+
+    /// The rows of the residuals [`residuals_of`](Self::residuals_of) from
+    /// output sensitivities `s` (a column per parameter or perturbation):
+    /// the current's, `flux`'s (the flux term's, when the objective has
+    /// one), then the position's where the data has it.
+    fn residual_rows(
+        &self,
+        s: &sensitivity::OutputSensitivities,
+        flux: Option<DMatrix<f64>>,
+    ) -> DMatrix<f64> {
+        let (n, p) = (self.data.len(), s.current.ncols());
+        let sw: Vec<f64> = self.weights.iter().map(|w| w.sqrt()).collect();
+        let mut blocks = vec![DMatrix::from_fn(n, p, |k, j| {
+            sw[k] * s.current[(k, j)] / self.current_norm
+        })];
+        blocks.extend(flux);
         if let (Some(norm), Some(_)) = (self.position_norm, &self.data.z) {
-            blocks.push(s.z / norm);
+            blocks.push(&s.z / norm);
         }
         let rows = blocks.iter().map(|b| b.nrows()).sum();
-        let mut jac = DMatrix::zeros(rows, p);
+        let mut stacked = DMatrix::zeros(rows, p);
         let mut at = 0;
         for b in blocks {
-            jac.rows_mut(at, b.nrows()).copy_from(&b);
+            stacked.rows_mut(at, b.nrows()).copy_from(&b);
             at += b.nrows();
         }
-        Some(jac)
+        stacked
     }
 
     /// The residuals' linearised response to perturbations of the voltage's
@@ -491,19 +506,7 @@ impl<'a> Objective<'a> {
         };
         let mut model = Model::build(d);
         let s = sensitivity::input_response(&mut model, perturbations, &trajectory, &input).ok()?;
-        let (n, k) = (self.data.len(), columns.len());
-        let position = (self.position_norm.zip(self.data.z.as_ref())).map(|(norm, _)| s.z / norm);
-        let mut rows = DMatrix::zeros(n + position.as_ref().map_or(0, |z| z.nrows()), k);
-        for i in 0..n {
-            let sw = self.weights[i].sqrt() / self.current_norm;
-            for j in 0..k {
-                rows[(i, j)] = sw * s.current[(i, j)];
-            }
-        }
-        if let Some(z) = position {
-            rows.rows_mut(n, z.nrows()).copy_from(&z);
-        }
-        Some(rows)
+        Some(self.residual_rows(&s, None))
     }
 
     /// ∂φ_ref/∂θ for the parameter `path`: the integrated reference

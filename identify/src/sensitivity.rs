@@ -230,7 +230,8 @@ struct Field<'a> {
     z_max: f64,
     /// The input's perturbations: its columns are the last ones.
     perturbed: Option<InputPerturbations<'a>>,
-    /// δu of each perturbed column at the last [`Field::input_forcing`].
+    /// δu of each perturbed column (scratch of [`Field::input_forcing`] and
+    /// [`Field::current`]).
     du: RefCell<Vec<f64>>,
     /// Where the input's piece being integrated starts (δu follows that
     /// piece up to its end, as u does).
@@ -321,8 +322,7 @@ impl<'a> Field<'a> {
 
     /// f_u·δu(t) of the perturbed columns into their entries of the d×p
     /// block `b` (rows of z and v left alone when `stuck`), f_u from the
-    /// last evaluation, which must be at `t`; δu(t) kept for
-    /// [`current`](Self::current).
+    /// last evaluation, which must be at `t`.
     fn input_forcing(&self, t: f64, stuck: bool, b: &mut [f64]) {
         let Some(q) = self.perturbed else {
             return;

@@ -152,11 +152,8 @@ fn polish(
     };
     // (more located edges than the joint fit takes: one stage, every edge
     // held where it was placed, as the one-stage fit holds them)
-    let located = (own.edges.iter().flatten())
-        .filter(|e| e.located && e.k + 1 < own.len())
-        .count();
     let first = crate::staged_fit::first_pulses(own)
-        .filter(|_| located <= crate::edge_fit::MAX_FITTED_EDGES)
+        .filter(|_| !crate::edge_fit::holds_edges(own))
         .and_then(|end| Some((end, fitted(&fit.description, &own.head(end))?)));
     let Some((end, first)) = first else {
         return fitted(&fit.description, own);
@@ -205,14 +202,18 @@ pub(super) fn propagated(
     match linearisation {
         Some((fitted, jacobian)) => {
             let pinv = values_pseudo_inverse(jacobian, &named.values)?;
-            let r0 = crate::residuals_at(d, fitted, &c.params, options).ok()?;
+            let setup = crate::em_fit::Setup::new(d, fitted, &c.params, options).ok()?;
+            let objective = &setup.objective;
             let voltage = |v: Vec<f64>, _| Measured {
                 v,
                 ..fitted.clone()
             };
-            let drawn = voltage_noise_variances(c, d, fitted, &pinv, options)
-                .or_else(|| drawn_variances(c, d, fitted, (&pinv, &r0), options, voltage))?;
-            let current = current_noise_variances(c, named, fitted, &pinv, options);
+            // (the draws' reference residuals replayed only where they run)
+            let drawn = voltage_noise_variances(d, objective, fitted, &pinv).or_else(|| {
+                let r0 = crate::residuals_at(d, fitted, &c.params, options).ok()?;
+                drawn_variances(c, d, fitted, (&pinv, &r0), options, voltage)
+            })?;
+            let current = current_noise_variances(objective, fitted, &pinv);
             Some(Propagated { drawn, current })
         }
         None => {
@@ -249,15 +250,11 @@ pub(super) fn propagated(
 /// fit weighs the samples after the edges most (|φ̇| is large there), where
 /// the residual scale, averaged over the record, underrates the noise.
 fn current_noise_variances(
-    candidate: &Candidate,
-    named: &FitReport,
+    objective: &crate::em_fit::Objective,
     fitted: &Measured,
     pinv: &DMatrix<f64>,
-    options: &FitOptions,
 ) -> Option<Vec<f64>> {
-    let setup = crate::em_fit::Setup::new(&named.description, fitted, &candidate.params, options);
-    let setup = setup.ok()?;
-    let (weights, norm) = setup.objective.current_weights();
+    let (weights, norm) = objective.current_weights();
     if pinv.ncols() < weights.len() {
         return None;
     }
@@ -272,7 +269,7 @@ fn current_noise_variances(
 }
 
 /// Perturbations of the voltage noise propagated at once by
-/// [`voltage_noise_variances`] (each variance then within about ±25 %, √(2/64)).
+/// [`voltage_noise_variances`] (each variance then within about ±18 %, √(2/64)).
 const NOISE_COLUMNS: usize = 64;
 
 /// Variance of each named value from the voltage noise of `fitted`'s σ_v
@@ -287,22 +284,20 @@ const NOISE_COLUMNS: usize = 64;
 /// record the standard errors with the linearised part came out 0.43–0.87
 /// times those with the draws').
 fn voltage_noise_variances(
-    c: &Candidate,
     d: &crate::description::Description,
+    objective: &crate::em_fit::Objective,
     fitted: &Measured,
     pinv: &DMatrix<f64>,
-    options: &FitOptions,
 ) -> Option<Vec<f64>> {
     if matches!(d.core, crate::description::Core::JilesAtherton(_)) {
         return None;
     }
-    let setup = crate::em_fit::Setup::new(d, fitted, &c.params, options).ok()?;
     let sigma_v = rank::noise_std(&fitted.v);
     let zeros = vec![0.0; fitted.len()];
     let columns: Vec<Vec<f64>> = (0..NOISE_COLUMNS as u64)
         .map(|j| rank::with_noise(&zeros, sigma_v, PROPAGATION_SEED.wrapping_add(2 * j)))
         .collect();
-    let rows = setup.objective.voltage_response(d, fitted, &columns)?;
+    let rows = objective.voltage_response(d, fitted, &columns)?;
     if rows.nrows() != pinv.ncols() {
         return None;
     }
