@@ -26,6 +26,7 @@ use reldesign_identify::diagnose::{
     diagnose_causes, Cause, Causes, Diagnosis, FittedParameter, Options,
 };
 use reldesign_identify::edit::{annotate, write_physics};
+use reldesign_identify::lm::Status;
 use reldesign_identify::{flux_from_data, Measured, SimOutputs};
 use serde_json::{json, Value};
 
@@ -425,6 +426,7 @@ fn recalibration_json(answer: &Causes) -> Value {
         "causes_wnrmse": r.causes_wnrmse,
         "causes_bic": r.causes_bic,
         "explains": r.explains(),
+        "given_up": r.given_up,
     })
 }
 
@@ -744,6 +746,17 @@ fn plots(
     Ok([comparison, residual_svg, flux_loop])
 }
 
+/// How a candidate's fit that did not converge ended, for the ranking's
+/// lines (its BIC is then an upper bound of the candidate's).
+fn unfinished(status: Status) -> String {
+    match status {
+        _ if status.converged() => String::new(),
+        Status::GaveUp => "  (given up far above the best fit: BIC an upper bound)".into(),
+        Status::MaxIterations => "  (at the iteration cap: BIC an upper bound)".into(),
+        other => format!("  (ended: {other:?}; BIC an upper bound)"),
+    }
+}
+
 fn percent(x: f64) -> String {
     format!("{:.3} %", 100.0 * x)
 }
@@ -805,12 +818,13 @@ fn text_report(
                     .collect();
                 let _ = writeln!(
                     s,
-                    "  {:<17} k = {}  wNRMSE {:>9}  BIC {:>12.1}  {}",
+                    "  {:<17} k = {}  wNRMSE {:>9}  BIC {:>12.1}  {}{}",
                     c.cause.name(),
                     c.parameters,
                     percent(c.wnrmse_fit),
                     c.bic,
-                    values.join(", ")
+                    values.join(", "),
+                    unfinished(f.status)
                 );
             }
             Err(e) => {
@@ -892,6 +906,7 @@ fn json_report(
                 "parameters": c.parameters,
                 "wnrmse": c.wnrmse_fit,
                 "bic": c.bic,
+                "status": format!("{:?}", f.status),
                 "values": f.values.iter().map(|(k, v)| (k.clone(), json!(v))).collect::<serde_json::Map<_, _>>(),
             }),
             Err(e) => json!({"cause": c.cause.name(), "error": e}),

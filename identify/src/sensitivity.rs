@@ -64,6 +64,8 @@ use crate::model::Model;
 use crate::sim::{Affine, EventKind, Input, Limit, Mode, Trajectory, MAX_DIM};
 use crate::sym::{Id, Tape};
 
+mod split;
+
 /// RK4 substeps per sample interval (and per piece of one cut at events):
 /// on the saturating valve at 20 µs samples, 4 keep the Jacobian within
 /// 3e-6 of central differences (as 32 do); 2 lose accuracy at voltage edges.
@@ -746,7 +748,7 @@ fn spectral_bound(a: &[f64], d: usize) -> f64 {
 /// The sensitivities of `paths` along `trajectory`, a replay of `model`
 /// (with its values) driven by `input` (the intervals are cut at its
 /// breakpoints, e.g. a voltage edge between samples).
-pub fn forward<I: Input + ?Sized>(
+pub fn forward<I: Input + Sync + ?Sized>(
     model: &mut Model,
     paths: &[&str],
     trajectory: &Trajectory,
@@ -759,7 +761,7 @@ pub fn forward<I: Input + ?Sized>(
 /// to its instant. The steps must be in order of time and each a
 /// breakpoint of `input` where it steps from `before` to `after` (else the
 /// jumps are applied late, or where the trajectory has none).
-pub fn forward_with_steps<I: Input + ?Sized>(
+pub fn forward_with_steps<I: Input + Sync + ?Sized>(
     model: &mut Model,
     paths: &[&str],
     steps: &[InputStep],
@@ -772,6 +774,9 @@ pub fn forward_with_steps<I: Input + ?Sized>(
     );
     let mut theta = symbols(model, paths)?;
     theta.extend(steps.iter().map(|_| Theta::StepInstant));
+    if split::worth_it(trajectory.len(), model.dim(), theta.len()) {
+        return split::along_in_halves(model, &theta, paths.len(), steps, trajectory, input);
+    }
     let field = Field::new(model, &theta, None);
     along(&field, paths.len(), steps, trajectory, input)
 }
@@ -801,6 +806,19 @@ fn along<I: Input + ?Sized>(
     trajectory: &Trajectory,
     input: &I,
 ) -> Result<OutputSensitivities, Unsupported> {
+    along_from(field, first_step, steps, trajectory, input, None).map(|(out, _)| out)
+}
+
+/// [`along`] from S = `s0` (row-major d×p; None: zero) at the trajectory's
+/// first sample, and S at its last.
+fn along_from<I: Input + ?Sized>(
+    field: &Field,
+    first_step: usize,
+    steps: &[InputStep],
+    trajectory: &Trajectory,
+    input: &I,
+    s0: Option<Vec<f64>>,
+) -> Result<(OutputSensitivities, Vec<f64>), Unsupported> {
     let tr = trajectory;
     let (n, d, p) = (tr.t.len(), field.d, field.p);
     let mut out = OutputSensitivities {
@@ -810,7 +828,7 @@ fn along<I: Input + ?Sized>(
         radau_intervals: 0,
         rk4_intervals: 0,
     };
-    let mut s = vec![0.0; d * p];
+    let mut s = s0.unwrap_or_else(|| vec![0.0; d * p]);
     let mut row = vec![0.0; p];
     let mut record = |k: usize, s: &[f64], out: &mut OutputSensitivities| {
         field.current(tr.t[k], &tr.x[k], s, tr.u[k], &mut row);
@@ -821,7 +839,7 @@ fn along<I: Input + ?Sized>(
         }
     };
     if n == 0 {
-        return Ok(out);
+        return Ok((out, s));
     }
     record(0, &s, &mut out);
     let events = &tr.events;
@@ -900,7 +918,7 @@ fn along<I: Input + ?Sized>(
         }
         record(k + 1, &s, &mut out);
     }
-    Ok(out)
+    Ok((out, s))
 }
 
 #[cfg(test)]

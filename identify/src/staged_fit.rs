@@ -60,14 +60,37 @@ pub fn fit_staged(
     params: &[FitParam],
     options: &FitOptions,
 ) -> Result<FitReport, FitError> {
-    let one_stage = || fit(description, data, params, options, &|_| {});
-    let first_stage = (options.starts > 1 && options.only_start.is_none())
+    let first = race(description, data, params, options);
+    after_race(description, data, params, options, first)
+}
+
+/// The first stage of [`fit_staged`]: every start fitted on the first
+/// pulses (None: the fit has one stage).
+pub fn race(
+    description: &Description,
+    data: &Measured,
+    params: &[FitParam],
+    options: &FitOptions,
+) -> Option<Result<FitReport, FitError>> {
+    let end = (options.starts > 1 && options.only_start.is_none())
         .then(|| first_pulses(data))
-        .flatten();
-    let Some(end) = first_stage else {
-        return one_stage();
-    };
-    let Ok(first) = fit(description, &data.head(end), params, options, &|_| {}) else {
+        .flatten()?;
+    Some(fit(description, &data.head(end), params, options, &|_| {}))
+}
+
+/// The rest of [`fit_staged`] after [`race`] gave `first`: the winner on
+/// the whole record (`options` may differ from the race's, e.g. by a
+/// give-up rule), or the one-stage fit where there was no race or a stage
+/// failed.
+pub fn after_race(
+    description: &Description,
+    data: &Measured,
+    params: &[FitParam],
+    options: &FitOptions,
+    first: Option<Result<FitReport, FitError>>,
+) -> Result<FitReport, FitError> {
+    let one_stage = || fit(description, data, params, options, &|_| {});
+    let Some(Ok(first)) = first else {
         return one_stage();
     };
     let only = FitOptions {

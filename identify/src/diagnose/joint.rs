@@ -52,8 +52,10 @@ pub(super) fn refit(steps: &mut [Diagnosis], data: &Measured, options: &FitOptio
     ) else {
         return false;
     };
-    let polished = polish::with_edges(Some(&candidate), &start, &data, k, options);
-    let (own, linearisation) = (polished.own, polished.linearisation);
+    let located = crate::edges::located(&start.description, &data);
+    let polished = polish::with_edges(Some(&candidate), &start, (&data, located), k, options);
+    let own = polish::placed(polished.own, polished.fit.as_ref());
+    let linearisation = polished.linearisation;
     let fit = polished.fit.unwrap_or(start);
     // (the fits saw the fitted part only: the rest may not replay)
     let Ok(replay) = crate::simulate_outputs(&fit.description, &own) else {

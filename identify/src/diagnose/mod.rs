@@ -25,6 +25,7 @@ pub mod rank;
 pub mod recalibration;
 mod second_start;
 pub mod unexplained;
+mod waves;
 
 pub use candidate::{Candidate, NotApplicable, Scales};
 pub use cause::Cause;
@@ -34,7 +35,7 @@ use crate::description::Description;
 use crate::edges::Edge;
 use crate::lm::Stop;
 use crate::{flux_rate_weights, wnrmse, FitError, FitOptions, FitReport, Measured, SimOutputs};
-use second_start::SecondStart;
+use waves::Race;
 
 /// Settings of a diagnosis.
 #[derive(Debug, Clone)]
@@ -293,15 +294,25 @@ fn diagnose_step(
     let fit_options = fit_options(options);
     // Jiles–Atherton fits cost most and are not convex: the hysteresis
     // candidate is fitted from its own start and, where that does not beat
-    // the fitted saturating core, from that core too (`fit_all`).
+    // the fitted saturating core, from that core too (`waves::fit_all`).
     let all_candidates = candidates.clone();
     let (hysteresis, others): (Vec<Candidate>, Vec<Candidate>) = candidates
         .into_iter()
         .partition(|c| c.cause == Cause::Hysteresis);
-    let fit_one = |c: &Candidate, stop: Option<&Stop>| {
-        score(c, &fit_data, &ranking_options(c, stop, &fit_options), n_eff)
+    let race = |c: &Candidate| {
+        let options = ranking_options(c, None, &fit_options);
+        crate::staged_fit::race(&c.start, &fit_data, &c.params, &options)
     };
-    let mut ranking = fit_all(baseline, &others, hysteresis.first(), &fit_one);
+    let fit = |c: &Candidate, race: Race, stop: Option<&Stop>| {
+        let options = ranking_options(c, stop, &fit_options);
+        let report = crate::staged_fit::after_race(&c.start, &fit_data, &c.params, &options, race);
+        score(c, report, n_eff)
+    };
+    let fits = waves::Fits {
+        race: &race,
+        fit: &fit,
+    };
+    let mut ranking = waves::fit_all(baseline, &others, hysteresis.first(), &fits);
     ranking.sort_by(|a, b| a.bic.total_cmp(&b.bic).then(a.cause.cmp(&b.cause)));
 
     // The best candidate that beats `none` and does not lose on the
@@ -338,8 +349,13 @@ fn diagnose_step(
             continue;
         }
         // The held-out check replays the record as the ranking did, with the
-        // baseline's edges.
-        let extended_replay = replay(&fit.description)?;
+        // baseline's edges; beside it, the edges placed by the extension for
+        // its polish (wasted where the held-out part rejects it: rare).
+        let (extended_replay, located) = rayon::join(
+            || replay(&fit.description),
+            || crate::edges::located(&fit.description, data),
+        );
+        let extended_replay = extended_replay?;
         match held_out_gain(&extended_replay) {
             Some(h)
                 if !(h.gain > 0.0) && h.baseline_wnrmse > options.floor_factor * noise_floor =>
@@ -358,7 +374,10 @@ fn diagnose_step(
                 let candidate = all_candidates.iter().find(|c| c.cause == scored.cause);
                 let refit_now = recalibrate && refit.is_none();
                 let (polished, refitted) = rayon::join(
-                    || polish::with_edges(candidate, fit, data, fitted_samples, &fit_options),
+                    || {
+                        let data = (data, located);
+                        polish::with_edges(candidate, fit, data, fitted_samples, &fit_options)
+                    },
                     || {
                         refit_now.then(|| {
                             recalibration::refit(
@@ -367,20 +386,27 @@ fn diagnose_step(
                                 &edges,
                                 fitted_samples,
                                 &fit_options,
+                                Some((scored.cause, fit.cost)),
                             )
                         })
                     },
                 );
                 refit = refit.or(refitted);
                 let own = polished.own;
+                let placed_again = polished.fit.is_some();
                 let named = polished.fit.unwrap_or_else(|| fit.clone());
                 let linearisation = polished.linearisation.as_ref();
-                // The replay over the whole record and the propagation (on
-                // the fitted part) side by side; the propagation is wasted
-                // where the replay then rejects the cause (rare).
+                // The replay over the whole record (on the edges the named
+                // model places) and the propagation (on the fitted part; it
+                // reads `own` only where the polish gave no fit) side by
+                // side; the propagation is wasted where the replay then
+                // rejects the cause (rare).
                 let own_fitted = own.head(fitted_samples);
                 let (extended_replay, propagated) = rayon::join(
-                    || replay_own(&named.description, &own),
+                    || {
+                        let own = polish::placed(own, placed_again.then_some(&named));
+                        replay_own(&named.description, &own)
+                    },
                     || {
                         let (c, named) = (candidate, &named);
                         polish::propagated(c, named, &own_fitted, linearisation, &fit_options)
@@ -462,11 +488,12 @@ fn diagnose_step(
 /// (`causes_are_found_on_generated_devices`).
 const RANKING_FTOL_HYSTERESIS: f64 = 1e-3;
 
-/// The settings of `c`'s fit for the ranking: `base` with the run's `stop`,
-/// the candidate's give-up rule and, for the hysteresis candidate,
-/// [`RANKING_FTOL_HYSTERESIS`].
+/// The settings of `c`'s fit for the ranking: `base` with its starts, the
+/// run's `stop`, the candidate's give-up rule and, for the hysteresis
+/// candidate, [`RANKING_FTOL_HYSTERESIS`].
 fn ranking_options(c: &Candidate, stop: Option<&Stop>, base: &FitOptions) -> FitOptions {
     FitOptions {
+        starts: c.starts,
         stop: stop.cloned(),
         give_up: c.give_up,
         ftol: match c.cause {
@@ -559,6 +586,8 @@ pub fn diagnose_causes(
     // a trace above the noise) against a recalibration of the description
     let consulted =
         steps[0].cause != Cause::None || residual.over_floor >= recalibration::NONE_ABOVE_FLOOR;
+    // (a refit given up against a cause the answer does not name: in full)
+    let refit = refit.filter(|r| r.as_ref().is_none_or(|r| r.holds_for(steps[0].cause)));
     let recalibration = (consulted && !residual.unexplained())
         .then(|| match &refit {
             Some(refit) => refit
@@ -616,15 +645,10 @@ fn candidates(
     (ok, not)
 }
 
-/// Fits one candidate on `data` and scores it.
-fn score(c: &Candidate, data: &Measured, options: &FitOptions, n_eff: f64) -> Scored {
-    let options = FitOptions {
-        starts: c.starts,
-        ..options.clone()
-    };
-    let fit = crate::staged_fit::fit_staged(&c.start, data, &c.params, &options);
+/// `c` scored by its fit's `report`.
+fn score(c: &Candidate, report: Result<FitReport, FitError>, n_eff: f64) -> Scored {
     let parameters = c.params.len();
-    match fit {
+    match report {
         Ok(report) => {
             let e = report.wnrmse_current;
             Scored {
@@ -643,103 +667,6 @@ fn score(c: &Candidate, data: &Measured, options: &FitOptions, n_eff: f64) -> Sc
             fit: Err(e.to_string()),
         },
     }
-}
-
-/// Every candidate of `others` fitted and scored by `fit`, in parallel,
-/// and the hysteresis candidate (`hysteresis`) from its own start and,
-/// where that does not beat the fitted saturating core by BIC, from that
-/// core too ([`SecondStart`]; the saturation fit finds the flux scale
-/// reliably, the Jiles–Atherton objective has local minima). The better
-/// hysteresis start is kept (the own one on a tie). The order of the
-/// result is not meaningful.
-///
-/// Where the own start beats the saturating core, the second start ran its
-/// 40 iterations (2–3.5 s, the longest fit of a 40 000-sample record). On
-/// the confusion matrix's 105 records it then found a better
-/// Jiles–Atherton fit in 25 of 65 rankings, which changed no answer (the
-/// candidate's reported values and a named core's polish start do change);
-/// a measured rule, not a bound: a better second start could in principle
-/// lift the candidate past another. Where it is needed, the second start
-/// still gives up after a few iterations far above the core it started
-/// from ([`second_start::giving_up`]).
-fn fit_all(
-    baseline: &Description,
-    others: &[Candidate],
-    hysteresis: Option<&Candidate>,
-    fit: &(dyn Fn(&Candidate, Option<&Stop>) -> Scored + Sync),
-) -> Vec<Scored> {
-    use std::sync::Mutex;
-    let push = |to: &Mutex<Vec<(usize, Scored)>>, item: (usize, Scored)| {
-        if let Ok(mut v) = to.lock() {
-            v.push(item);
-        }
-    };
-    let scored = Mutex::new(Vec::new());
-    let starts = Mutex::new(Vec::new());
-    let second = SecondStart::default();
-    // The order of the spawns: rayon runs a scope's spawns last-first on
-    // the spawning thread and first-first on a thread that steals them. So
-    // the saturation fit goes first (stolen at once: the second start waits
-    // for it, and runs next on its thread), the own hysteresis start last
-    // (run at once here), and the others between by their number of
-    // starts × parameters, cheapest first: the costliest run here next,
-    // while the other threads take the cheap ones.
-    let mut order: Vec<usize> = (0..others.len()).collect();
-    order.sort_by_key(|&k| {
-        let c = &others[k];
-        (c.cause != Cause::Saturation, c.starts * c.params.len())
-    });
-    rayon::scope(|s| {
-        for k in order {
-            let c = &others[k];
-            let (scored, starts, push, second) = (&scored, &starts, &push, &second);
-            s.spawn(move |s| {
-                let result = fit(c, None);
-                let seeded = (hysteresis.is_some() && c.cause == Cause::Saturation)
-                    .then(|| result.fit.as_ref().ok())
-                    .flatten()
-                    .and_then(|f| {
-                        let seeded =
-                            candidate::hysteresis_from_saturation(baseline, &f.description);
-                        seeded.map(|c| second_start::giving_up(c, f.cost))
-                    })
-                    .filter(|_| second.saturation_fitted(result.bic));
-                if let Some(seeded) = seeded {
-                    s.spawn(move |_| {
-                        // (stopped while it waited for a thread: not fitted)
-                        if !second.stop.raised() {
-                            push(starts, (1, fit(&seeded, Some(&second.stop))));
-                        }
-                    });
-                }
-                push(scored, (k, result));
-            });
-        }
-        if let Some(own) = hysteresis {
-            let (starts, push, second) = (&starts, &push, &second);
-            s.spawn(move |_| {
-                let result = fit(own, None);
-                second.own_fitted(result.bic);
-                push(starts, (0, result));
-            });
-        }
-    });
-    let mut ranking: Vec<Scored> = (scored.into_inner().unwrap_or_default())
-        .into_iter()
-        .map(|(_, s)| s)
-        .collect();
-    let mut starts = starts.into_inner().unwrap_or_default();
-    starts.retain(|(k, _)| *k == 0 || second.counts());
-    starts.sort_by_key(|(k, _)| *k);
-    let best = (starts.into_iter().map(|(_, s)| s)).reduce(|best, s| {
-        if s.bic.total_cmp(&best.bic).is_lt() {
-            s
-        } else {
-            best
-        }
-    });
-    ranking.extend(best);
-    ranking
 }
 
 /// The extensions that beat the baseline's own best (`none`) by BIC, best
@@ -923,8 +850,8 @@ mod tests {
             &base,
         );
         assert_eq!(
-            (o.ftol, o.give_up),
-            (RANKING_FTOL_HYSTERESIS, Some(give_up))
+            (o.ftol, o.give_up, o.starts),
+            (RANKING_FTOL_HYSTERESIS, Some(give_up), 1)
         );
         assert_eq!(o.stop, Some(stop));
         let o = ranking_options(&candidate(Cause::Saturation, None), None, &base);

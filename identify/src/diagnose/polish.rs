@@ -38,17 +38,15 @@ use nalgebra::DMatrix;
 
 use crate::description::Description;
 use crate::edge_fit::EdgeFit;
+use crate::edges::Edge;
 use crate::{FitOptions, FitReport, Measured};
 
 /// The polish of a named cause.
 pub(super) struct Polished {
     /// The polished fit (None: the ranking's stands).
     pub fit: Option<FitReport>,
-    /// The record with the edges the polished model places (as the
-    /// baseline's were placed: what the diagnosis replays, judges and
-    /// plots; the fitted instants would give the named cause alone one more
-    /// free parameter per edge there, and fit effects outside the
-    /// vocabulary, e.g. Coulomb friction, down to the noise floor).
+    /// The record with the edges the ranking's model placed (the polish's
+    /// start; [`placed`] places them again by the polished model).
     pub own: Measured,
     /// The fitted samples with the edges at their fitted instants, and
     /// ∂r/∂(θ, edge instants) there (see
@@ -65,12 +63,14 @@ pub(super) struct Polished {
 pub(super) fn with_edges(
     candidate: Option<&Candidate>,
     fit: &FitReport,
-    data: &Measured,
+    (data, located): (&Measured, Vec<Edge>),
     fitted_samples: usize,
     options: &FitOptions,
 ) -> Polished {
-    let mut own = data.clone();
-    own.edges = Some(crate::edges::located(&fit.description, data));
+    let own = Measured {
+        edges: Some(located),
+        ..data.clone()
+    };
     let head = own.head(fitted_samples);
     let Some(polished) = polish(candidate, fit, &head, options) else {
         return Polished {
@@ -79,7 +79,6 @@ pub(super) fn with_edges(
             linearisation: None,
         };
     };
-    own.edges = Some(crate::edges::located(&polished.report.description, data));
     let fitted = Measured {
         edges: Some(polished.edges),
         ..head
@@ -88,6 +87,21 @@ pub(super) fn with_edges(
         fit: Some(polished.report),
         own,
         linearisation: Some((fitted, polished.jacobian)),
+    }
+}
+
+/// The record `own` of a polish with the edges `polished` places, where
+/// the polish gave a fit (as the baseline's were placed: what the diagnosis
+/// replays, judges and plots; the fitted instants would give the named
+/// cause alone one more free parameter per edge there, and fit effects
+/// outside the vocabulary, e.g. Coulomb friction, down to the noise floor).
+pub(super) fn placed(own: Measured, polished: Option<&FitReport>) -> Measured {
+    match polished {
+        Some(fit) => Measured {
+            edges: Some(crate::edges::located(&fit.description, &own)),
+            ..own
+        },
+        None => own,
     }
 }
 
