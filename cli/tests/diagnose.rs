@@ -164,6 +164,27 @@ fn json_names_hidden_saturation_and_writes_the_extended_model_in_out_dir() {
     let r = &m["parameters"]["coil.resistance"];
     assert_eq!(r["baseline"].as_f64(), Some(75.0), "{r}");
     assert!(m["rejected"].as_array().is_some());
+    // how each candidate's fit ended (a fit given up far above the best
+    // counts with an upper bound of its BIC); the named one's converged
+    let ended = [
+        "CostConverged",
+        "StepConverged",
+        "GradientConverged",
+        "MaxIterations",
+        "GaveUp",
+    ];
+    let candidates = m["candidates"].as_array().unwrap();
+    for c in candidates {
+        assert!(ended.contains(&c["status"].as_str().unwrap()), "{c}");
+    }
+    let named = candidates
+        .iter()
+        .find(|c| c["cause"] == "saturation")
+        .unwrap();
+    assert!(
+        named["status"].as_str().unwrap().ends_with("Converged"),
+        "{named}"
+    );
 }
 
 #[test]
@@ -611,6 +632,7 @@ fn effects_outside_the_vocabulary_are_unexplained() {
             let r = &m["recalibration"];
             let bic = |k: &str| r[k].as_f64().unwrap();
             assert!(bic("bic") <= bic("causes_bic"), "{what}");
+            assert_eq!(r["given_up"].as_bool(), Some(false), "{what}");
             assert!(
                 r["values"]["coil.resistance"].as_f64().unwrap() > 0.0,
                 "{what}"
