@@ -300,6 +300,34 @@ mod tests {
         parse_file(std::path::Path::new(path)).expect("the example parses")
     }
 
+    /// A candidate of `cause` on `base` with `starts` starts (no
+    /// parameters: the stubs fit none).
+    fn candidate(base: &Description, cause: Cause, starts: usize) -> Candidate {
+        Candidate {
+            cause,
+            start: base.clone(),
+            params: Vec::new(),
+            starts,
+            give_up: None,
+        }
+    }
+
+    /// `fit_all` of `others` and the own hysteresis start `own` by the
+    /// stubs `fits`, on `threads` threads.
+    fn ranked(
+        threads: usize,
+        base: &Description,
+        others: &[Candidate],
+        own: &Candidate,
+        fits: &Fits,
+    ) -> Vec<Scored> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| fit_all(base, others, Some(own), fits))
+    }
+
     /// A fit report whose objective is `cost`.
     fn report(cost: f64, description: Description) -> FitReport {
         let names = ["coil.resistance".to_string()];
@@ -358,13 +386,6 @@ mod tests {
             r0: 3.25e6,
             phi_sat: 2e-5,
         };
-        let candidate = |cause| Candidate {
-            cause,
-            start: base.clone(),
-            params: Vec::new(),
-            starts: 1,
-            give_up: None,
-        };
         let (own_done, seeded_calls, stopped) = (
             AtomicBool::new(false),
             AtomicUsize::new(0),
@@ -404,22 +425,18 @@ mod tests {
                 scored(c.cause, saturation, saturated.clone())
             }
         };
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(4)
-            .build()
-            .unwrap();
-        let ranking = pool.install(|| {
-            let fits = Fits {
-                race: &|_| None,
-                fit: &fit,
-            };
-            fit_all(
-                &base,
-                &[candidate(Cause::Saturation)],
-                Some(&candidate(Cause::Hysteresis)),
-                &fits,
-            )
-        });
+        let fits = Fits {
+            race: &|_| None,
+            fit: &fit,
+        };
+        let others = [candidate(&base, Cause::Saturation, 1)];
+        let ranking = ranked(
+            4,
+            &base,
+            &others,
+            &candidate(&base, Cause::Hysteresis, 1),
+            &fits,
+        );
         let hysteresis = ranking
             .iter()
             .find(|s| s.cause == Cause::Hysteresis)
@@ -463,24 +480,13 @@ mod tests {
     /// bouncing raced, then fitted in the second wave.
     fn waves(threads: usize, first_fails: bool) -> (Vec<(Cause, f64)>, Vec<Option<GiveUp>>) {
         let base = baseline();
-        let candidate = |cause, starts| Candidate {
-            cause,
-            start: base.clone(),
-            params: vec![crate::FitParam {
-                path: "coil.resistance".into(),
-                lower: 1.0,
-                upper: 100.0,
-            }],
-            starts,
-            give_up: None,
-        };
         let others = [
-            candidate(Cause::Fringing, 3),
-            candidate(Cause::None, 1),
-            candidate(Cause::Bouncing, 4),
-            candidate(Cause::EddyCurrents, 1),
+            candidate(&base, Cause::Fringing, 3),
+            candidate(&base, Cause::None, 1),
+            candidate(&base, Cause::Bouncing, 4),
+            candidate(&base, Cause::EddyCurrents, 1),
         ];
-        let own = candidate(Cause::Hysteresis, 1);
+        let own = candidate(&base, Cause::Hysteresis, 1);
         let first_ended = AtomicUsize::new(0);
         let given_up = std::sync::Mutex::new(Vec::new());
         let race = |c: &Candidate| (c.starts > 1).then(|| Ok(report(1.0, c.start.clone())));
@@ -513,15 +519,11 @@ mod tests {
                 false => scored(c.cause, bic, c.start.clone()),
             }
         };
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
         let fits = Fits {
             race: &race,
             fit: &fit,
         };
-        let ranking = pool.install(|| fit_all(&base, &others, Some(&own), &fits));
+        let ranking = ranked(threads, &base, &others, &own, &fits);
         let bics = ranking.iter().map(|s| (s.cause, s.bic)).collect();
         (bics, given_up.into_inner().unwrap())
     }
@@ -565,13 +567,6 @@ mod tests {
     fn a_held_second_start_runs_only_where_the_own_start_needs_it() {
         for (own, calls) in [(-200.0, 0), (-50.0, 1)] {
             let base = baseline();
-            let candidate = |cause| Candidate {
-                cause,
-                start: base.clone(),
-                params: Vec::new(),
-                starts: 1,
-                give_up: None,
-            };
             let (saturated, own_done) = (AtomicBool::new(false), AtomicBool::new(false));
             let seeded_calls = AtomicUsize::new(0);
             let fit = |c: &Candidate, _: Race, stop: Option<&Stop>| {
@@ -596,17 +591,16 @@ mod tests {
                 };
                 scored(c.cause, bic, c.start.clone())
             };
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(4)
-                .build()
-                .unwrap();
             let fits = Fits {
                 race: &|_| None,
                 fit: &fit,
             };
-            let others = [candidate(Cause::Saturation), candidate(Cause::None)];
-            let own_candidate = candidate(Cause::Hysteresis);
-            let ranking = pool.install(|| fit_all(&base, &others, Some(&own_candidate), &fits));
+            let others = [
+                candidate(&base, Cause::Saturation, 1),
+                candidate(&base, Cause::None, 1),
+            ];
+            let own_candidate = candidate(&base, Cause::Hysteresis, 1);
+            let ranking = ranked(4, &base, &others, &own_candidate, &fits);
             assert_eq!(seeded_calls.into_inner(), calls, "own BIC {own}");
             let hysteresis = ranking.iter().find(|s| s.cause == Cause::Hysteresis);
             let want = if calls == 0 { own } else { -300.0 };
