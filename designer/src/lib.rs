@@ -3,7 +3,7 @@
 //!
 //! - [`sym`]: the symbolic core (hash-consed expression DAG, simplification,
 //!   differentiation, CSE, flat-tape evaluation). Knows nothing of actuators.
-//! - [`design`]: controller derivations (Lie derivatives, feedback linearization).
+//! - [`design`]: controller design: derivations, trajectories, laws, analyses.
 //! - [`backstepping_loop`]: the backstepping position controller in a sampled loop (`loop`).
 //! - [`closed_loop`]: the designed controller in a sampled loop on a plant (`loop`, `sweep`).
 //! - [`description`]: the validated actuator description (`valve.toml`).

@@ -322,7 +322,7 @@ pub struct BacksteppingKeys {
     pub gains: [f64; 3],
     pub switching: Switching,
     /// α [1/s] of AᵀP + PA ⪯ −α·P [SB Theorem 3]; `None`: the default
-    /// (`design::backstepping_design`).
+    /// (`design::law::backstepping::design`).
     pub decay: Option<f64>,
     pub reference: SetPoint,
 }

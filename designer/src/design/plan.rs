@@ -5,7 +5,7 @@
 //! description → model → feedback linearization (α, β, T, T⁻¹) → per
 //! operation a reference (polynomial or energy-optimal) → feasibility [PT 54],
 //! [PT 56], [PT 57] → reference table → (sliding mode: u_max > max u* [SM 48])
-//! → the decisions of `decisions.rs`; and the
+//! → the decisions of `law/decisions.rs`; and the
 //! discretised model [JA 84–87] of the EKF/UKF. An infeasible design is an
 //! error that says which condition fails, where, and what to try.
 
@@ -15,121 +15,22 @@ use crate::description::{
 use crate::model::Model;
 use crate::observe::discrete::{DiscreteModel, KalmanSettings, ResistanceSettings};
 
-use super::backstepping_design::{design_backstepping, BacksteppingDesign};
-use super::decisions::{gains, ControllerDesign, ControllerSpec, DesignedOperation, LawDesign};
-use super::feasibility::check as check_feasibility;
-use super::fit_segments::{fit_segments, SegmentTolerance};
-use super::hold::{design_hold, HoldDesign};
-use super::linearization::{DesignError, Linearization};
-use super::optimal::{energy_optimal, OptimalError, OptimalSpec, OptimalTrajectory};
-use super::reference::{Polynomial, Reference};
-use super::robustness::{operation_end, ErrorBounds, Evaluator};
+use super::analysis::robustness::{operation_end, ErrorBounds, Evaluator};
+use super::derive::linearization::Linearization;
+use super::error::PlanError;
+use super::law::backstepping::design::{design_backstepping, BacksteppingDesign};
+use super::law::decisions::{
+    gains, ControllerDesign, ControllerSpec, DesignedOperation, LawDesign,
+};
+use super::law::hold::{design_hold, HoldDesign};
+use super::trajectory::feasibility::check as check_feasibility;
+use super::trajectory::fit_segments::{fit_segments, SegmentTolerance};
+use super::trajectory::optimal::problem::{OptimalError, OptimalSpec};
+use super::trajectory::optimal::{energy_optimal, OptimalTrajectory};
+use super::trajectory::reference::{Polynomial, Reference};
 
 /// Instants of the sliding-mode supply check per operation.
 const ROBUSTNESS_SAMPLES: usize = 4000;
-
-/// Why a description could not be designed (the file name is the caller's).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum PlanError {
-    #[error(
-        "nothing to build: add [trajectory] and [controller] sections, or an [observer] section (see the README)"
-    )]
-    NothingToBuild,
-    /// (`[controller]` without `[trajectory]` is refused by the parser.)
-    #[error("[trajectory] alone builds nothing: add a [controller] section to track it (see the README)")]
-    TrajectoryWithoutController,
-    #[error("the {estimator} observer: {message}")]
-    Observer {
-        estimator: &'static str,
-        message: String,
-    },
-    #[error("{0}")]
-    Design(#[from] DesignError),
-    #[error(
-        "the {operation} reference is infeasible (perfect-tracking-soft-landing §4):\n{report}"
-    )]
-    Infeasible {
-        operation: &'static str,
-        report: String,
-    },
-    #[error("the {operation} energy-optimal trajectory: {message}")]
-    Optimal {
-        operation: &'static str,
-        message: String,
-    },
-    #[error("the {operation} reference table: {message}")]
-    Table {
-        operation: &'static str,
-        message: String,
-    },
-    #[error("the controller has no operation")]
-    NoOperation,
-    #[error("the {0:?} operation is given twice")]
-    DuplicateOperation(Operation),
-    #[error("the reference table of the {0:?} operation is empty")]
-    EmptyTable(Operation),
-    #[error("the reference table of the {operation:?} operation spans [{first}, {end}] s, not the motion [t0, tf] = [{takeoff}, {landing}] s")]
-    TableTiming {
-        operation: Operation,
-        first: f64,
-        end: f64,
-        takeoff: f64,
-        landing: f64,
-    },
-    #[error("the design value `{name}` = {value} is not finite or out of range")]
-    BadValue { name: String, value: f64 },
-    #[error("the reference never needs a positive, finite flux: no guard threshold for φ → 0 can be derived")]
-    NoFluxFloor,
-    #[error(
-        "the sliding-mode law cannot track the {operation} reference: it needs \
-         u_max > max u* = {max_u_star:.4} (model-free-sliding-mode (48), worst at t = {:.4} ms \
-         from the operation's start), but supply.u_max = {u_max}; give a longer motion \
-         (trajectory.landing − trajectory.takeoff) or a larger supply.u_max{hint}; see \
-         `reldesign robustness` for the sufficient bound (49)",
-        at * 1e3
-    )]
-    SlidingSupply {
-        operation: &'static str,
-        max_u_star: f64,
-        at: f64,
-        u_max: f64,
-        hint: String,
-    },
-    #[error(
-        "controller.position = {position:e} m cannot be held: at rest there the flux would \
-         need φ² = {flux_squared:e} Wb² (must be > 0: the magnet only attracts, so the spring \
-         must push away from z_min there); choose a position where the spring pushes the \
-         armature open"
-    )]
-    Unholdable { position: f64, flux_squared: f64 },
-    #[error(
-        "controller.position = {position:e} m needs a steady input of {input:.4} to hold \
-         (R·i, or i with current drive, of the flux that balances the spring there), but \
-         supply.u_max = {u_max}: \
-         choose a position nearer z_max or a larger supply.u_max"
-    )]
-    HoldingInput {
-        position: f64,
-        input: f64,
-        u_max: f64,
-    },
-    #[error("internal error: the symbol `{0}` of the linearization is unbound")]
-    UnboundSymbol(String),
-    #[error("the backstepping law's region: {0}")]
-    Region(super::region::RegionError),
-    #[error("the backstepping law: {0}")]
-    Backstepping(super::backstepping::BacksteppingError),
-}
-
-impl Operation {
-    /// `closing` or `opening`, as reports and the description name it.
-    pub fn name(self) -> &'static str {
-        match self {
-            Operation::Closing => "closing",
-            Operation::Opening => "opening",
-        }
-    }
-}
 
 /// A complete design, ready to emit: the controller and/or the observers.
 pub struct Design {

@@ -6,10 +6,10 @@ use std::fmt::Write as _;
 
 use crate::description::Estimator;
 
-use super::backstepping_design::BacksteppingDesign;
-use super::decisions::LawDesign;
-use super::optimal::OptimalTrajectory;
+use super::law::backstepping::design::BacksteppingDesign;
+use super::law::decisions::LawDesign;
 use super::plan::Design;
+use super::trajectory::optimal::OptimalTrajectory;
 
 impl Design {
     /// The report (one block per operation, then the observers).
@@ -170,7 +170,7 @@ fn law_text(law: &LawDesign) -> String {
             }
         ),
         LawDesign::ModelSlidingMode { p, k } => {
-            let [k1, k2, k3] = super::decisions::model_sliding_gains(p, k);
+            let [k1, k2, k3] = super::law::decisions::model_sliding_gains(p, k);
             format!(
                 "model-based sliding mode [JA 89]: p = {p:e} s⁻¹, K = {k:e} s⁻¹ (the tracking law [PT 50] with K = [{k1:e}, {k2:e}, {k3:e}]), inputs in [0, u_max] [JA 94]"
             )

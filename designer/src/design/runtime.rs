@@ -21,10 +21,10 @@ use crate::description::{Operation, SetPoint, Switching};
 use crate::model::Model;
 use crate::sym::Tape;
 
-use super::backstepping_design::BacksteppingDesign;
-use super::decisions::{ControllerDesign, LawDesign};
-use super::hold::HoldDesign;
-use super::linearization::Linearization;
+use super::derive::linearization::Linearization;
+use super::law::backstepping::design::BacksteppingDesign;
+use super::law::decisions::{ControllerDesign, LawDesign};
+use super::law::hold::HoldDesign;
 
 /// The tracking law [PT 50] from a tape: (x, u, t) → [α, β, a(x)] [PT 32],
 /// [PT 41], x the model's states (H_c too on the Jiles–Atherton core).

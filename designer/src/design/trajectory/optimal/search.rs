@@ -18,10 +18,10 @@
 //! by safeguarded regula falsi, each arc warm-started from the nearest one
 //! found (continuation in τ).
 
-use super::bvp::{solve_bvp, BvpOptions, BvpProblem, BvpSolution};
-use super::optimal::{HamiltonianSystem, OptimalError, OptimalSpec};
-use super::optimal_guess::GuessTapes;
-use super::reference::Polynomial;
+use super::guess::GuessTapes;
+use super::problem::{HamiltonianSystem, OptimalError, OptimalSpec, AUX_H, AUX_U};
+use crate::design::trajectory::bvp::{solve_bvp, BvpOptions, BvpProblem, BvpSolution};
+use crate::design::trajectory::reference::Polynomial;
 
 /// The Hamiltonian BVP of one arc: rest states at both ends.
 struct Problem<'a> {
@@ -126,7 +126,7 @@ impl ArcSolver<'_> {
         };
         let sol =
             solve_bvp(&problem, &t, &y, &opts).map_err(|source| OptimalError::Bvp { source })?;
-        let h = |k: usize| self.sys.aux_at(sol.t[k], &sol.y[k])[super::optimal::AUX_H];
+        let h = |k: usize| self.sys.aux_at(sol.t[k], &sol.y[k])[AUX_H];
         let last = sol.t.len() - 1;
         // z at the nodes and on the interpolant between them
         let between = sol
@@ -138,7 +138,7 @@ impl ArcSolver<'_> {
             [lo.min(z), hi.max(z)]
         });
         let u2: Vec<f64> = (0..=last)
-            .map(|k| self.sys.aux_at(sol.t[k], &sol.y[k])[super::optimal::AUX_U].powi(2))
+            .map(|k| self.sys.aux_at(sol.t[k], &sol.y[k])[AUX_U].powi(2))
             .collect();
         let cost = sol
             .t

@@ -21,14 +21,14 @@
 //!   φ = 0, where the runtime does not evaluate the law.
 //!
 //! With the Jiles–Atherton core, H_c enters f_F through φ̇ (as it enters α, β
-//! of `linearization.rs`) and is an input of the law; the force itself reads
+//! of `derive/linearization.rs`) and is an input of the law; the force itself reads
 //! φ only. Parameters, gains, y_r and P stay symbolic.
 
 use crate::model::Model;
 use crate::sym::{Graph, Id};
 
-use super::lie::lie;
-use super::linearization::{DesignError, Linearization};
+use crate::design::derive::lie::lie;
+use crate::design::derive::linearization::{DesignError, Linearization};
 
 /// The backstepping law's expressions, in full (over states, y_r, gains,
 /// P and parameters) and as stages for emitted code.

@@ -18,9 +18,9 @@
 use crate::model::Model;
 use crate::sym::Tape;
 
-use super::linearization::Linearization;
-use super::optimal::{CostateGuess, OptimalError};
-use super::reference::{Polynomial, Reference};
+use super::problem::{CostateGuess, OptimalError};
+use crate::design::derive::linearization::Linearization;
+use crate::design::trajectory::reference::{Polynomial, Reference};
 
 /// Compiled α, β, ∂f/∂x, g over (z, v, φ, u, t) and T⁻¹, φ² over ξ.
 pub(crate) struct GuessTapes {

@@ -21,8 +21,8 @@ use crate::description::Core;
 use crate::model::{FieldPath, Model, Statics};
 use crate::sym::Tape;
 
-use super::linearization::Linearization;
 use super::reference::Reference;
+use crate::design::derive::linearization::Linearization;
 
 /// One condition evaluated along the reference.
 #[derive(Debug, Clone, PartialEq)]

@@ -8,11 +8,11 @@ pub use crate::description::triple_pole_settling_product;
 use crate::description::{Gains, Operation};
 use crate::model::Model;
 
-use super::feasibility::Feasibility;
-use super::linearization::{FluxSquared, Linearization};
-use super::optimal::OptimalTrajectory;
-use super::plan::PlanError;
-use super::segments::Segments;
+use crate::design::derive::linearization::{FluxSquared, Linearization};
+use crate::design::error::PlanError;
+use crate::design::trajectory::feasibility::Feasibility;
+use crate::design::trajectory::optimal::OptimalTrajectory;
+use crate::design::trajectory::segments::Segments;
 
 /// Fraction of the smallest reference flux below which the law is not
 /// evaluated (before rounding down to one significant digit).

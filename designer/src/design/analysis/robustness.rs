@@ -7,7 +7,7 @@
 //! - [SM 13] F*_mag = m·a_r − F_pas(z_r, v_r) ≤ 0 (the magnet only attracts) and
 //!   [SM 14] F*_mag ≥ −½·R_g′(z_r)·φ_sat² (saturation): the reference is feasible;
 //! - [SM 26] B_j = −L_g L_f²h, [SM 25] f_j = L_f³h, both from the model's own
-//!   derivation (`linearization.rs`), so every gap, core and coil is covered;
+//!   derivation (`derive/linearization.rs`), so every gap, core and coil is covered;
 //! - [SM 48] u* = |f_j − j_r| / |B_j|, the input of ideal tracking;
 //! - [SM 49]–[SM 50] required u_max = max u* + (max|ε| + η)/min|B_j|, with
 //!   ε = (λ₁ + λ₂)·ã + λ₁λ₂·ṽ [SM 24] bounded by the error bounds [SM 52]
@@ -22,9 +22,9 @@ use crate::description::{schema, SlidingSurface};
 use crate::model::{FieldPath, Model};
 use crate::sym::Tape;
 
-use super::feasibility::reference_field;
-use super::linearization::Linearization;
-use super::reference::Reference;
+use crate::design::derive::linearization::Linearization;
+use crate::design::trajectory::feasibility::reference_field;
+use crate::design::trajectory::reference::Reference;
 
 /// The end of an operation [s from its start]: the rest after landing lasts
 /// as long as the one before takeoff [SM 45], t_f − t_land = t_takeoff − t₀.

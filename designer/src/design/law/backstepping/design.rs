@@ -5,24 +5,24 @@
 //! `backstepping` module applies it.
 //!
 //! - every target y_r must be holdable (an attracting flux balances the
-//!   spring there within the supply, as for the hold of `hold.rs`);
+//!   spring there within the supply, as for the hold of `law/hold.rs`);
 //! - the spring's rest X₀, the state u = 0 converges to: the zero of the
 //!   passive force F_p(z, 0) within the stroke, or the stop it pushes
 //!   against (z_max for the bundled valves, whose preload holds them open);
 //! - the region (`region.rs`) on A = [[−α₁, 1], [−1, −α₂]] [SB 14] and
 //!   F_d = g − kᵀZ, whose g and k are read off the derived F_d (affine,
-//!   checked by `backstepping.rs`); the switching strategies need X₀ ∈ D.
+//!   checked by `derivation.rs`); the switching strategies need X₀ ∈ D.
 
 use crate::description::{BacksteppingKeys, Description, Mechanics, SetPoint, Switching};
 use crate::model::Model;
 use crate::sym::Id;
 
-use super::backstepping::{Backstepping, BacksteppingError};
-use super::decisions::round_down_1sig;
-use super::hold::holding;
-use super::linearization::{FluxSquared, Linearization};
-use super::plan::PlanError;
-use super::region::{decay_limit, design_region, Region, RegionError, Target};
+use super::derivation::Backstepping;
+use super::region::{decay_limit, design_region, Region, Target};
+use crate::design::derive::linearization::{FluxSquared, Linearization};
+use crate::design::error::PlanError;
+use crate::design::law::decisions::round_down_1sig;
+use crate::design::law::hold::holding;
 
 /// The default decay: this fraction of the largest a quadratic V certifies.
 const DEFAULT_DECAY_FRACTION: f64 = 0.2;
@@ -69,18 +69,6 @@ impl BacksteppingDesign {
             ("region_p12", law.coupling[0], p12),
             ("region_p22", law.coupling[1], p22),
         ]
-    }
-}
-
-impl From<RegionError> for PlanError {
-    fn from(e: RegionError) -> Self {
-        PlanError::Region(e)
-    }
-}
-
-impl From<BacksteppingError> for PlanError {
-    fn from(e: BacksteppingError) -> Self {
-        PlanError::Backstepping(e)
     }
 }
 

@@ -14,9 +14,9 @@ use crate::description::{params, Description, Law, Operation, SlidingSurface};
 use crate::model::Model;
 use crate::random::SplitMix64;
 
-use super::linearization::Linearization;
-use super::plan::{design_reference, SharedReference};
 use super::robustness::{operation_end, ErrorBounds, Evaluator, Robustness};
+use crate::design::derive::linearization::Linearization;
+use crate::design::plan::{design_reference, SharedReference};
 
 /// Why an analysis could not run.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -10,17 +10,17 @@
 //!   arc is warm-started from the last one found (continuation in τ).
 //! - **J against t_f − t₀.** Free arcs from the shortest up, each warm-started
 //!   from the last, while they stay inside the stroke and H < u_rest²
-//!   (`optimal_search.rs`); beyond, the optimal motion is that arc followed
+//!   (`optimal/search.rs`); beyond, the optimal motion is that arc followed
 //!   by rest, and J grows by u_rest² per second.
 
 use crate::model::Model;
 use crate::sym::Tape;
 
-use super::linearization::Linearization;
-use super::optimal::{HamiltonianSystem, OptimalError, OptimalSpec, AUX_U};
-use super::optimal_guess::GuessTapes;
-use super::optimal_search::{Arc, ArcSolver, PROBE_MAX_NODES};
+use super::optimal::guess::GuessTapes;
+use super::optimal::problem::{HamiltonianSystem, OptimalError, OptimalSpec, AUX_U};
+use super::optimal::search::{Arc, ArcSolver, PROBE_MAX_NODES};
 use super::reference::Polynomial;
+use crate::design::derive::linearization::Linearization;
 
 /// One point of the J(t_f − t₀) curve.
 #[derive(Debug, Clone, Copy, PartialEq)]

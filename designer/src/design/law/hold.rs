@@ -13,8 +13,8 @@ use crate::description::{Description, Drive, ModelSurface};
 use crate::model::{rest_point, Model};
 
 use super::decisions::{model_sliding_gains, round_down_1sig};
-use super::linearization::{FluxSquared, Linearization};
-use super::plan::PlanError;
+use crate::design::derive::linearization::{FluxSquared, Linearization};
+use crate::design::error::PlanError;
 
 /// Fraction of the holding flux below which the law is not evaluated.
 const GUARD_FRACTION: f64 = 1e-3;
