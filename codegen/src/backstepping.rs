@@ -22,8 +22,9 @@ use designer::sym::{Graph, Id};
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
-use crate::controller::{runtime_state_pattern, state_args, ControllerError};
+use crate::controller::{runtime_state_pattern, state_args};
 use crate::emit::{function_tokens_as, FunctionSpec, Inline};
+use crate::error::ControllerError;
 use crate::float::{Float, Scalar, MACRO_LITERALS};
 use crate::format::{comment_lets, format_items, macro_rules, space_items};
 use crate::operations::{documented_consts, unique_floats};

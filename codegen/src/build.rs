@@ -10,14 +10,16 @@ use designer::description::{parse_file, Estimator, FloatType};
 use designer::design::{Design, LawDesign, PlanError};
 
 use crate::backstepping::{emit_backstepping, BacksteppingInput};
-use crate::controller::{emit_controller, ControllerError, ControllerInput};
+use crate::controller::emit_controller;
 use crate::emit::params_macro;
+use crate::error::ControllerError;
 use crate::error::EmitError;
 use crate::header::Header;
 use crate::hold::{emit_hold, HoldInput};
 use crate::observer::{
     emit_ekf, emit_kalman_macro, emit_ukf, wrap_module, ObserverError, ObserverInput,
 };
+use crate::operations::ControllerInput;
 use crate::semera::{emit_semera, SemeraError, SemeraInput};
 use crate::sliding::emit_sliding_mode;
 use crate::Float;

@@ -30,41 +30,14 @@ use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
 use crate::emit::{function_tokens_as, FunctionSpec, Inline};
-use crate::error::EmitError;
+use crate::error::ControllerError;
 use crate::float::{Float, Scalar, MACRO_LITERALS};
 use crate::format::{comment_lets, format_items, macro_rules, space_items};
-use crate::operations::{checked_floats, documented_consts, plan_items, splice_tables};
+use crate::operations::{
+    checked_floats, documented_consts, plan_items, splice_tables, ControllerInput,
+};
 use crate::param::Param;
 use crate::physical::{in_scope, of_model};
-
-/// Why a controller could not be emitted.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ControllerError {
-    #[error(transparent)]
-    Emit(#[from] EmitError),
-    #[error("no float type to emit")]
-    NoFloat,
-    #[error("the {0} law has no gains K [PT 48]: it is emitted by its own module")]
-    NotFeedbackLinearization(&'static str),
-    #[error("internal error: the sliding-mode module was asked to emit another law")]
-    NotSlidingMode,
-    #[error("the design value `{name}` = {value} is not finite in the float type")]
-    BadValue { name: String, value: f64 },
-    #[error(
-        "the name `{0}` of a design constant or reference symbol is already taken by the model"
-    )]
-    NameTaken(String),
-}
-
-/// Everything [`emit_controller`] needs.
-#[derive(Clone)]
-pub struct ControllerInput<'a> {
-    /// The model the design is for (graph, parameters, states, stroke).
-    pub model: &'a Model,
-    pub design: &'a ControllerDesign,
-    /// Emitted float types, in this order (duplicates ignored).
-    pub floats: Vec<Float>,
-}
 
 /// Names of the law's own constants (checked against the parameters' const names).
 const GAIN_CONSTS: &[&str] = &["GAIN_K1", "GAIN_K2", "GAIN_K3", "SURFACE_P", "REACHING_K"];

@@ -1,4 +1,5 @@
-//! Why an emission was refused.
+//! Why an emission was refused: by the expression emitter ([`EmitError`]) or
+//! by a controller module ([`ControllerError`], every law's).
 
 /// Errors of the emitter: every one names the offending symbol or name.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -23,4 +24,23 @@ pub enum EmitError {
     OutputUsedEarly(String),
     #[error("internal error: the emitted tokens do not parse as Rust: {0}")]
     Syntax(String),
+}
+
+/// Why a controller could not be emitted (every law's module returns it).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ControllerError {
+    #[error(transparent)]
+    Emit(#[from] EmitError),
+    #[error("no float type to emit")]
+    NoFloat,
+    #[error("the {0} law has no gains K [PT 48]: it is emitted by its own module")]
+    NotFeedbackLinearization(&'static str),
+    #[error("internal error: the sliding-mode module was asked to emit another law")]
+    NotSlidingMode,
+    #[error("the design value `{name}` = {value} is not finite in the float type")]
+    BadValue { name: String, value: f64 },
+    #[error(
+        "the name `{0}` of a design constant or reference symbol is already taken by the model"
+    )]
+    NameTaken(String),
 }

@@ -16,9 +16,8 @@ use designer::design::HoldDesign;
 use designer::model::Model;
 use quote::{format_ident, quote};
 
-use crate::controller::{
-    compensation_doc, law_macro_text, runtime_state_pattern, ControllerError, LawSource,
-};
+use crate::controller::{compensation_doc, law_macro_text, runtime_state_pattern, LawSource};
+use crate::error::ControllerError;
 use crate::float::Float;
 use crate::format::{format_items, space_items};
 use crate::operations::{documented_consts, unique_floats};

@@ -24,9 +24,9 @@
 //! | `fold.rs` | parameter-only subexpressions that need a math call, evaluated when generated |
 //! | `float.rs` | [`Float`], shortest round-trip literals, and the `$f` of macros written once for every float type |
 //! | `format.rs` | `prettyplease` formatting, `//` comments and `macro_rules!` bodies |
-//! | `error.rs` | [`EmitError`] |
+//! | `error.rs` | [`EmitError`], [`ControllerError`] |
 //! | `build.rs` | a description → the emitted file ([`build_file`], [`compile`], [`emit`]) |
-//! | `operations.rs` | what every controller module states: the plan's consts, tables, `Operation`, `Design` with `control::Plan` |
+//! | `operations.rs` | what every controller module states: its input, the plan's consts, tables, `Operation`, `Design` with `control::Plan` |
 //! | `controller.rs` | the tracking-law controller (feedback linearization, and the model-based sliding mode [JA 89] which is it with other gains): the `law!` macro and the float modules (over `reldesign_runtime::control`) |
 //! | `backstepping.rs` | the backstepping position controller [SB 19]: the `law!` macro of its stages and the float modules (over `reldesign_runtime::backstepping`) |
 //! | `hold.rs` | the position hold of the model-based sliding mode: the float modules (over `reldesign_runtime::hold`) |
@@ -56,10 +56,11 @@ mod sliding;
 
 pub use backstepping::{emit_backstepping, BacksteppingInput};
 pub use build::{build_file, compile, emit, write_if_changed, BuildError};
-pub use controller::{emit_controller, ControllerError, ControllerInput};
+pub use controller::emit_controller;
 pub use emit::{
     emit_function, emit_params, function_tokens, params_macro, params_tokens, FunctionSpec,
 };
+pub use error::ControllerError;
 pub use error::EmitError;
 pub use float::Float;
 pub use format::format_items;
@@ -67,6 +68,7 @@ pub use header::{sha256_hex, Header};
 pub use hold::{emit_hold, HoldInput};
 pub use names::const_name;
 pub use observer::*;
+pub use operations::ControllerInput;
 pub use param::Param;
 pub use semera::*;
 pub use sliding::emit_sliding_mode;

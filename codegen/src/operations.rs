@@ -1,4 +1,5 @@
-//! What every controller module states, whichever its law: the design
+//! What every controller module states, whichever its law: its input
+//! ([`ControllerInput`]: model, design, float types), the design
 //! constants the runtime's `control::Settings` reads (supply bounds, timing,
 //! guard threshold, landed band, press, creep), the reference tables (one
 //! `[[f; 7]; N]` per operation, one row `[t_k, z_k, v_k, c0, c1, c2, c3]` per
@@ -13,11 +14,21 @@ use designer::model::Model;
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::controller::{ControllerError, ControllerInput};
 use crate::emit::doc_attrs;
-use crate::error::EmitError;
+use crate::error::{ControllerError, EmitError};
 use crate::float::Float;
 use crate::names::const_name;
+
+/// Everything a tracking law's module (`controller.rs`, `sliding.rs`)
+/// needs: [`crate::emit_controller`]'s input.
+#[derive(Clone)]
+pub struct ControllerInput<'a> {
+    /// The model the design is for (graph, parameters, states, stroke).
+    pub model: &'a Model,
+    pub design: &'a ControllerDesign,
+    /// Emitted float types, in this order (duplicates ignored).
+    pub floats: Vec<Float>,
+}
 
 /// Names of the plan's constants (checked against the parameters' const names).
 const PLAN_CONSTS: &[&str] = &[

@@ -14,10 +14,12 @@
 use designer::design::LawDesign;
 use quote::{format_ident, quote};
 
-use crate::controller::{ControllerError, ControllerInput};
+use crate::error::ControllerError;
 use crate::float::Float;
 use crate::format::{format_items, space_items};
-use crate::operations::{checked_floats, documented_consts, plan_items, splice_tables};
+use crate::operations::{
+    checked_floats, documented_consts, plan_items, splice_tables, ControllerInput,
+};
 
 /// Names of the law's own constants.
 const SURFACE_CONSTS: &[&str] = &["LAMBDA1", "LAMBDA2", "NONNEGATIVE_CURRENT"];
