@@ -17,7 +17,8 @@
 //! - `drift.rs`: the growth of the residual from cycle to cycle;
 //! - `position.rs`: the simulated position against a measured one;
 //! - `report.rs`: the [`Localisation`] and how it reads;
-//! - `stats.rs`: range, mean, deviation and median of a signal.
+//! - `stats.rs`: range, mean, deviation and median of a signal; a share in
+//!   whole percent.
 
 mod drift;
 mod position;

@@ -12,8 +12,7 @@
 
 use std::fmt;
 
-use super::report::pct;
-use super::stats::{median, range};
+use super::stats::{median, pct, range};
 use super::Sums;
 
 /// Schmitt-trigger levels of the rising edges, as fractions of the range.

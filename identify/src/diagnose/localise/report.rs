@@ -6,6 +6,7 @@ use std::fmt;
 use super::drift::Drift;
 use super::position::PositionError;
 use super::regions::{Region, RegionShare};
+use super::stats::pct;
 use super::timing::EdgeTiming;
 use super::windows::Window;
 
@@ -60,11 +61,6 @@ impl Localisation {
             .map(|w| (w.start, w.end, "largest residual".to_string()));
         region.chain(worst).collect()
     }
-}
-
-/// A fraction in whole percent.
-pub(super) fn pct(x: f64) -> f64 {
-    (100.0 * x).round()
 }
 
 impl fmt::Display for Localisation {

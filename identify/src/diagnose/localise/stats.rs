@@ -1,4 +1,5 @@
-//! Summary statistics of a signal: its range, mean and deviation, median.
+//! Summary statistics of a signal: its range, mean and deviation, median;
+//! a share as the percentage the reports print.
 
 /// Min and max of the finite values (0, 0 when there is none).
 pub(super) fn range(x: &[f64]) -> (f64, f64) {
@@ -31,4 +32,9 @@ pub(super) fn median(x: &mut [f64]) -> Option<f64> {
         n if n % 2 == 1 => Some(x[n / 2]),
         n => Some(0.5 * (x[n / 2 - 1] + x[n / 2])),
     }
+}
+
+/// A fraction in whole percent.
+pub(super) fn pct(x: f64) -> f64 {
+    (100.0 * x).round()
 }
