@@ -273,3 +273,24 @@ fn equation_citations_carry_their_paper() {
         "citations without a paper key ([PT 50], [JA 84a], [SE Alg. 1]): {untagged:#?}"
     );
 }
+
+#[path = "tidy/circles.rs"]
+mod circles;
+
+/// No crate's modules use each other in a circle (issue 34 found four:
+/// `design/{plan, decisions, hold, backstepping_design}`, `design/{optimal,
+/// optimal_guess, optimal_search}`, `codegen/{controller, operations}`,
+/// `diagnose/localise/{drift, report}`); what two modules share lives in a
+/// lower one.
+#[test]
+fn no_module_uses_itself_through_another() {
+    let found: Vec<String> = CRATES
+        .iter()
+        .flat_map(|krate| {
+            circles::circles(&root().join(krate).join("src"), "")
+                .into_iter()
+                .map(move |c| format!("{krate}: {}", c.join(" → ")))
+        })
+        .collect();
+    assert!(found.is_empty(), "import circles: {found:#?}");
+}
