@@ -843,14 +843,14 @@ pub struct SweepRow {
 
 /// The description's design redone at each sample period (controller, and
 /// the observer's period with it, its process noise per step ∝ T_s), each in
-/// closed loop on the plant; rows in the order of `periods` (run in parallel).
+/// closed loop on the plant; rows in the order of `periods` (run in parallel
+/// with the `parallel` feature).
 pub fn sweep(
     description: &Description,
     plant: Option<&Description>,
     periods: &[f64],
     options: &Options,
 ) -> Result<Vec<SweepRow>, LoopError> {
-    use rayon::prelude::*;
     if let Some(law) = design_positions(description) {
         return Err(LoopError::Positions(law));
     }
@@ -860,27 +860,24 @@ pub fn sweep(
     for &ts in periods {
         check_sample_period(description, ts)?;
     }
-    let rows: Vec<Result<SweepRow, LoopError>> = periods
-        .par_iter()
-        .map(|&ts| {
-            let mut d = description.clone();
-            if let Some(c) = &mut d.controller {
-                c.sample_period = ts;
-            }
-            if let Some(o) = &mut d.observer {
-                resample_observer(o, ts);
-            }
-            let design = Design::new(&d).map_err(|e| LoopError::Design {
-                sample_period: ts,
-                message: e.to_string(),
-            })?;
-            let run = run_loop(&design, plant, ts, None, Noise::seeded(0), options)?;
-            Ok(SweepRow {
-                sample_period: ts,
-                outcomes: run.outcomes(t.takeoff, t.landing),
-            })
+    let rows: Vec<Result<SweepRow, LoopError>> = crate::parallel::map(periods, |&ts| {
+        let mut d = description.clone();
+        if let Some(c) = &mut d.controller {
+            c.sample_period = ts;
+        }
+        if let Some(o) = &mut d.observer {
+            resample_observer(o, ts);
+        }
+        let design = Design::new(&d).map_err(|e| LoopError::Design {
+            sample_period: ts,
+            message: e.to_string(),
+        })?;
+        let run = run_loop(&design, plant, ts, None, Noise::seeded(0), options)?;
+        Ok(SweepRow {
+            sample_period: ts,
+            outcomes: run.outcomes(t.takeoff, t.landing),
         })
-        .collect();
+    });
     // the first failing period in the order given, whatever the threads did
     rows.into_iter().collect()
 }

@@ -21,6 +21,7 @@ pub mod description;
 pub mod design;
 pub mod model;
 pub mod observe;
+mod parallel;
 pub mod random;
 pub mod record;
 pub mod replay;

@@ -6,12 +6,12 @@
 //! tracks them; each draw changes the device, not the design. A draw varies every key of
 //! `--vary KEY=±P%` uniformly within ±P % of its nominal value; draw k is
 //! generated from (seed, k) alone, so the answer does not depend on the
-//! number of threads. The draws run in parallel (rayon).
-
-use rayon::prelude::*;
+//! number of threads. The draws run in parallel with the `parallel` feature
+//! (`designer/src/parallel.rs`).
 
 use crate::description::{params, Description, Law, Operation, SlidingSurface};
 use crate::model::Model;
+use crate::parallel;
 use crate::random::SplitMix64;
 
 use super::robustness::{operation_end, ErrorBounds, Evaluator, Robustness};
@@ -272,14 +272,16 @@ impl<'a> Analysis<'a> {
         }
         // reduced as they come (no list of every draw), associatively, so the
         // answer is the same whatever the split between threads
-        let tally = (0..draws)
-            .into_par_iter()
-            .map(|k| {
+        let tally = parallel::try_map_reduce(
+            draws,
+            |k| {
                 let draw = self.draw(variations, seed, k);
                 progress();
                 draw.map(Tally::of)
-            })
-            .try_reduce(Tally::empty, |a, b| Ok(a.merge(b)))?;
+            },
+            Tally::empty,
+            Tally::merge,
+        )?;
         let worst = tally.worst.ok_or(RobustnessError::NoDraws)?;
         Ok(MonteCarlo {
             draws,

@@ -1,0 +1,46 @@
+//! A firmware build compiles only what designing and emitting need: the
+//! designer's analyses run on rayon's threads only with its `parallel`
+//! feature, which the CLI turns on and the build crate does not, so
+//! `cargo tree -p firmware-example -e normal,build` (the firmware's own
+//! resolution, as `cargo build -p firmware-example` sees it) has no rayon.
+
+use std::path::Path;
+use std::process::Command;
+
+/// The package names of the firmware example's normal and build dependencies.
+fn firmware_packages() -> Vec<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = Command::new(env!("CARGO"))
+        .current_dir(&root)
+        .args(["tree", "--offline", "-p", "firmware-example"])
+        .args(["-e", "normal,build", "--prefix", "none"])
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "cargo tree: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .map(str::to_owned)
+        .collect()
+}
+
+#[test]
+fn a_firmware_build_compiles_no_thread_pool() {
+    let packages = firmware_packages();
+    assert!(
+        packages.iter().any(|p| p == "reldesign-designer"),
+        "the tree was not read: {packages:?}"
+    );
+    let threads: Vec<&String> = packages
+        .iter()
+        .filter(|p| p.starts_with("rayon") || p.starts_with("crossbeam"))
+        .collect();
+    assert!(
+        threads.is_empty(),
+        "the firmware's build compiles {threads:?}"
+    );
+}
