@@ -30,6 +30,7 @@ use reldesign_identify::lm::Status;
 use reldesign_identify::{flux_from_data, Measured, SimOutputs};
 use serde_json::{json, Value};
 
+use crate::progress::Progress;
 use crate::{diagnose_plot, fail};
 
 #[derive(clap::Args)]
@@ -539,7 +540,6 @@ fn batch(
     options: &Options,
 ) -> Result<(), Report> {
     use rayon::prelude::*;
-    use std::sync::atomic::{AtomicUsize, Ordering};
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| fail(format!("--batch {}: {e}", dir.display())))?
         .filter_map(|entry| entry.ok().map(|e| e.path()))
@@ -552,8 +552,9 @@ fn batch(
             dir.display()
         )));
     }
-    let done = AtomicUsize::new(0);
     let total = files.len();
+    let bar = Progress::new(total as u64, "records");
+    let done = std::sync::atomic::AtomicUsize::new(0);
     let results: Vec<Result<One, String>> = files
         .par_iter()
         .map(|path| {
@@ -562,15 +563,17 @@ fn batch(
                 .and_then(|data| {
                     diagnose_one(description, &data, out, path, options).map_err(|e| e.to_string())
                 });
-            let k = done.fetch_add(1, Ordering::Relaxed) + 1;
+            let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             let what = match &one {
                 Ok(o) => format!("{} (gain {})", o.cause.name(), percent(o.gain)),
                 Err(_) => "failed".to_owned(),
             };
-            eprintln!("[{k}/{total}] {}: {what}", path.display());
+            bar.println(&format!("[{k}/{total}] {}: {what}", path.display()));
+            bar.inc();
             one
         })
         .collect();
+    bar.finish();
     let mut failed = 0;
     let mut by_cause: Vec<(String, usize, f64)> = Vec::new();
     for (path, result) in files.iter().zip(&results) {

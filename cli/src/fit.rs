@@ -11,7 +11,6 @@
 //! design sections kept, atomically); `--json` prints one JSON object.
 //! Progress goes to stderr only when stderr is a terminal.
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 use designer::description::Description;
@@ -24,6 +23,7 @@ use reldesign_identify::params::{self, Domain};
 use reldesign_identify::{current_wnrmse, fit, FitOptions, FitParam, Measured};
 use serde_json::{json, Value};
 
+use crate::progress::Progress;
 use crate::{fail, finite};
 
 #[derive(clap::Args)]
@@ -89,22 +89,23 @@ fn run_fit(args: &Args, description: &Description) -> Result<(), Report> {
         ..FitOptions::default()
     };
     let before = current_wnrmse(description, &data).map_err(fail)?;
-    let terminal = std::io::stderr().is_terminal();
+    let bar = Progress::new(
+        (options.starts * options.max_iterations) as u64,
+        "iterations at most",
+    );
     let progress = |p: FitProgress| {
-        if terminal {
-            eprint!(
-                "\rstart {}/{} iteration {:3}: objective {:.4e}   ",
-                p.start + 1,
-                p.starts,
-                p.iteration,
-                p.objective
-            );
-        }
+        bar.inc();
+        bar.message(format!(
+            "start {}/{} iteration {}: objective {:.4e}",
+            p.start + 1,
+            p.starts,
+            p.iteration,
+            p.objective
+        ));
     };
-    let report = fit(description, &data, &fitted, &options, &progress).map_err(fail)?;
-    if terminal {
-        eprintln!();
-    }
+    let report = fit(description, &data, &fitted, &options, &progress).map_err(fail);
+    bar.finish();
+    let report = report?;
     let written = write_out(args, description, &report.description)?;
     if args.json {
         println!(

@@ -15,6 +15,7 @@ mod limits;
 mod observe;
 mod plot;
 mod position_loop;
+mod progress;
 mod region_plot;
 mod robustness;
 mod simulate;

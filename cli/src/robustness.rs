@@ -4,14 +4,13 @@
 //! case over parameter bounds.
 
 use std::fmt::Write as _;
-use std::io::IsTerminal as _;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use designer::design::{Analysis, ErrorBounds, MonteCarlo, Nominal, Robustness, Variation};
 use miette::Report;
 use serde_json::{json, Value};
 
+use crate::progress::Progress;
 use crate::{fail, finite};
 
 #[derive(clap::Args)]
@@ -83,26 +82,15 @@ fn error_bounds(args: &Args) -> Result<ErrorBounds, Report> {
     })
 }
 
-/// The draws, with a progress line on a terminal.
+/// The draws, with a progress bar on a terminal.
 fn run_draws(
     analysis: &Analysis,
     variations: &[Variation],
     args: &Args,
 ) -> Result<MonteCarlo, designer::design::RobustnessError> {
-    let done = AtomicUsize::new(0);
-    let terminal = std::io::stderr().is_terminal();
-    let draws = args.draws as usize;
-    let step = (draws / 100).max(1);
-    let progress = || {
-        let k = done.fetch_add(1, Ordering::Relaxed) + 1;
-        if terminal && (k % step == 0 || k == draws) {
-            eprint!("\r  draws {k}/{draws}");
-        }
-    };
-    let result = analysis.monte_carlo(variations, draws, args.seed, &progress);
-    if terminal {
-        eprintln!();
-    }
+    let bar = Progress::new(u64::from(args.draws), "draws");
+    let result = analysis.monte_carlo(variations, args.draws as usize, args.seed, &|| bar.inc());
+    bar.finish();
     result
 }
 
