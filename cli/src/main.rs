@@ -9,6 +9,8 @@ mod check;
 mod closed_loop;
 mod diagnose;
 mod diagnose_plot;
+#[cfg(test)]
+mod doc_commands;
 mod eval;
 mod fit;
 mod limits;
