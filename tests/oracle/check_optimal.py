@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Oracle for reldesign's energy-optimal trajectory (designer/src/design/optimal.rs;
+"""Oracle for reldesign's energy-optimal trajectory (designer/src/design/trajectory/optimal.rs;
 perfect-tracking-soft-landing §4, eqs. 58-66).
 
 Independently of reldesign: f(x, u, t) from the TOML (tests/oracle/model.py

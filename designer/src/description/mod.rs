@@ -243,7 +243,7 @@ pub struct Controller {
     /// `None`: 2.5·10⁻³ of the stroke per motion time (`codegen`).
     pub creep_speed: Option<f64>,
     /// [m] (> 0): within this distance of its end stop the armature counts as
-    /// in contact. `None`: 10⁻⁹ of the stroke (`design::decisions`).
+    /// in contact. `None`: 10⁻⁹ of the stroke (`design::law::decisions`).
     pub landed_band: Option<f64>,
     /// The observer of `[observer]` that drives the controller in the closed
     /// loops of `reldesign loop` and `sweep` (`Ekf` or `Ukf`); `None`: the
