@@ -12,6 +12,7 @@ mod diagnose_plot;
 mod eval;
 mod fit;
 mod limits;
+mod loop_runs;
 mod observe;
 mod plot;
 mod position_loop;
