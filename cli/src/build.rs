@@ -225,7 +225,7 @@ fn calibration_report(design: &designer::design::Design, sample_period: f64) -> 
             for a in &c.parameters {
                 let _ = writeln!(
                     s,
-                    "  adapts {:<22} from {:e} within [{:e}, {:e}] ({:.0} % of its information new)",
+                    "  adapts {:<22} from {:.4e} within [{:.4e}, {:.4e}] ({:.0} % of its information new)",
                     a.key,
                     a.nominal,
                     a.lower,
