@@ -186,11 +186,13 @@ pub fn expert_rule<T: Scalar>(
     }
 }
 
-/// No hover, ever: after t_f + `arrival_margin`, an armature that is not at
-/// its end stop (the expert rule [SM 43] did not take it) is driven there —
-/// closing: u = u_max·sgn φ pulls it in; opening: u = u_min while φ >
-/// `phi_guard` quenches the flux, then u = 0 lets the spring open it.
-/// `None` before. Saturated.
+/// No hover, ever: after t_f + `arrival_margin` the armature is driven to
+/// its end stop, wherever its (estimated) position says it is — closing:
+/// u = u_max·sgn φ pulls it in (at the stop, the expert rule [SM 43]);
+/// opening: u = u_min while φ > `phi_guard` drains the flux, then u = 0 lets
+/// the spring open it (at the stop, the rule's 0 V a little sooner). A
+/// sensorless estimate that has lost the armature cannot hold it short of
+/// its stop. `None` before. Saturated.
 #[inline]
 pub fn finish_stroke<T: Scalar>(
     motion: &Motion<T>,
@@ -339,9 +341,10 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
         self.late = false;
     }
 
-    /// Whether the armature missed its stop by t_f + `arrival_margin` and
-    /// [`finish_stroke`] drove it there: a landing later than planned, for
-    /// the firmware to report (and its calibration to learn from).
+    /// Whether the armature was not at its stop (by the position read) at
+    /// t_f + `arrival_margin` and [`finish_stroke`] drove it there: a landing
+    /// later than planned, for the firmware to report (and its calibration
+    /// to learn from).
     #[must_use]
     pub const fn finished_late(&self) -> bool {
         self.late
@@ -382,12 +385,16 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
     /// observer), which the law of a design on a Jiles–Atherton core reads.
     pub fn step_with_field(&mut self, t: T, z: T, v: T, phi: T, hc: T) -> T {
         let time = self.tracker.elapsed(t);
-        if let Some(u) = self.hold(time, z, phi) {
+        let motion = self.law.motion(self.tracker.operation());
+        let settings = self.law.settings();
+        // the push comes first: at the stop it is the expert rule (closing)
+        // or drains the flux the rule would leave to decay (opening), and it
+        // does not trust a position estimate that may have lost the armature
+        if let Some(u) = finish_stroke(&motion, &settings, time, phi) {
+            self.late |= expert_rule(&motion, &settings, z, phi).is_none();
             return u;
         }
-        let motion = self.law.motion(self.tracker.operation());
-        if let Some(u) = finish_stroke(&motion, &self.law.settings(), time, phi) {
-            self.late = true;
+        if let Some(u) = self.hold(time, z, phi) {
             return u;
         }
         let reference = self.reference(t);

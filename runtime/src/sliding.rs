@@ -138,12 +138,13 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
         } else {
             flux_sign(phi)
         };
-        // [SM 43]
-        if let Some(u) = expert_rule(&motion, &settings, z, flux) {
+        let landed = expert_rule(&motion, &settings, z, flux);
+        if let Some(u) = finish_stroke(&motion, &settings, self.tracker.elapsed(t), phi) {
+            self.late |= landed.is_none();
             return u;
         }
-        if let Some(u) = finish_stroke(&motion, &settings, self.tracker.elapsed(t), phi) {
-            self.late = true;
+        // [SM 43]
+        if let Some(u) = landed {
             return u;
         }
         let [zr, vr, ar, _] = self.tracker.reference(&self.plan, t);

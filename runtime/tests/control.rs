@@ -204,9 +204,13 @@ macro_rules! toy {
                 assert_eq!(c.step(4.1, 0.5, 0.0, 1.0), -24.0);
                 assert_eq!(c.step(4.1, 0.5, 0.0, 1e-4), 0.0);
                 assert!(c.finished_late());
-                // at the stop the expert rule holds, not the push
+                // at the stop: the flux drained all the same, but not late
                 let mut c = Ctl::new(Operation::Opening);
-                assert_eq!(c.step(4.1, 1.0, 0.0, 1.0), 0.0);
+                assert_eq!(c.step(4.1, 1.0, 0.0, 1.0), -24.0);
+                assert_eq!(c.step(4.1, 1.0, 0.0, 1e-4), 0.0);
+                assert!(!c.finished_late());
+                let mut c = Ctl::new(Operation::Closing);
+                assert_eq!(c.step(4.1, 0.0, 0.0, 1.0), 20.0);
                 assert!(!c.finished_late());
             }
 

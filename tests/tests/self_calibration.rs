@@ -76,6 +76,8 @@ struct Study {
     worst_late: [f64; 2],
     bounce_late: [f64; 2],
     hovered: bool,
+    /// The uncontrolled switching reaches both stops (a valve that works).
+    switches: bool,
 }
 
 fn study(design: &Design, d: &Description, plant: &Variant, n: usize) -> Study {
@@ -101,6 +103,7 @@ fn study(design: &Design, d: &Description, plant: &Variant, n: usize) -> Study {
         worst_late: [f64::INFINITY; 2],
         bounce_late: [0.0; 2],
         hovered: false,
+        switches: baseline.iter().all(|(_, v)| v.is_some()),
     };
     for k in 0..2 {
         s.first[k] = softness(&done[0], k);
@@ -142,8 +145,12 @@ fn the_self_calibration_study_over_forty_plants() {
         ("tuning seeds 0–19", 0..20),
         ("held-out seeds 20–39", 20..40),
     ] {
-        let part = &studies[range];
-        println!("{name}: {} plants, {n} runs each", part.len());
+        let part: Vec<&Study> = studies[range].iter().filter(|s| s.switches).collect();
+        println!(
+            "{name}: {} plants that switch ({} whose uncontrolled switching misses a stop left out), {n} runs each",
+            part.len(),
+            20 - part.len()
+        );
         for (k, op) in ["closing", "opening"].iter().enumerate() {
             println!(
                 "  {op}: softness ×switching at run 1   {}",
@@ -185,5 +192,8 @@ fn the_self_calibration_study_over_forty_plants() {
     for s in &studies {
         println!("{s:?}");
     }
-    assert!(studies.iter().all(|s| !s.hovered), "an operation hovered");
+    assert!(
+        studies.iter().filter(|s| s.switches).all(|s| !s.hovered),
+        "an operation hovered"
+    );
 }
