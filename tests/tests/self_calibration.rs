@@ -126,7 +126,7 @@ fn quantiles(mut x: Vec<f64>) -> String {
     x.sort_by(f64::total_cmp);
     let q = |p: f64| x[((x.len() - 1) as f64 * p).round() as usize];
     format!(
-        "worst {:6.1}  median {:6.1}  best {:6.1}",
+        "min {:6.1}  median {:6.1}  max {:6.1}",
         q(0.0),
         q(0.5),
         q(1.0)
