@@ -222,6 +222,19 @@ fn calibration_report(design: &designer::design::Design, sample_period: f64) -> 
     let mut s = String::from("self-calibration (controller.self_calibration):\n");
     match designer::calibrate::choose(design, sample_period) {
         Ok(c) => {
+            let _ = writeln!(
+                s,
+                "  method: {} ({})",
+                c.method.name(),
+                match c.method {
+                    designer::calibrate::Method::Innovations => {
+                        "the observer's innovations over each run, every physics parameter"
+                    }
+                    designer::calibrate::Method::Replay => {
+                        "each operation's record replayed, the parameters its current identifies"
+                    }
+                }
+            );
             for a in &c.parameters {
                 let _ = writeln!(
                     s,

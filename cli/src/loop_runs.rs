@@ -8,7 +8,7 @@
 
 use std::fmt::Write as _;
 
-use designer::calibrate::{choose, run_runs, CalibrationDesign, Outcome, Run};
+use designer::calibrate::{choose, run_runs, CalibrationDesign, Outcome, Run, Update};
 use designer::closed_loop::{check_sample_period, resample_observer, switching_baseline};
 use designer::description::Operation;
 use designer::design::Design;
@@ -80,15 +80,22 @@ fn number(x: Option<f64>) -> Value {
         .map_or(Value::Null, |v| json!(v))
 }
 
-fn update_json(update: &Option<Outcome<f64>>) -> Value {
+fn update_json(update: &Option<Update>) -> Value {
     match update {
         None => Value::Null,
-        Some(Outcome::Updated { before, after }) => json!({
+        Some(Update::Replay(Outcome::Updated { before, after })) => json!({
             "updated": true,
             "rms_current_error_before": before.sqrt(),
             "rms_current_error_after": after.sqrt(),
         }),
-        Some(Outcome::Refused(why)) => json!({ "updated": false, "refused": format!("{why:?}") }),
+        Some(Update::Replay(Outcome::Refused(why))) => {
+            json!({ "updated": false, "refused": format!("{why:?}") })
+        }
+        Some(Update::Innovations(u)) => json!({
+            "updated": u.accepted,
+            "rms_innovation_before": u.before,
+            "rms_innovation_after": u.after,
+        }),
     }
 }
 
@@ -137,6 +144,7 @@ fn to_json(
     serde_json::to_string_pretty(&json!({
         "runs": runs,
         "switching": switching,
+        "calibration": calibration.map(|c| c.method.name()),
         "adapted": adapted,
     }))
     .unwrap_or_default()
@@ -151,7 +159,12 @@ fn text(
     match calibration {
         Some(c) => {
             let keys: Vec<&str> = c.parameters.iter().map(|a| a.key).collect();
-            let _ = writeln!(s, "self-calibration adapts {}", keys.join(", "));
+            let _ = writeln!(
+                s,
+                "self-calibration ({}) adapts {}",
+                c.method.name(),
+                keys.join(", ")
+            );
         }
         None => {
             let _ = writeln!(s, "no self-calibration ([controller] self_calibration)");

@@ -312,3 +312,50 @@ fn every_operation_reaches_its_stop_on_a_plant_the_design_cannot_follow() {
         );
     }
 }
+
+/// The prediction-error update (`calibrate::innovations`) on one noise-free
+/// run of the design on a plant 10 % more resistive with a 5 % smaller gap
+/// and a 10 % weaker preload: four updates over the same run lower the
+/// innovations every time, bring R and the gap to the plant's within 2 % and
+/// the preload closer to it (its part of the current is small beside the
+/// bounces the filter does not model).
+#[test]
+fn the_innovations_update_moves_towards_the_plant() {
+    use designer::calibrate::{candidates, innovations, Adapted};
+    let design = design();
+    let plant = plant(&[
+        ("resistance = 75.0", "resistance = 82.5"),
+        ("area = 20e-6", "area = 19e-6"),
+        ("preload = -0.75", "preload = -0.675"),
+    ]);
+    let run = quiet_run(&design, &plant);
+    let keys = ["coil.resistance", "gap.area", "mechanics.preload"];
+    let adapted: Vec<Adapted> = candidates(&design.description)
+        .into_iter()
+        .filter(|c| keys.contains(&c.key))
+        .map(|c| Adapted {
+            key: c.key,
+            symbol: c.symbol,
+            nominal: c.nominal,
+            lower: (0.7 * c.nominal).min(1.3 * c.nominal),
+            upper: (0.7 * c.nominal).max(1.3 * c.nominal),
+            new_information: 1.0,
+        })
+        .collect();
+    let mut theta: Vec<f64> = adapted.iter().map(|a| a.nominal).collect();
+    for _ in 0..4 {
+        let u = innovations::update(&design, &adapted, &mut theta, &run.measured, 0.2, 4)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(u.after <= u.before, "{u:?}");
+    }
+    let truth = [82.5, 19e-6, -0.675];
+    for ((a, fitted), truth) in adapted.iter().zip(&theta).zip(truth) {
+        let closer = (fitted - truth).abs() < (a.nominal - truth).abs();
+        let near = (fitted / truth - 1.0).abs() < 0.02 || a.key == "mechanics.preload";
+        assert!(
+            closer && near,
+            "{}: {fitted:e}, the plant's {truth:e}",
+            a.key
+        );
+    }
+}

@@ -21,7 +21,7 @@ use crate::description::{params, Core, Description, Operation};
 use crate::design::Design;
 use crate::sim::Options;
 
-use super::{Adapted, CalibrationDesign, TapePredictor};
+use super::{Adapted, CalibrationDesign, Method, TapePredictor};
 
 /// A parameter is adapted only where one run tells it to 2 % (1 σ) …
 pub const MAX_RELATIVE_ERROR: f64 = 0.02;
@@ -102,6 +102,7 @@ pub fn choose(design: &Design, sample_period: f64) -> Result<CalibrationDesign, 
     let per_operation = (super::operation_window(t) / sample_period).ceil() as usize;
     let decimation = per_operation.div_ceil(CAPACITY - 1).max(1);
     let mut calibration = CalibrationDesign {
+        method: Method::Replay,
         parameters: Vec::new(),
         rejected: Vec::new(),
         decimation: decimation as u32,
@@ -117,6 +118,12 @@ pub fn choose(design: &Design, sample_period: f64) -> Result<CalibrationDesign, 
         dip_share: 0.05,
         motion_evidence: 1.0,
     };
+    if design.kalman.is_some() && d.controller.as_ref().is_some_and(|c| c.estimator.is_some()) {
+        // the prediction-error update through the observer: every candidate
+        calibration.method = Method::Innovations;
+        calibration.parameters = candidates.iter().map(|c| adapted(c, 1.0)).collect();
+        return Ok(calibration);
+    }
     let information = information(design, &candidates, &calibration, sample_period)?;
     let sigma = d.observer.as_ref().map_or(1e-3, |o| o.current_noise);
     let fisher: Vec<Vec<f64>> = information
@@ -344,7 +351,7 @@ fn relative_errors(f: &[Vec<f64>], set: &[usize]) -> Vec<f64> {
 }
 
 /// A·x = b by Gaussian elimination with partial pivoting (small, dense).
-fn solve(a: &[Vec<f64>], b: &[f64]) -> Option<Vec<f64>> {
+pub(crate) fn solve(a: &[Vec<f64>], b: &[f64]) -> Option<Vec<f64>> {
     let n = b.len();
     let mut m: Vec<Vec<f64>> = a
         .iter()

@@ -10,13 +10,14 @@
 //! re-implements it.
 
 mod choice;
+pub mod innovations;
 mod predictor;
 mod runs;
 
-pub use choice::{choose, Candidate, ChoiceError};
+pub use choice::{candidates, choose, Candidate, ChoiceError};
 pub use predictor::TapePredictor;
 pub use reldesign_runtime::calibrate::{Outcome, Refusal};
-pub use runs::{run_runs, OperationRun, Run, RunsError};
+pub use runs::{run_runs, OperationRun, Run, RunsError, Update};
 
 use reldesign_runtime::calibrate::Settings;
 
@@ -47,9 +48,31 @@ pub struct Adapted {
     pub new_information: f64,
 }
 
+/// How θ is updated between runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// The observer's innovations over the run (`innovations.rs`): every
+    /// physics parameter the filter's model reads; for designs whose law is
+    /// driven by an observer.
+    Innovations,
+    /// The record's voltage replayed open-loop (`reldesign_runtime::calibrate`):
+    /// the parameters the planned operations' current identifies.
+    Replay,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Innovations => "innovations",
+            Method::Replay => "replay",
+        }
+    }
+}
+
 /// What the emitted calibration adapts and how (the design report states it).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibrationDesign {
+    pub method: Method,
     /// The adapted parameters θ, in the order of the emitted arrays.
     pub parameters: Vec<Adapted>,
     /// The candidates the analysis looked at and why each was not chosen.

@@ -11,7 +11,7 @@ use crate::description::{Description, Operation};
 use crate::design::Design;
 use crate::sim::Options;
 
-use super::{adapted_design, CalibrationDesign, TapePredictor};
+use super::{adapted_design, CalibrationDesign, Method, TapePredictor};
 
 /// The designer's record buffer: larger than any design's capacity (the
 /// design sizes its decimation so that an operation fits in its capacity).
@@ -28,12 +28,22 @@ pub enum RunsError {
     TooMany(usize),
 }
 
+/// What an update did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Update {
+    /// The runtime's replay update of one operation's record.
+    Replay(Outcome<f64>),
+    /// The prediction-error update of a whole run.
+    Innovations(super::innovations::Update),
+}
+
 /// One operation of one run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OperationRun {
     pub outcome: OperationOutcome,
-    /// What the update after it did (`None`: no calibration).
-    pub update: Option<Outcome<f64>>,
+    /// What the update after it did (`None`: no calibration, or no update
+    /// after this operation).
+    pub update: Option<Update>,
 }
 
 /// One run: the parameters it used and its operations.
@@ -60,81 +70,155 @@ pub fn run_runs(
     seed: u64,
     options: &Options,
 ) -> Result<Vec<Run>, RunsError> {
-    let p = calibration.map_or(0, |c| c.parameters.len());
-    macro_rules! with_p {
-        ($($n:literal)*) => {
-            match p {
-                $($n => runs_with::<$n>(design, calibration, plant, runs, sample_period, seed, options),)*
-                n => Err(RunsError::TooMany(n)),
+    let study = Study {
+        design,
+        plant,
+        sample_period,
+        seed,
+        options,
+    };
+    match calibration {
+        Some(c) if c.method == Method::Innovations => study.innovations(c, runs),
+        _ => {
+            let p = calibration.map_or(0, |c| c.parameters.len());
+            macro_rules! with_p {
+                ($($n:literal)*) => {
+                    match p {
+                        $($n => study.replays::<$n>(calibration, runs),)*
+                        n => Err(RunsError::TooMany(n)),
+                    }
+                };
             }
-        };
+            with_p!(0 1 2 3 4 5 6 7 8)
+        }
     }
-    with_p!(0 1 2 3 4 5 6 7 8)
 }
 
-fn runs_with<const P: usize>(
-    design: &Design,
-    calibration: Option<&CalibrationDesign>,
-    plant: Option<&Description>,
-    runs: usize,
+/// What every run shares.
+struct Study<'a> {
+    design: &'a Design,
+    plant: Option<&'a Description>,
     sample_period: f64,
     seed: u64,
-    options: &Options,
-) -> Result<Vec<Run>, RunsError> {
-    let adapted = calibration.filter(|_| P > 0);
-    let settings = adapted.map(|c| c.settings::<P>());
-    let predictor = adapted.map(|c| {
-        let ids = super::symbols::<P>(&design.model, c.parameters.iter().map(|a| a.symbol));
-        TapePredictor::<P>::new(&design.model, &ids)
-    });
-    let mut state = settings.as_ref().map(Calibration::new);
-    let mut out = Vec::with_capacity(runs);
-    for run in 1..=runs {
-        let values: Vec<(&'static str, f64)> = match (adapted, &state) {
-            (Some(c), Some(s)) => c.parameters.iter().map(|a| a.key).zip(s.theta).collect(),
-            _ => Vec::new(),
-        };
-        let run_design = if values.is_empty() {
+    options: &'a Options,
+}
+
+impl Study<'_> {
+    /// Run `run` with the adapted parameters at `values`, its operations a
+    /// window apart, and its outcomes.
+    fn run(
+        &self,
+        run: usize,
+        values: &[(&'static str, f64)],
+    ) -> Result<(LoopRun, Vec<OperationOutcome>), RunsError> {
+        let adapted = if values.is_empty() {
             None
         } else {
             Some(
-                adapted_design(design, &values)
+                adapted_design(self.design, values)
                     .map_err(|message| RunsError::Adapted { run, message })?,
             )
         };
-        let d = run_design.as_ref().unwrap_or(design);
-        let noise = Noise::seeded(seed.wrapping_add(run as u64));
-        let window = design
-            .description
-            .trajectory
-            .as_ref()
-            .map(super::operation_window);
-        let looped = run_spaced_loop(d, plant, sample_period, None, window, noise, options)?;
-        let (takeoff, landing) = design
-            .description
-            .trajectory
-            .as_ref()
-            .map_or((0.0, 0.0), |t| (t.takeoff, t.landing));
+        let d = adapted.as_ref().unwrap_or(self.design);
+        let noise = Noise::seeded(self.seed.wrapping_add(run as u64));
+        let trajectory = self.design.description.trajectory.as_ref();
+        let window = trajectory.map(super::operation_window);
+        let looped = run_spaced_loop(
+            d,
+            self.plant,
+            self.sample_period,
+            None,
+            window,
+            noise,
+            self.options,
+        )?;
+        let (takeoff, landing) = trajectory.map_or((0.0, 0.0), |t| (t.takeoff, t.landing));
         let outcomes = looped.outcomes(takeoff, landing);
-        let mut operations = Vec::with_capacity(outcomes.len());
-        for (outcome, &(operation, start)) in outcomes.into_iter().zip(&looped.operations) {
-            let update = match (&settings, &predictor, &mut state) {
-                (Some(settings), Some(predictor), Some(state)) => {
-                    let record = record::<P>(settings, &looped, operation, start, design);
-                    Some(state.update(predictor, settings, &record))
-                }
-                _ => None,
-            };
-            operations.push(OperationRun { outcome, update });
-        }
-        out.push(Run {
-            run,
-            parameters: values,
-            operations,
-            run_loop: looped,
-        });
+        Ok((looped, outcomes))
     }
-    Ok(out)
+
+    /// The runtime's replay update after every operation (P parameters).
+    fn replays<const P: usize>(
+        &self,
+        calibration: Option<&CalibrationDesign>,
+        runs: usize,
+    ) -> Result<Vec<Run>, RunsError> {
+        let design = self.design;
+        let adapted = calibration.filter(|_| P > 0);
+        let settings = adapted.map(|c| c.settings::<P>());
+        let predictor = adapted.map(|c| {
+            let ids = super::symbols::<P>(&design.model, c.parameters.iter().map(|a| a.symbol));
+            TapePredictor::<P>::new(&design.model, &ids)
+        });
+        let mut state = settings.as_ref().map(Calibration::new);
+        let mut out = Vec::with_capacity(runs);
+        for run in 1..=runs {
+            let values: Vec<(&'static str, f64)> = match (adapted, &state) {
+                (Some(c), Some(s)) => c.parameters.iter().map(|a| a.key).zip(s.theta).collect(),
+                _ => Vec::new(),
+            };
+            let (looped, outcomes) = self.run(run, &values)?;
+            let mut operations = Vec::with_capacity(outcomes.len());
+            for (outcome, &(operation, start)) in outcomes.into_iter().zip(&looped.operations) {
+                let update = match (&settings, &predictor, &mut state) {
+                    (Some(settings), Some(predictor), Some(state)) => {
+                        let record = record::<P>(settings, &looped, operation, start, design);
+                        Some(Update::Replay(state.update(predictor, settings, &record)))
+                    }
+                    _ => None,
+                };
+                operations.push(OperationRun { outcome, update });
+            }
+            out.push(Run {
+                run,
+                parameters: values,
+                operations,
+                run_loop: looped,
+            });
+        }
+        Ok(out)
+    }
+
+    /// The prediction-error update after every run, over the whole run.
+    fn innovations(&self, c: &CalibrationDesign, runs: usize) -> Result<Vec<Run>, RunsError> {
+        let mut theta: Vec<f64> = c.parameters.iter().map(|a| a.nominal).collect();
+        let mut out = Vec::with_capacity(runs);
+        for run in 1..=runs {
+            let values: Vec<(&'static str, f64)> = c
+                .parameters
+                .iter()
+                .map(|a| a.key)
+                .zip(theta.iter().copied())
+                .collect();
+            let (looped, outcomes) = self.run(run, &values)?;
+            let update = super::innovations::update(
+                self.design,
+                &c.parameters,
+                &mut theta,
+                &looped.measured,
+                c.max_step,
+                c.iterations as usize,
+            )
+            .map_err(|message| RunsError::Adapted { run, message })?;
+            let last = outcomes.len().saturating_sub(1);
+            let operations = outcomes
+                .into_iter()
+                .enumerate()
+                .map(|(k, outcome)| OperationRun {
+                    outcome,
+                    // one update per run, after its last operation
+                    update: (k == last).then_some(Update::Innovations(update)),
+                })
+                .collect();
+            out.push(Run {
+                run,
+                parameters: values,
+                operations,
+                run_loop: looped,
+            });
+        }
+        Ok(out)
+    }
 }
 
 /// The record the firmware keeps of `operation` (started at `start`): every
