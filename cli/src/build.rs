@@ -43,6 +43,11 @@ pub fn run(args: &Args) -> Result<(), Report> {
             description.name,
             design.report()
         );
+        if let Some(c) = &description.controller {
+            if c.self_calibration {
+                eprintln!("{}", calibration_report(&design, c.sample_period));
+            }
+        }
     }
     let report = args
         .report_json
@@ -208,4 +213,54 @@ fn report_json(design: &designer::design::Design) -> String {
         map.insert("region".into(), region_json(b));
     }
     serde_json::to_string_pretty(&value).unwrap_or_default() + "\n"
+}
+
+/// What the self-calibration adapts and why (the identifiability of the
+/// planned operations), and what the emitted file does not carry yet.
+fn calibration_report(design: &designer::design::Design, sample_period: f64) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::from("self-calibration (controller.self_calibration):\n");
+    match designer::calibrate::choose(design, sample_period) {
+        Ok(c) => {
+            let _ = writeln!(
+                s,
+                "  method: {} ({})",
+                c.method.name(),
+                match c.method {
+                    designer::calibrate::Method::Innovations => {
+                        "the observer's innovations over each run, every physics parameter"
+                    }
+                    designer::calibrate::Method::Replay => {
+                        "each operation's record replayed, the parameters its current identifies"
+                    }
+                }
+            );
+            for a in &c.parameters {
+                let _ = writeln!(
+                    s,
+                    "  adapts {:<22} from {:.4e} within [{:.4e}, {:.4e}] ({:.0} % of its information new)",
+                    a.key,
+                    a.nominal,
+                    a.lower,
+                    a.upper,
+                    100.0 * a.new_information
+                );
+            }
+            for (key, why) in &c.rejected {
+                let _ = writeln!(s, "  keeps  {key:<22} {why}");
+            }
+            let _ = writeln!(
+                s,
+                "  record: {} samples per operation, every {} sample(s)",
+                c.capacity, c.decimation
+            );
+        }
+        Err(e) => {
+            let _ = writeln!(s, "  not designed: {e}");
+        }
+    }
+    s.push_str(
+        "  warning: the emitted file does not carry the update yet; `reldesign loop --runs N` runs it",
+    );
+    s
 }

@@ -25,40 +25,58 @@ use crate::{atomic, fail};
 #[derive(clap::Args)]
 pub struct Args {
     /// The actuator description, with [trajectory] and [controller]
-    model: PathBuf,
-    /// Output CSV (written atomically)
+    pub(crate) model: PathBuf,
+    /// Output CSV (written atomically; required without --runs; with --runs, the last run's)
     #[arg(long)]
-    out: PathBuf,
+    pub(crate) out: Option<PathBuf>,
+    /// Run every operation N times in succession, the design's self-calibration
+    /// (`[controller] self_calibration`) updated between runs as the emitted code does
+    #[arg(long)]
+    pub(crate) runs: Option<usize>,
+    /// With --runs: print the runs as JSON (the contract of `loop --runs N --json`)
+    #[arg(long)]
+    pub(crate) json: bool,
     /// The plant's description (default: MODEL itself): a device other than the design's
     #[arg(long)]
-    plant: Option<PathBuf>,
+    pub(crate) plant: Option<PathBuf>,
     /// Sample period T_s [s] (default: controller.sample_period)
     #[arg(long, allow_hyphen_values = true)]
-    sample_period: Option<f64>,
+    pub(crate) sample_period: Option<f64>,
     /// Simulated time [s] (default: every operation once, takeoff + landing each)
     #[arg(long, allow_hyphen_values = true)]
-    duration: Option<f64>,
+    pub(crate) duration: Option<f64>,
     /// Also draw position and reference, input and current to this SVG file
     #[arg(long)]
-    plot: Option<PathBuf>,
+    pub(crate) plot: Option<PathBuf>,
     /// Seed of the measurement noise, where an observer drives the controller
     #[arg(long, default_value_t = 0)]
-    seed: u64,
+    pub(crate) seed: u64,
     /// The measurement noise σ_v,σ_i [V,A] the observer reads (default: the observer's own
     /// voltage_noise, current_noise)
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
-    noise: Option<Vec<f64>>,
+    pub(crate) noise: Option<Vec<f64>>,
     /// The plant's initial core field H_c [A/m] (a Jiles–Atherton plant; the observer
     /// still starts from 0)
     #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
-    initial_field: f64,
+    pub(crate) initial_field: f64,
     /// The plant's initial state z,v,phi [m, m/s, Wb] (law = "backstepping"; default: at
     /// rest on the spring's stop without flux)
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
-    initial_state: Option<Vec<f64>>,
+    pub(crate) initial_state: Option<Vec<f64>>,
 }
 
 pub fn run(args: &Args) -> Result<(), Report> {
+    if args.runs.is_some() {
+        return crate::loop_runs::run(args);
+    }
+    if args.json {
+        return Err(fail(
+            "--json: only with --runs N (the other forms print a summary)",
+        ));
+    }
+    let Some(out) = &args.out else {
+        return Err(fail("--out OUT.csv is required (or --runs N --json)"));
+    };
     let description = crate::load(&args.model)?;
     let file = args.model.display().to_string();
     let plant = args.plant.as_deref().map(crate::load).transpose()?;
@@ -131,7 +149,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
             design.model.dim() > 3,
             Some((",switching,lyapunov,desired_force", &extra)),
         );
-        write_outputs(args, &csv, &run.run, &description.name, ts)?;
+        write_outputs(args, out, &csv, &run.run, &description.name, ts)?;
         print!("{summary}");
         return Ok(());
     }
@@ -157,7 +175,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
     }
     .map_err(|e| fail(format!("{file}: {e}")))?;
     let csv = to_csv(&run, design.model.dim() > 3, None);
-    write_outputs(args, &csv, &run, &description.name, ts)?;
+    write_outputs(args, out, &csv, &run, &description.name, ts)?;
     if holds {
         let outcome = run.hold_outcome();
         print!("{}", hold_summary(&outcome, run.z_ref.first().copied(), ts));
@@ -175,12 +193,19 @@ pub fn run(args: &Args) -> Result<(), Report> {
 }
 
 /// The CSV and, with `--plot`, the run's SVG, written together atomically.
-fn write_outputs(args: &Args, csv: &str, run: &LoopRun, name: &str, ts: f64) -> Result<(), Report> {
+pub(crate) fn write_outputs(
+    args: &Args,
+    out: &std::path::Path,
+    csv: &str,
+    run: &LoopRun,
+    name: &str,
+    ts: f64,
+) -> Result<(), Report> {
     let svg = match &args.plot {
         Some(_) => Some(plot(run, name, ts).map_err(fail)?),
         None => None,
     };
-    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(args.out.as_path(), csv.as_bytes())];
+    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(out, csv.as_bytes())];
     if let (Some(path), Some(svg)) = (&args.plot, &svg) {
         files.push((path.as_path(), svg.as_bytes()));
     }
@@ -188,7 +213,7 @@ fn write_outputs(args: &Args, csv: &str, run: &LoopRun, name: &str, ts: f64) -> 
 }
 
 /// `Some(x)` must be positive and finite.
-pub fn positive(name: &str, x: Option<f64>) -> Result<Option<f64>, Report> {
+pub(crate) fn positive(name: &str, x: Option<f64>) -> Result<Option<f64>, Report> {
     match x {
         Some(v) if !(v.is_finite() && v > 0.0) => Err(fail(format!(
             "{name}: expected a positive number of seconds, found {v}"
@@ -256,7 +281,7 @@ fn hold_summary(o: &HoldOutcome, z_ref: Option<f64>, ts: f64) -> String {
 /// Extra columns: their header (with the leading comma) and each sample's.
 type Extra<'a> = (&'a str, &'a dyn Fn(usize) -> String);
 
-fn to_csv(run: &LoopRun, with_field: bool, extra: Option<Extra>) -> String {
+pub(crate) fn to_csv(run: &LoopRun, with_field: bool, extra: Option<Extra>) -> String {
     let tr = &run.trajectory;
     let mut s = String::from(if with_field {
         "t,u,i,z,vz,phi,Hc,mode,z_ref"

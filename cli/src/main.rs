@@ -14,6 +14,7 @@ mod doc_commands;
 mod eval;
 mod fit;
 mod limits;
+mod loop_runs;
 mod observe;
 mod plot;
 mod position_loop;

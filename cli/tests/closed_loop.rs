@@ -193,3 +193,39 @@ fn bad_input_is_named_and_nothing_is_written() {
     rd!("sweep", sm, "--sample-periods", "1e-3").rejected(&["T_s = 1e-3", "at most"]);
     assert_eq!(dir.files(), ["broken-plant.toml"], "nothing written");
 }
+
+/// `loop --runs N --json` (`shared/spec/cli.md`): per run the adapted
+/// parameters keyed as in the description, per operation the first impact,
+/// the bounces and the highest bounce; the switching baseline; the last
+/// run's CSV where asked. Without --runs, --json is refused, and --out is
+/// required.
+#[test]
+fn loop_runs_prints_the_contracts_json() {
+    let dir = TempDir::new("loop-runs");
+    let model = example_path("self-calibrating-valve.toml");
+    let out = dir.join("last.csv");
+    let text = rd!("loop", model, "--runs", "2", "--json", "--seed", "5", "--out", out).ok();
+    let json: Value = serde_json::from_str(&text).unwrap();
+    let runs = json["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    for (k, run) in runs.iter().enumerate() {
+        assert_eq!(run["run"], k + 1);
+        let r = run["parameters"]["coil.resistance"].as_f64().unwrap();
+        assert!((50.0..100.0).contains(&r), "{run}");
+        let ops = run["operations"].as_array().unwrap();
+        assert_eq!(ops.len(), 2);
+        for (op, name) in ops.iter().zip(["closing", "opening"]) {
+            assert_eq!(op["operation"], name);
+            assert!(op["impact_velocity"].is_number(), "{op}");
+            assert!(op["bounces"].is_u64() && op["max_bounce_height"].is_number());
+        }
+    }
+    assert_eq!(runs[0]["parameters"]["coil.resistance"], 75.0);
+    assert_eq!(json["switching"].as_array().unwrap().len(), 2);
+    assert_eq!(json["calibration"], "innovations");
+    let (header, _) = read_csv(&out);
+    assert_eq!(header[0], "t");
+    rd!("loop", model, "--json").rejected(&["--json", "--runs"]);
+    rd!("loop", model).rejected(&["--out"]);
+    rd!("loop", model, "--runs", "0", "--json").rejected(&["--runs"]);
+}

@@ -42,6 +42,7 @@ const PLAN_CONSTS: &[&str] = &[
     "PRESS",
     "CREEP",
     "CREEP_MAX",
+    "ARRIVAL_MARGIN",
     "REFERENCE_CLOSING",
     "REFERENCE_OPENING",
 ];
@@ -113,6 +114,7 @@ fn plan_consts(d: &ControllerDesign, float: Float) -> Result<TokenStream, Contro
             ("PRESS", d.press, "After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes\nthe last gap gently and the contact is certain."),
             ("CREEP", d.creep, "After t_f the reference creeps on beyond the stop at CREEP·stroke per second [1/s]:\nwhere the plant differs from the model and a pure hold would hover short of the\nstop, the armature still lands, at about that speed."),
             ("CREEP_MAX", d.creep_max, "The creep stops CREEP_MAX·stroke beyond the end stop."),
+            ("ARRIVAL_MARGIN", d.arrival_margin, "No hover [s]: an armature not at its end stop by t_f + ARRIVAL_MARGIN is driven\nthere (closing: u_max; opening: the flux quenched, then 0 V) and the operation is\nflagged late. A tenth of the motion time."),
         ],
     )
 }
@@ -168,6 +170,7 @@ pub fn plan_items(
                     press: PRESS,
                     creep: CREEP,
                     creep_max: CREEP_MAX,
+                    arrival_margin: ARRIVAL_MARGIN,
                 }
             }
 

@@ -107,6 +107,7 @@ pub fn run_backstepping(
             operation_length: t_end,
             estimates,
             stops: crate::closed_loop::end_stops(plant_description),
+            measured: sensing.take_measured(),
         },
         modes,
         inside,

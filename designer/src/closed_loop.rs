@@ -80,6 +80,21 @@ pub struct LoopRun {
     pub estimates: Option<Vec<Estimate>>,
     /// The plant's end stops [z_min, z_max] [m].
     pub stops: [f64; 2],
+    /// At every sample: the voltage commanded over the last sample period,
+    /// the voltage and the current measured (with the observer's noise where
+    /// one drives the controller): what a firmware's calibration records.
+    pub measured: Vec<Measured>,
+}
+
+/// What a firmware reads at one sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measured {
+    pub t: f64,
+    /// The voltage the controller commanded over the last sample period.
+    pub commanded: f64,
+    /// That voltage and the current now, as measured.
+    pub voltage: f64,
+    pub current: f64,
 }
 
 /// The observer that drives the controller from the measured voltage and
@@ -99,15 +114,15 @@ enum Filter {
 
 impl Observer {
     /// The estimate after measuring the current `i` now and the voltage
-    /// `held` over the last sample, and the measured current.
-    fn step(&mut self, held: f64, i: f64) -> (Estimate, f64) {
+    /// `held` over the last sample, and the measured voltage and current.
+    fn step(&mut self, held: f64, i: f64) -> (Estimate, f64, f64) {
         let u = held + self.sigma_v * self.noise.normal();
         let i = i + self.sigma_i * self.noise.normal();
         let e = match &mut self.filter {
             Filter::Ekf(f) => f.step(u, i),
             Filter::Ukf(f) => f.step(u, i),
         };
-        (e, i)
+        (e, u, i)
     }
 }
 
@@ -123,6 +138,7 @@ pub(crate) struct Sensing<'a> {
     /// through the eddy-current term).
     held: f64,
     estimates: Vec<(f64, Estimate)>,
+    measured: Vec<Measured>,
     /// `controller.compensate_resistance`: the design's R and the supply's
     /// limits, with the current measured at the last sample.
     compensation: Option<Compensation>,
@@ -152,6 +168,7 @@ impl<'a> Sensing<'a> {
             nonnegative_current,
             held: 0.0,
             estimates: Vec::new(),
+            measured: Vec::new(),
             compensation: compensation(design),
         })
     }
@@ -177,7 +194,13 @@ impl<'a> Sensing<'a> {
             Some(o) => {
                 // the ADC samples i just before the new voltage is applied
                 let (i, _) = self.plant.current_and_voltage(m.t, x, self.held);
-                let (e, i) = o.step(self.held, i);
+                let (e, u, i) = o.step(self.held, i);
+                self.measured.push(Measured {
+                    t: m.t,
+                    commanded: self.held,
+                    voltage: u,
+                    current: i,
+                });
                 if let Some(c) = &mut self.compensation {
                     c.current = i;
                 }
@@ -186,6 +209,13 @@ impl<'a> Sensing<'a> {
                 ([e.z, e.v, phi, e.hc.unwrap_or(0.0)], e.a)
             }
             None => {
+                let (i, _) = self.plant.current_and_voltage(m.t, x, self.held);
+                self.measured.push(Measured {
+                    t: m.t,
+                    commanded: self.held,
+                    voltage: self.held,
+                    current: i,
+                });
                 let mut dx: State = [0.0; crate::sim::MAX_DIM];
                 self.plant.deriv(m.t, x, 0.0, &mut dx);
                 // a: the free-motion acceleration, 0 against a stop
@@ -199,6 +229,11 @@ impl<'a> Sensing<'a> {
                 ([x[0], x[1], phi, x[3]], a)
             }
         }
+    }
+
+    /// What was measured at every sample (taken: the log is left empty).
+    pub(crate) fn take_measured(&mut self) -> Vec<Measured> {
+        std::mem::take(&mut self.measured)
     }
 
     /// The run's current at every sample, its records at the samples (the
@@ -281,6 +316,20 @@ pub fn run_loop(
     noise: Noise,
     options: &Options,
 ) -> Result<LoopRun, LoopError> {
+    run_spaced_loop(design, plant, sample_period, duration, None, noise, options)
+}
+
+/// [`run_loop`] with the operations `spacing` [s] apart (default: takeoff +
+/// landing, [SM 45]): a run-to-run study leaves a late landing time to end.
+pub fn run_spaced_loop(
+    design: &Design,
+    plant: Option<&Description>,
+    sample_period: f64,
+    duration: Option<f64>,
+    spacing: Option<f64>,
+    noise: Noise,
+    options: &Options,
+) -> Result<LoopRun, LoopError> {
     let (Some(c), Some(t)) = (&design.controller, &design.description.trajectory) else {
         return Err(LoopError::NoController);
     };
@@ -289,7 +338,7 @@ pub fn run_loop(
     let mut plant_model = Model::build(plant_description);
     check_plant(design, &plant_model)?;
     let model_plant = ModelPlant::new(&mut plant_model);
-    let length = operation_end(t.takeoff, t.landing);
+    let length = spacing.unwrap_or_else(|| operation_end(t.takeoff, t.landing));
     let operations: Vec<(Operation, f64)> = t
         .operations
         .iter()
@@ -343,6 +392,7 @@ pub fn run_loop(
         operation_length: length,
         estimates,
         stops,
+        measured: sequencer.sensing.take_measured(),
     })
 }
 
@@ -418,6 +468,7 @@ pub fn run_hold(
         operation_length: t_end,
         estimates,
         stops: end_stops(plant_description),
+        measured: sensing.take_measured(),
     })
 }
 

@@ -16,6 +16,7 @@
 
 pub mod backstepping_loop;
 pub mod bisect;
+pub mod calibrate;
 pub mod closed_loop;
 pub mod description;
 pub mod design;

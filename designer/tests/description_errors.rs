@@ -431,6 +431,7 @@ fn both_sections_parse_into_the_expected_values() {
             landed_band: None,
             estimator: None,
             compensate_resistance: false,
+            self_calibration: false,
         }),
         "float defaults to both, creep_speed to the generator's"
     );

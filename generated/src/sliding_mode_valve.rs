@@ -92,6 +92,11 @@ pub mod f32 {
     /// The creep stops CREEP_MAX·stroke beyond the end stop.
     pub const CREEP_MAX: f32 = 0.05;
 
+    /// No hover [s]: an armature not at its end stop by t_f + ARRIVAL_MARGIN is driven
+    /// there (closing: u_max; opening: the flux quenched, then 0 V) and the operation is
+    /// flagged late. A tenth of the motion time.
+    pub const ARRIVAL_MARGIN: f32 = 0.0004;
+
     /// Reference of the closing motion z_m on [t₀, t_f] [PT 51]: one row
     /// [t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;
     /// a(τ) = c0 + c1·τ + c2·τ² + c3·τ³ with τ = t − t_k, v and z its integrals.
@@ -139,6 +144,7 @@ pub mod f32 {
                 press: PRESS,
                 creep: CREEP,
                 creep_max: CREEP_MAX,
+                arrival_margin: ARRIVAL_MARGIN,
             }
         }
 
@@ -233,6 +239,11 @@ pub mod f64 {
     /// The creep stops CREEP_MAX·stroke beyond the end stop.
     pub const CREEP_MAX: f64 = 0.05;
 
+    /// No hover [s]: an armature not at its end stop by t_f + ARRIVAL_MARGIN is driven
+    /// there (closing: u_max; opening: the flux quenched, then 0 V) and the operation is
+    /// flagged late. A tenth of the motion time.
+    pub const ARRIVAL_MARGIN: f64 = 0.0004;
+
     /// Reference of the closing motion z_m on [t₀, t_f] [PT 51]: one row
     /// [t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;
     /// a(τ) = c0 + c1·τ + c2·τ² + c3·τ³ with τ = t − t_k, v and z its integrals.
@@ -280,6 +291,7 @@ pub mod f64 {
                 press: PRESS,
                 creep: CREEP,
                 creep_max: CREEP_MAX,
+                arrival_margin: ARRIVAL_MARGIN,
             }
         }
 

@@ -17,6 +17,9 @@
 //!   rules of model-free-sliding-mode-soft-landing [SM 43] apply: closing →
 //!   u = u_max·sgn φ (holds it closed; sgn 0 taken as +1, a NaN φ gives 0),
 //!   opening → u = 0;
+//! - no hover: after t_f + `arrival_margin` an armature not yet at its end
+//!   stop is driven there ([`finish_stroke`]), and the operation is flagged
+//!   late ([`SoftLanding::finished_late`]);
 //! - guard at φ → 0: where φ ≤ `phi_guard` the law is not evaluated and
 //!   u = u_max drives the flux into D₀⁺ = {φ > 0} ([`guarded_law`]);
 //! - every output is saturated to [u_min, u_max] (NaN → the bound nearest 0,
@@ -75,6 +78,10 @@ pub struct Settings<T> {
     pub creep: T,
     /// … up to `creep_max`·stroke beyond it.
     pub creep_max: T,
+    /// [s] after t_f: an armature not at its end stop by t_f +
+    /// `arrival_margin` is driven there ([`finish_stroke`]): no operation
+    /// hovers, whatever the model error.
+    pub arrival_margin: T,
 }
 
 /// What every controller module provides: its operations, design values and
@@ -179,6 +186,31 @@ pub fn expert_rule<T: Scalar>(
     }
 }
 
+/// No hover, ever: after t_f + `arrival_margin` the armature is driven to
+/// its end stop, wherever its (estimated) position says it is — closing:
+/// u = u_max·sgn φ pulls it in (at the stop, the expert rule [SM 43]);
+/// opening: u = u_min while φ > `phi_guard` drains the flux, then u = 0 lets
+/// the spring open it (at the stop, the rule's 0 V a little sooner). A
+/// sensorless estimate that has lost the armature cannot hold it short of
+/// its stop. `None` before. Saturated.
+#[inline]
+pub fn finish_stroke<T: Scalar>(
+    motion: &Motion<T>,
+    settings: &Settings<T>,
+    time: T,
+    phi: T,
+) -> Option<T> {
+    if !(time > settings.landing + settings.arrival_margin) {
+        return None;
+    }
+    let u = match motion.landing {
+        Landing::Closing => settings.u_max * flux_sign(phi),
+        Landing::Opening if phi > settings.phi_guard => settings.u_min,
+        Landing::Opening => T::ZERO,
+    };
+    Some(saturate(u, settings))
+}
+
 /// The law [PT 50] as applied: where φ ≤ `phi_guard` (φ → 0, where β = 1/L_g L_f²h
 /// blows up and D₀⁺ is left) it is not evaluated and u = u_max drives the flux
 /// back into D₀⁺; otherwise [`Law::law`]. Saturated.
@@ -280,6 +312,8 @@ impl<O: Copy, T: Scalar + From<u8>> Tracker<O, T> {
 pub struct SoftLanding<L: Law<T>, T> {
     law: L,
     tracker: Tracker<L::Operation, T>,
+    /// [`finish_stroke`] drove this operation.
+    late: bool,
 }
 
 impl<L: Law<T> + ConstPlan, T: Scalar + From<u8>> SoftLanding<L, T> {
@@ -297,12 +331,23 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
         SoftLanding {
             law,
             tracker: Tracker::new(operation),
+            late: false,
         }
     }
 
     /// Starts the operation at `t_start` [s]: reference times count from here.
     pub fn start(&mut self, t_start: T) {
         self.tracker.start(t_start);
+        self.late = false;
+    }
+
+    /// Whether the armature was not at its stop (by the position read) at
+    /// t_f + `arrival_margin` and [`finish_stroke`] drove it there: a landing
+    /// later than planned, for the firmware to report (and its calibration
+    /// to learn from).
+    #[must_use]
+    pub const fn finished_late(&self) -> bool {
+        self.late
     }
 
     /// The operation this controller runs.
@@ -339,7 +384,17 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
     /// [`SoftLanding::step`] with the core's field H_c [A/m] (estimated by the
     /// observer), which the law of a design on a Jiles–Atherton core reads.
     pub fn step_with_field(&mut self, t: T, z: T, v: T, phi: T, hc: T) -> T {
-        if let Some(u) = self.hold(self.tracker.elapsed(t), z, phi) {
+        let time = self.tracker.elapsed(t);
+        let motion = self.law.motion(self.tracker.operation());
+        let settings = self.law.settings();
+        // the push comes first: at the stop it is the expert rule (closing)
+        // or drains the flux the rule would leave to decay (opening), and it
+        // does not trust a position estimate that may have lost the armature
+        if let Some(u) = finish_stroke(&motion, &settings, time, phi) {
+            self.late |= expert_rule(&motion, &settings, z, phi).is_none();
+            return u;
+        }
+        if let Some(u) = self.hold(time, z, phi) {
             return u;
         }
         let reference = self.reference(t);

@@ -16,6 +16,7 @@
 )]
 
 pub mod backstepping;
+pub mod calibrate;
 pub mod control;
 pub mod hold;
 pub mod integral;

@@ -357,3 +357,25 @@ pub fn all_finite<T: Scalar, const N: usize>(x: &[T; N]) -> bool {
 pub fn all_finite_matrix<T: Scalar, const N: usize>(a: &Matrix<T, N>) -> bool {
     a.iter().all(all_finite)
 }
+
+/// x with A·x = b for a symmetric positive definite A, by [`cholesky`] and
+/// two triangular solves; `None` where A does not factor.
+pub fn cholesky_solve<T: Scalar, const N: usize>(a: &Matrix<T, N>, b: &[T; N]) -> Option<[T; N]> {
+    let l = cholesky(a)?;
+    // L·y = b
+    let mut y = [T::ZERO; N];
+    for (i, (l_row, bi)) in l.iter().zip(b).enumerate() {
+        let s = *bi - dot_prefix(l_row, &y, i);
+        *y.get_mut(i)? = s / *l_row.get(i)?;
+    }
+    // Lᵀ·x = y
+    let mut x = [T::ZERO; N];
+    for i in (0..N).rev() {
+        let mut s = *y.get(i)?;
+        for (k, xk) in x.iter().enumerate().skip(i + 1) {
+            s = s - *l.get(k)?.get(i)? * *xk;
+        }
+        *x.get_mut(i)? = s / *l.get(i)?.get(i)?;
+    }
+    Some(x)
+}

@@ -23,7 +23,7 @@
 //! No model function is evaluated: the law is two comparisons and a
 //! multiplication, with the reference lookup.
 
-use crate::control::{expert_rule, flux_sign, saturate, ConstPlan, Plan, Tracker};
+use crate::control::{expert_rule, finish_stroke, flux_sign, saturate, ConstPlan, Plan, Tracker};
 use crate::linalg::Scalar;
 
 /// The surface's constants.
@@ -73,6 +73,8 @@ pub fn switching_sign<T: Scalar>(s: T, at_z_min: bool) -> Option<T> {
 pub struct SlidingMode<S: Surface<T>, T> {
     plan: S,
     tracker: Tracker<S::Operation, T>,
+    /// [`finish_stroke`] drove this operation.
+    late: bool,
 }
 
 impl<S: Surface<T> + ConstPlan, T: Scalar + From<u8>> SlidingMode<S, T> {
@@ -90,12 +92,21 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
         SlidingMode {
             plan,
             tracker: Tracker::new(operation),
+            late: false,
         }
     }
 
     /// Starts the operation at `t_start` [s]: reference times count from here.
     pub fn start(&mut self, t_start: T) {
         self.tracker.start(t_start);
+        self.late = false;
+    }
+
+    /// Whether [`finish_stroke`] drove the armature to its stop: a landing
+    /// later than planned.
+    #[must_use]
+    pub const fn finished_late(&self) -> bool {
+        self.late
     }
 
     /// The operation this controller runs.
@@ -127,8 +138,13 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
         } else {
             flux_sign(phi)
         };
+        let landed = expert_rule(&motion, &settings, z, flux);
+        if let Some(u) = finish_stroke(&motion, &settings, self.tracker.elapsed(t), phi) {
+            self.late |= landed.is_none();
+            return u;
+        }
         // [SM 43]
-        if let Some(u) = expert_rule(&motion, &settings, z, flux) {
+        if let Some(u) = landed {
             return u;
         }
         let [zr, vr, ar, _] = self.tracker.reference(&self.plan, t);

@@ -46,6 +46,7 @@ macro_rules! toy {
                     press: 0.01,
                     creep: 0.5,
                     creep_max: 0.05,
+                    arrival_margin: 1.0,
                 };
 
             impl Plan<$f> for Toy {
@@ -185,6 +186,32 @@ macro_rules! toy {
                 assert_eq!(o.step(3.5, 1.0, 0.0, 0.3), 0.0);
                 assert_eq!(o.step(3.5, 2.0, 0.0, 0.3), 0.0);
                 assert_ne!(o.step(3.5, 0.9, 0.0, 0.3), 0.0);
+            }
+
+            #[test]
+            fn an_armature_short_of_its_stop_is_driven_there_after_the_margin() {
+                // t_f = 3, arrival margin 1: until 4 the law, then the push
+                let mut c = Ctl::new(Operation::Closing);
+                let before = c.step(3.9, 0.5, 0.0, 1.0);
+                assert!(!c.finished_late() && before != 20.0, "{before}");
+                assert_eq!(c.step(4.1, 0.5, 0.0, 1.0), 20.0);
+                assert_eq!(c.step(4.1, 0.5, 0.0, -1.0), -20.0);
+                assert!(c.finished_late());
+                c.start(10.0);
+                assert!(!c.finished_late(), "a new operation starts on time");
+                // opening: the flux quenched at u_min, then 0 V
+                let mut c = Ctl::new(Operation::Opening);
+                assert_eq!(c.step(4.1, 0.5, 0.0, 1.0), -24.0);
+                assert_eq!(c.step(4.1, 0.5, 0.0, 1e-4), 0.0);
+                assert!(c.finished_late());
+                // at the stop: the flux drained all the same, but not late
+                let mut c = Ctl::new(Operation::Opening);
+                assert_eq!(c.step(4.1, 1.0, 0.0, 1.0), -24.0);
+                assert_eq!(c.step(4.1, 1.0, 0.0, 1e-4), 0.0);
+                assert!(!c.finished_late());
+                let mut c = Ctl::new(Operation::Closing);
+                assert_eq!(c.step(4.1, 0.0, 0.0, 1.0), 20.0);
+                assert!(!c.finished_late());
             }
 
             #[test]

@@ -48,6 +48,7 @@ macro_rules! toy {
                             press: 0.0,
                             creep: 0.0,
                             creep_max: 0.0,
+                            arrival_margin: 1.0,
                             }
                         }
                         fn motion(&self, operation: Operation) -> Motion<'_, $f> {

@@ -7,6 +7,7 @@ pub mod hidden;
 pub mod landings;
 pub mod outside;
 pub mod sensorless;
+pub mod variants;
 
 use designer::description::{parse_file, parse_str, Description};
 use designer::model::Model;

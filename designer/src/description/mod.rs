@@ -253,6 +253,10 @@ pub struct Controller {
     /// is corrected to the estimator's coil resistance, u + (R̂ − R)·i
     /// (`reldesign_runtime::resistance`); needs an estimator that estimates R.
     pub compensate_resistance: bool,
+    /// `self_calibration = true`: the emitted code adapts the model's
+    /// identifiable parameters from run to run, from the coil current
+    /// (`designer::calibrate`, `reldesign_runtime::calibrate`).
+    pub self_calibration: bool,
 }
 
 /// `controller.law` with the keys of that law.

@@ -138,6 +138,7 @@ impl Plan<f64> for RuntimePlan<'_> {
             press: d.press,
             creep: d.creep,
             creep_max: d.creep_max,
+            arrival_margin: d.arrival_margin,
         }
     }
 

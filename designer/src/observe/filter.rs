@@ -18,6 +18,7 @@ pub trait Runtime<const N: usize>: Sized {
     fn covariance(&self) -> Matrix<f64, N>;
     fn skipped(&self) -> u32;
     fn repairs(&self) -> u32;
+    fn innovation(&self) -> (f64, f64);
 }
 
 macro_rules! runtime_impl {
@@ -41,6 +42,9 @@ macro_rules! runtime_impl {
             }
             fn repairs(&self) -> u32 {
                 <$filter>::repairs(self)
+            }
+            fn innovation(&self) -> (f64, f64) {
+                <$filter>::innovation(self)
             }
         }
     };
@@ -124,6 +128,11 @@ impl<A: Runtime<3>, B: Runtime<4>, C: Runtime<5>> Reference<A, B, C> {
             ByDim::Four(_) => 4,
             ByDim::Five(_) => 5,
         }
+    }
+
+    /// The last step's innovation y − ŷ and its variance S.
+    pub fn innovation(&self) -> (f64, f64) {
+        each!(&self.0, f => f.innovation())
     }
 
     /// Samples whose measurement update was skipped (non-finite data).

@@ -77,6 +77,13 @@ impl<M, T: Scalar, const N: usize> Ekf<M, T, N> {
     pub const fn repairs(&self) -> u32 {
         self.post.repairs
     }
+
+    /// The last step's innovation y − ŷ and its variance S ((0, 0) where its
+    /// update was skipped).
+    #[must_use]
+    pub const fn innovation(&self) -> (T, T) {
+        self.post.innovation
+    }
 }
 
 impl<M: Linearised<T, N>, T: Scalar, const N: usize> Ekf<M, T, N> {

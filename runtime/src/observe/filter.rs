@@ -95,6 +95,9 @@ pub(crate) struct Posterior<T, const N: usize> {
     pub now: T,
     pub skipped: u32,
     pub repairs: u32,
+    /// The last update's innovation y − ŷ and its variance S (0 and 0 where
+    /// the update was skipped): what a prediction-error calibration reads.
+    pub innovation: (T, T),
 }
 
 /// The input of one step.
@@ -117,6 +120,7 @@ impl<T: Scalar, const N: usize> Posterior<T, N> {
             now: T::ZERO,
             skipped: 0,
             repairs: 0,
+            innovation: (T::ZERO, T::ZERO),
         }
     }
 
@@ -154,8 +158,10 @@ impl<T: Scalar, const N: usize> Posterior<T, N> {
     #[inline]
     pub fn correct(&mut self, innovation: T, s: T, gain: &[T; N]) -> Option<[T; N]> {
         if !(innovation.finite() && s.finite() && s > T::ZERO) {
+            self.innovation = (T::ZERO, T::ZERO);
             return None;
         }
+        self.innovation = (innovation, s);
         let k = gain.map(|g| g / s);
         linalg::axpy(&mut self.x, innovation, &k);
         Some(k)

@@ -102,6 +102,13 @@ impl<M, T: Scalar, const N: usize, const P: usize> Ukf<M, T, N, P> {
     pub const fn repairs(&self) -> u32 {
         self.post.repairs
     }
+
+    /// The last step's innovation y − ŷ and its variance S ((0, 0) where its
+    /// update was skipped).
+    #[must_use]
+    pub const fn innovation(&self) -> (T, T) {
+        self.post.innovation
+    }
 }
 
 impl<M: Sampled<T, N>, T: Jitter, const N: usize, const P: usize> Ukf<M, T, N, P> {

@@ -71,6 +71,7 @@ pub(super) fn parse_controller(s: &Sect) -> Res<Controller> {
         _ => Estimator::Ukf,
     });
     let compensate_resistance = s.opt_bool("compensate_resistance")?.unwrap_or(false);
+    let self_calibration = s.opt_bool("self_calibration")?.unwrap_or(false);
     Ok(Controller {
         law,
         sample_period,
@@ -79,6 +80,7 @@ pub(super) fn parse_controller(s: &Sect) -> Res<Controller> {
         landed_band,
         estimator,
         compensate_resistance,
+        self_calibration,
     })
 }
 

@@ -27,6 +27,9 @@ const PRESS_FRACTION: f64 = 1e-6;
 const CREEP_FRACTION: f64 = 2.5e-3;
 /// … up to this fraction of the stroke beyond it.
 const CREEP_MAX_FRACTION: f64 = 0.05;
+/// No hover: the armature is driven to its stop a tenth of the motion time
+/// after t_f at the latest.
+const ARRIVAL_FRACTION: f64 = 0.1;
 
 /// Reference samples per segment when searching the smallest flux.
 const FLUX_SAMPLES: usize = 64;
@@ -148,6 +151,9 @@ pub struct ControllerDesign {
     pub creep: f64,
     /// … up to `creep_max`·stroke beyond it.
     pub creep_max: f64,
+    /// [s] after t_f: an armature not at its stop by then is driven there
+    /// (`reldesign_runtime::control::finish_stroke`); a tenth of the motion time.
+    pub arrival_margin: f64,
     /// In the order of `[trajectory].operations`, no operation twice.
     pub operations: Vec<DesignedOperation>,
 }
@@ -183,6 +189,7 @@ impl ControllerDesign {
             press: PRESS_FRACTION,
             creep,
             creep_max: CREEP_MAX_FRACTION,
+            arrival_margin: ARRIVAL_FRACTION * (spec.landing - spec.takeoff),
             operations,
         })
     }

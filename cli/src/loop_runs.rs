@@ -1,0 +1,200 @@
+//! `reldesign loop MODEL.toml --runs N [--json] [--plant PLANT.toml]
+//! [--sample-period S] [--seed K] [--out OUT.csv] [--plot FILE.svg]`: N
+//! successive runs of the designed controller on the plant, the design's
+//! self-calibration (`[controller] self_calibration`) updated between them by
+//! the runtime's own code; per run the parameters used, per operation the
+//! first impact, the bounces and the highest bounce, against the
+//! uncontrolled switching (`../shared/spec/cli.md`, `loop --runs N --json`).
+
+use std::fmt::Write as _;
+
+use designer::calibrate::{choose, run_runs, CalibrationDesign, Outcome, Run, Update};
+use designer::closed_loop::{check_sample_period, resample_observer, switching_baseline};
+use designer::description::Operation;
+use designer::design::Design;
+use designer::sim::Options;
+use miette::Report;
+
+use serde_json::{json, Value};
+
+use crate::closed_loop::Args;
+use crate::fail;
+
+pub fn run(args: &Args) -> Result<(), Report> {
+    let runs = match args.runs {
+        Some(n) if n > 0 => n,
+        _ => return Err(fail("--runs: expected a positive number of runs")),
+    };
+    let description = crate::load(&args.model)?;
+    let file = args.model.display().to_string();
+    let plant = args.plant.as_deref().map(crate::load).transpose()?;
+    let Some(controller) = &description.controller else {
+        return Err(fail(format!(
+            "{file}: `loop --runs` runs the designed controller: the description needs [trajectory] and [controller]"
+        )));
+    };
+    let ts = crate::closed_loop::positive("--sample-period", args.sample_period)?
+        .unwrap_or(controller.sample_period);
+    check_sample_period(&description, ts).map_err(|e| fail(format!("{file}: {e}")))?;
+    let mut designed = description.clone();
+    if let Some(c) = &mut designed.controller {
+        c.sample_period = ts;
+    }
+    if let (Some(o), Some(_)) = (&mut designed.observer, args.sample_period) {
+        resample_observer(o, ts);
+    }
+    let design = Design::new(&designed).map_err(|e| fail(format!("{file}: {e}")))?;
+    let calibration = if controller.self_calibration {
+        Some(choose(&design, ts).map_err(|e| fail(format!("{file}: self-calibration: {e}")))?)
+    } else {
+        None
+    };
+    let options = Options::default();
+    let done = run_runs(
+        &design,
+        calibration.as_ref(),
+        plant.as_ref(),
+        runs,
+        ts,
+        args.seed,
+        &options,
+    )
+    .map_err(|e| fail(format!("{file}: {e}")))?;
+    let baseline = switching_baseline(&description, plant.as_ref(), &options)
+        .map_err(|e| fail(format!("{file}: {e}")))?;
+    if let (Some(out), Some(last)) = (&args.out, done.last()) {
+        let csv = crate::closed_loop::to_csv(&last.run_loop, design.model.dim() > 3, None);
+        crate::closed_loop::write_outputs(args, out, &csv, &last.run_loop, &description.name, ts)?;
+    }
+    if args.json {
+        println!("{}", to_json(&done, &baseline, calibration.as_ref()));
+    } else {
+        print!("{}", text(&done, &baseline, calibration.as_ref()));
+    }
+    Ok(())
+}
+
+/// A number for JSON: not finite → null.
+fn number(x: Option<f64>) -> Value {
+    x.filter(|v| v.is_finite())
+        .map_or(Value::Null, |v| json!(v))
+}
+
+fn update_json(update: &Option<Update>) -> Value {
+    match update {
+        None => Value::Null,
+        Some(Update::Replay(Outcome::Updated { before, after })) => json!({
+            "updated": true,
+            "rms_current_error_before": before.sqrt(),
+            "rms_current_error_after": after.sqrt(),
+        }),
+        Some(Update::Replay(Outcome::Refused(why))) => {
+            json!({ "updated": false, "refused": format!("{why:?}") })
+        }
+        Some(Update::Innovations(u)) => json!({
+            "updated": u.accepted,
+            "rms_innovation_before": u.before,
+            "rms_innovation_after": u.after,
+        }),
+    }
+}
+
+fn to_json(
+    runs: &[Run],
+    baseline: &[(Operation, Option<f64>)],
+    calibration: Option<&CalibrationDesign>,
+) -> String {
+    let runs: Vec<Value> = runs
+        .iter()
+        .map(|r| {
+            let parameters: serde_json::Map<String, Value> = r
+                .parameters
+                .iter()
+                .map(|(k, v)| ((*k).to_owned(), json!(v)))
+                .collect();
+            let operations: Vec<Value> = r
+                .operations
+                .iter()
+                .map(|o| {
+                    json!({
+                        "operation": o.outcome.operation.name(),
+                        "impact_velocity": number(o.outcome.impact_velocity),
+                        "bounces": o.outcome.bounces,
+                        "max_bounce_height": o.outcome.highest_bounce,
+                        "calibration": update_json(&o.update),
+                    })
+                })
+                .collect();
+            json!({ "run": r.run, "parameters": parameters, "operations": operations })
+        })
+        .collect();
+    let switching: Vec<Value> = baseline
+        .iter()
+        .map(|(op, v)| json!({ "operation": op.name(), "impact_velocity": number(*v) }))
+        .collect();
+    let adapted: Vec<Value> = calibration.map_or(Vec::new(), |c| {
+        c.parameters
+            .iter()
+            .map(|a| {
+                json!({ "key": a.key, "design": a.nominal, "lower": a.lower, "upper": a.upper,
+                        "new_information": a.new_information })
+            })
+            .collect()
+    });
+    serde_json::to_string_pretty(&json!({
+        "runs": runs,
+        "switching": switching,
+        "calibration": calibration.map(|c| c.method.name()),
+        "adapted": adapted,
+    }))
+    .unwrap_or_default()
+}
+
+fn text(
+    runs: &[Run],
+    baseline: &[(Operation, Option<f64>)],
+    calibration: Option<&CalibrationDesign>,
+) -> String {
+    let mut s = String::new();
+    match calibration {
+        Some(c) => {
+            let keys: Vec<&str> = c.parameters.iter().map(|a| a.key).collect();
+            let _ = writeln!(
+                s,
+                "self-calibration ({}) adapts {}",
+                c.method.name(),
+                keys.join(", ")
+            );
+        }
+        None => {
+            let _ = writeln!(s, "no self-calibration ([controller] self_calibration)");
+        }
+    }
+    for r in runs {
+        let values: Vec<String> = r
+            .parameters
+            .iter()
+            .map(|(k, v)| format!("{k} = {v:.5e}"))
+            .collect();
+        let _ = writeln!(s, "run {}: {}", r.run, values.join(", "));
+        for o in &r.operations {
+            let v = o
+                .outcome
+                .impact_velocity
+                .map_or("never reached the stop".into(), |v| format!("{v:+.4e} m/s"));
+            let _ = writeln!(
+                s,
+                "  {:<8} first impact {v}, {} bounce(s), highest {:.2e} m",
+                o.outcome.operation.name(),
+                o.outcome.bounces,
+                o.outcome.highest_bounce
+            );
+        }
+    }
+    let _ = writeln!(s, "uncontrolled switching (u_max, then 0 V):");
+    for (op, v) in baseline {
+        let v = v.map_or("never".into(), |v| format!("{v:+.4e} m/s"));
+        let _ = writeln!(s, "  {:<8} first impact {v}", op.name());
+    }
+    s
+}

@@ -1,0 +1,179 @@
+//! Run-to-run self-calibration, the designer's side: which parameters the
+//! emitted code adapts and within which bounds ([`CalibrationDesign`], chosen
+//! by the identifiability of the planned operations, `choice.rs`), the
+//! calibration's model on tapes (`predictor.rs`), the design a run uses with
+//! the adapted values ([`adapted_design`]) and successive runs on a plant
+//! with the runtime's own update between them (`runs.rs`, `reldesign loop
+//! --runs`).
+//!
+//! The algorithm is `reldesign_runtime::calibrate`'s; nothing here
+//! re-implements it.
+
+mod choice;
+pub mod innovations;
+mod predictor;
+mod runs;
+
+pub use choice::{candidates, choose, Candidate, ChoiceError};
+pub use predictor::TapePredictor;
+pub use reldesign_runtime::calibrate::{Outcome, Refusal};
+pub use runs::{run_runs, OperationRun, Run, RunsError, Update};
+
+use reldesign_runtime::calibrate::Settings;
+
+use crate::description::{params, Description};
+use crate::design::{design_kalman, Design, Linearization};
+use crate::model::Model;
+
+/// The time [s] between two operations' starts in a run-to-run study (and
+/// the window a record covers): twice takeoff + landing, so that an
+/// operation the runtime had to finish ([`reldesign_runtime::control::finish_stroke`])
+/// ends before the next one starts.
+pub fn operation_window(t: &crate::description::Trajectory) -> f64 {
+    2.0 * crate::design::operation_end(t.takeoff, t.landing)
+}
+
+/// One adapted parameter: its description key, the model's symbol, the
+/// design's value and the physical domain the update keeps it in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Adapted {
+    pub key: &'static str,
+    pub symbol: &'static str,
+    pub nominal: f64,
+    pub lower: f64,
+    pub upper: f64,
+    /// Its share of the planned operations' current sensitivity that no
+    /// parameter chosen before it explains (the identifiability analysis):
+    /// why it was chosen.
+    pub new_information: f64,
+}
+
+/// How θ is updated between runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// The observer's innovations over the run (`innovations.rs`): every
+    /// physics parameter the filter's model reads; for designs whose law is
+    /// driven by an observer.
+    Innovations,
+    /// The record's voltage replayed open-loop (`reldesign_runtime::calibrate`):
+    /// the parameters the planned operations' current identifies.
+    Replay,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Innovations => "innovations",
+            Method::Replay => "replay",
+        }
+    }
+}
+
+/// What the emitted calibration adapts and how (the design report states it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CalibrationDesign {
+    pub method: Method,
+    /// The adapted parameters θ, in the order of the emitted arrays.
+    pub parameters: Vec<Adapted>,
+    /// The candidates the analysis looked at and why each was not chosen.
+    pub rejected: Vec<(&'static str, String)>,
+    /// Samples per stored sample.
+    pub decimation: u32,
+    /// Stored samples per operation (the record's buffer).
+    pub capacity: usize,
+    pub sample_period: f64,
+    pub z_min: f64,
+    pub z_max: f64,
+    /// Largest change of a parameter in one update, relative to its design value.
+    pub max_step: f64,
+    pub iterations: u32,
+    pub min_samples: usize,
+    pub current_limit: f64,
+    pub dip_tolerance: f64,
+    pub dip_share: f64,
+    pub motion_evidence: f64,
+}
+
+impl CalibrationDesign {
+    /// The runtime's settings for P = `parameters.len()` parameters.
+    ///
+    /// # Panics
+    /// Where P differs from the number of adapted parameters.
+    pub fn settings<const P: usize>(&self) -> Settings<f64, P> {
+        assert_eq!(P, self.parameters.len(), "P adapted parameters");
+        let pick = |f: fn(&Adapted) -> f64| {
+            let mut out = [0.0; P];
+            for (o, a) in out.iter_mut().zip(&self.parameters) {
+                *o = f(a);
+            }
+            out
+        };
+        Settings {
+            nominal: pick(|a| a.nominal),
+            lower: pick(|a| a.lower),
+            upper: pick(|a| a.upper),
+            max_step: self.max_step,
+            sample_period: self.sample_period,
+            decimation: self.decimation,
+            z_min: self.z_min,
+            z_max: self.z_max,
+            iterations: self.iterations,
+            min_samples: self.min_samples,
+            current_limit: self.current_limit,
+            dip_tolerance: self.dip_tolerance,
+            dip_share: self.dip_share,
+            motion_evidence: self.motion_evidence,
+        }
+    }
+}
+
+/// `design` with the adapted parameters at `values` (keys of the
+/// description): the law's α, β and the observer's model derived again on
+/// the adapted model; gains, references and every decision kept, as the
+/// emitted code keeps its tables and reads the parameters at run time.
+pub fn adapted_design(design: &Design, values: &[(&str, f64)]) -> Result<Design, String> {
+    let mut description: Description = design.description.clone();
+    for (key, value) in values {
+        params::set(&mut description, key, *value).map_err(|e| e.to_string())?;
+    }
+    let mut model = Model::build(&description);
+    let controller = match &design.controller {
+        Some(c) => {
+            let linearization = Linearization::derive(&mut model).map_err(|e| e.to_string())?;
+            Some(crate::design::ControllerDesign {
+                linearization,
+                ..c.clone()
+            })
+        }
+        None => None,
+    };
+    let kalman = design_kalman(&description, &model).map_err(|e| e.to_string())?;
+    Ok(Design {
+        description,
+        model,
+        controller,
+        hold: design.hold.clone(),
+        backstepping: design.backstepping.clone(),
+        kalman,
+    })
+}
+
+/// The model's symbols of `names` (each a parameter of the model).
+///
+/// # Panics
+/// Where a name is not a parameter of `model`, or there are not P names.
+pub(crate) fn symbols<'a, const P: usize>(
+    model: &Model,
+    names: impl Iterator<Item = &'a str>,
+) -> [crate::sym::Id; P] {
+    let ids: Vec<crate::sym::Id> = names
+        .map(|n| {
+            model
+                .params
+                .symbol(n)
+                .unwrap_or_else(|| panic!("`{n}` is not a parameter of the model"))
+        })
+        .collect();
+    ids.try_into()
+        .unwrap_or_else(|v: Vec<_>| panic!("{} symbols for {P} parameters", v.len()))
+}

@@ -1,0 +1,248 @@
+//! Successive runs of a design on a plant, the calibration updated between
+//! them by the runtime's own code (`reldesign loop --runs`): each run every
+//! operation once from rest (`closed_loop::run_loop`) with the parameters
+//! adapted so far; then each operation's record, as the firmware's
+//! `Record` keeps it from the measured voltage and current, updates θ.
+
+use reldesign_runtime::calibrate::{Calibration, Outcome, Record};
+
+use crate::closed_loop::{run_spaced_loop, LoopError, LoopRun, Noise, OperationOutcome};
+use crate::description::{Description, Operation};
+use crate::design::Design;
+use crate::sim::Options;
+
+use super::{adapted_design, CalibrationDesign, Method, TapePredictor};
+
+/// The designer's record buffer: larger than any design's capacity (the
+/// design sizes its decimation so that an operation fits in its capacity).
+const RECORD: usize = 4096;
+
+/// Why the runs stopped.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RunsError {
+    #[error(transparent)]
+    Loop(#[from] LoopError),
+    #[error("run {run}: the adapted design: {message}")]
+    Adapted { run: usize, message: String },
+    #[error("the calibration adapts {0} parameters; at most 8 are supported")]
+    TooMany(usize),
+}
+
+/// What an update did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Update {
+    /// The runtime's replay update of one operation's record.
+    Replay(Outcome<f64>),
+    /// The prediction-error update of a whole run.
+    Innovations(super::innovations::Update),
+}
+
+/// One operation of one run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OperationRun {
+    pub outcome: OperationOutcome,
+    /// What the update after it did (`None`: no calibration, or no update
+    /// after this operation).
+    pub update: Option<Update>,
+}
+
+/// One run: the parameters it used and its operations.
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// 1 … N.
+    pub run: usize,
+    /// The adapted parameters' values during the run, by description key.
+    pub parameters: Vec<(&'static str, f64)>,
+    pub operations: Vec<OperationRun>,
+    /// The loop itself (for plots).
+    pub run_loop: LoopRun,
+}
+
+/// `runs` runs of `design` on `plant` (default: its own model) at
+/// `sample_period`, the noise of run k seeded by `seed + k`, with the
+/// calibration (where given) updated after every operation's run.
+pub fn run_runs(
+    design: &Design,
+    calibration: Option<&CalibrationDesign>,
+    plant: Option<&Description>,
+    runs: usize,
+    sample_period: f64,
+    seed: u64,
+    options: &Options,
+) -> Result<Vec<Run>, RunsError> {
+    let study = Study {
+        design,
+        plant,
+        sample_period,
+        seed,
+        options,
+    };
+    match calibration {
+        Some(c) if c.method == Method::Innovations => study.innovations(c, runs),
+        _ => {
+            let p = calibration.map_or(0, |c| c.parameters.len());
+            macro_rules! with_p {
+                ($($n:literal)*) => {
+                    match p {
+                        $($n => study.replays::<$n>(calibration, runs),)*
+                        n => Err(RunsError::TooMany(n)),
+                    }
+                };
+            }
+            with_p!(0 1 2 3 4 5 6 7 8)
+        }
+    }
+}
+
+/// What every run shares.
+struct Study<'a> {
+    design: &'a Design,
+    plant: Option<&'a Description>,
+    sample_period: f64,
+    seed: u64,
+    options: &'a Options,
+}
+
+impl Study<'_> {
+    /// Run `run` with the adapted parameters at `values`, its operations a
+    /// window apart, and its outcomes.
+    fn run(
+        &self,
+        run: usize,
+        values: &[(&'static str, f64)],
+    ) -> Result<(LoopRun, Vec<OperationOutcome>), RunsError> {
+        let adapted = if values.is_empty() {
+            None
+        } else {
+            Some(
+                adapted_design(self.design, values)
+                    .map_err(|message| RunsError::Adapted { run, message })?,
+            )
+        };
+        let d = adapted.as_ref().unwrap_or(self.design);
+        let noise = Noise::seeded(self.seed.wrapping_add(run as u64));
+        let trajectory = self.design.description.trajectory.as_ref();
+        let window = trajectory.map(super::operation_window);
+        let looped = run_spaced_loop(
+            d,
+            self.plant,
+            self.sample_period,
+            None,
+            window,
+            noise,
+            self.options,
+        )?;
+        let (takeoff, landing) = trajectory.map_or((0.0, 0.0), |t| (t.takeoff, t.landing));
+        let outcomes = looped.outcomes(takeoff, landing);
+        Ok((looped, outcomes))
+    }
+
+    /// The runtime's replay update after every operation (P parameters).
+    fn replays<const P: usize>(
+        &self,
+        calibration: Option<&CalibrationDesign>,
+        runs: usize,
+    ) -> Result<Vec<Run>, RunsError> {
+        let design = self.design;
+        let adapted = calibration.filter(|_| P > 0);
+        let settings = adapted.map(|c| c.settings::<P>());
+        let predictor = adapted.map(|c| {
+            let ids = super::symbols::<P>(&design.model, c.parameters.iter().map(|a| a.symbol));
+            TapePredictor::<P>::new(&design.model, &ids)
+        });
+        let mut state = settings.as_ref().map(Calibration::new);
+        let mut out = Vec::with_capacity(runs);
+        for run in 1..=runs {
+            let values: Vec<(&'static str, f64)> = match (adapted, &state) {
+                (Some(c), Some(s)) => c.parameters.iter().map(|a| a.key).zip(s.theta).collect(),
+                _ => Vec::new(),
+            };
+            let (looped, outcomes) = self.run(run, &values)?;
+            let mut operations = Vec::with_capacity(outcomes.len());
+            for (outcome, &(operation, start)) in outcomes.into_iter().zip(&looped.operations) {
+                let update = match (&settings, &predictor, &mut state) {
+                    (Some(settings), Some(predictor), Some(state)) => {
+                        let record = record::<P>(settings, &looped, operation, start, design);
+                        Some(Update::Replay(state.update(predictor, settings, &record)))
+                    }
+                    _ => None,
+                };
+                operations.push(OperationRun { outcome, update });
+            }
+            out.push(Run {
+                run,
+                parameters: values,
+                operations,
+                run_loop: looped,
+            });
+        }
+        Ok(out)
+    }
+
+    /// The prediction-error update after every run, over the whole run.
+    fn innovations(&self, c: &CalibrationDesign, runs: usize) -> Result<Vec<Run>, RunsError> {
+        let mut theta: Vec<f64> = c.parameters.iter().map(|a| a.nominal).collect();
+        let mut out = Vec::with_capacity(runs);
+        for run in 1..=runs {
+            let values: Vec<(&'static str, f64)> = c
+                .parameters
+                .iter()
+                .map(|a| a.key)
+                .zip(theta.iter().copied())
+                .collect();
+            let (looped, outcomes) = self.run(run, &values)?;
+            let update = super::innovations::update(
+                self.design,
+                &c.parameters,
+                &mut theta,
+                &looped.measured,
+                c.max_step,
+                c.iterations as usize,
+            )
+            .map_err(|message| RunsError::Adapted { run, message })?;
+            let last = outcomes.len().saturating_sub(1);
+            let operations = outcomes
+                .into_iter()
+                .enumerate()
+                .map(|(k, outcome)| OperationRun {
+                    outcome,
+                    // one update per run, after its last operation
+                    update: (k == last).then_some(Update::Innovations(update)),
+                })
+                .collect();
+            out.push(Run {
+                run,
+                parameters: values,
+                operations,
+                run_loop: looped,
+            });
+        }
+        Ok(out)
+    }
+}
+
+/// The record the firmware keeps of `operation` (started at `start`): every
+/// sample of the operation's window pushed as measured.
+fn record<const P: usize>(
+    settings: &reldesign_runtime::calibrate::Settings<f64, P>,
+    looped: &LoopRun,
+    operation: Operation,
+    start: f64,
+    design: &Design,
+) -> Box<Record<f64, RECORD>> {
+    let m = &design.description.mechanics;
+    let z0 = match operation {
+        Operation::Closing => m.z_max,
+        Operation::Opening => m.z_min,
+    };
+    let end = start + looped.operation_length;
+    let tolerance = 1e-9 * looped.operation_length;
+    let mut record = Box::new(Record::<f64, RECORD>::new());
+    record.start(z0);
+    for s in &looped.measured {
+        if s.t >= start - tolerance && s.t < end - tolerance {
+            record.push(settings, s.commanded, s.voltage, s.current);
+        }
+    }
+    record
+}
