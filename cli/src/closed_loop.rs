@@ -66,9 +66,6 @@ pub struct Args {
 }
 
 pub fn run(args: &Args) -> Result<(), Report> {
-    if args.runs.is_some() {
-        return crate::loop_runs::run(args);
-    }
     if args.json {
         return Err(fail(
             "--json: only with --runs N (the other forms print a summary)",

@@ -92,6 +92,8 @@ fn main() -> ExitCode {
         Command::Diagnose(args) => diagnose::run(&args),
         Command::Limits(args) => limits::run(&args),
         Command::Robustness(args) => robustness::run(&args),
+        // `loop --runs N`: successive runs, the self-calibration between them
+        Command::Loop(args) if args.runs.is_some() => loop_runs::run(&args),
         Command::Loop(args) => closed_loop::run(&args),
         Command::Sweep(args) => sweep::run(&args),
     };
