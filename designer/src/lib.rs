@@ -4,6 +4,7 @@
 //! - [`sym`]: the symbolic core (hash-consed expression DAG, simplification,
 //!   differentiation, CSE, flat-tape evaluation). Knows nothing of actuators.
 //! - [`design`]: controller derivations (Lie derivatives, feedback linearization).
+//! - [`design_json`]: the design figures as JSON (`build --report-json`).
 //! - [`backstepping_loop`]: the backstepping position controller in a sampled loop (`loop`).
 //! - [`closed_loop`]: the designed controller in a sampled loop on a plant (`loop`, `sweep`).
 //! - [`description`]: the validated actuator description (`valve.toml`).
@@ -19,6 +20,7 @@ pub mod bisect;
 pub mod closed_loop;
 pub mod description;
 pub mod design;
+pub mod design_json;
 pub mod model;
 pub mod observe;
 pub mod random;
