@@ -41,8 +41,10 @@ __all__ = [
     "design",
     "diagnose",
     "fit",
+    "loop",
     "pulses",
     "simulate",
+    "sweep",
     "__version__",
 ]
 
@@ -190,3 +192,57 @@ def design(actuator: Union[Actuator, PathLike]) -> Design:
     """Designs the controller and observers (``reldesign build``): the
     result's ``report()`` is ``--report-json``'s dict, ``emit()`` the Rust code."""
     return _reldesign.design(_actuator(actuator))
+
+
+def loop(
+    actuator: Union[Actuator, PathLike],
+    *,
+    plant: Union[Actuator, PathLike, None] = None,
+    sample_period: Optional[float] = None,
+    duration: Optional[float] = None,
+    seed: int = 0,
+    noise: Optional[Tuple[float, float]] = None,
+    initial_field: float = 0.0,
+) -> pd.DataFrame:
+    """The designed controller in a sampled loop on the hybrid model of
+    ``plant`` (default: the description): ``reldesign loop``.
+
+    Returns the command line's columns ``t, u, i, z, vz, phi[, Hc], mode,
+    z_ref[, z_hat, v_hat, phi_hat[, Hc_hat]]``; ``.attrs["outcomes"]`` holds
+    per operation the first impact velocity, RMSE_z and bounces (or the
+    position hold's settling). The backstepping law's loop is the command
+    line's only.
+    """
+    columns, outcomes = _reldesign.closed_loop(
+        _actuator(actuator),
+        plant=None if plant is None else _actuator(plant),
+        sample_period=sample_period,
+        duration=duration,
+        seed=seed,
+        noise=noise,
+        initial_field=initial_field,
+    )
+    frame = pd.DataFrame(columns, copy=False)
+    frame.attrs["outcomes"] = outcomes
+    return frame
+
+
+def sweep(
+    actuator: Union[Actuator, PathLike],
+    sample_periods: Optional[Sequence[float]] = None,
+    *,
+    plant: Union[Actuator, PathLike, None] = None,
+) -> pd.DataFrame:
+    """The design redone at each sample period and run in closed loop:
+    ``reldesign sweep --json``'s rows (law, design, sample_period,
+    operation, impact_velocity, rmse_z, bounces) as a DataFrame;
+    ``.attrs["switching"]`` holds the uncontrolled switching's impact
+    velocity per operation."""
+    rows, switching = _reldesign.sweep(
+        _actuator(actuator),
+        None if sample_periods is None else [float(ts) for ts in sample_periods],
+        None if plant is None else _actuator(plant),
+    )
+    frame = pd.DataFrame(rows)
+    frame.attrs["switching"] = switching
+    return frame

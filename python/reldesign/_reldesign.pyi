@@ -98,3 +98,17 @@ def fit(
     seed: int = 1,
 ) -> Dict[str, Any]: ...
 def design(actuator: Actuator) -> Design: ...
+def closed_loop(
+    actuator: Actuator,
+    plant: Optional[Actuator] = None,
+    sample_period: Optional[float] = None,
+    duration: Optional[float] = None,
+    seed: int = 0,
+    noise: Optional[Tuple[float, float]] = None,
+    initial_field: float = 0.0,
+) -> Tuple[Dict[str, np.ndarray], List[Dict[str, Any]]]: ...
+def sweep(
+    actuator: Actuator,
+    sample_periods: Optional[List[float]] = None,
+    plant: Optional[Actuator] = None,
+) -> Tuple[List[Dict[str, Any]], List[Dict[str, Any]]]: ...

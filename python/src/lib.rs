@@ -15,6 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use reldesign_identify::Measured;
 
+mod closed_loop;
 mod design;
 mod diagnose;
 mod simulate;
@@ -213,5 +214,6 @@ fn _reldesign(m: &Bound<'_, PyModule>) -> PyResult<()> {
     simulate::register(m)?;
     diagnose::register(m)?;
     design::register(m)?;
+    closed_loop::register(m)?;
     Ok(())
 }

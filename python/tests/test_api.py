@@ -102,3 +102,25 @@ def test_design_equals_build_report_json(tmp_path, cli):
     assert design.report() == json.loads(json_path.read_text())
     assert design.report_json == json_path.read_text()
     assert design.emit() == code_path.read_text()
+
+
+def test_loop_and_sweep_equal_the_command_line(tmp_path, cli):
+    model = ROOT / "examples" / "perfect-tracking-valve.toml"
+    out = tmp_path / "loop.csv"
+    run = run_cli(cli, "loop", model, "--out", out)
+    assert run.returncode == 0, run.stderr
+    expected = pd.read_csv(out)
+    got = reldesign.loop(str(model))
+    assert list(got.columns) == list(expected.columns)
+    for column in expected.columns:
+        np.testing.assert_array_equal(got[column].to_numpy(), expected[column].to_numpy(), column)
+    for outcome in got.attrs["outcomes"]:
+        assert f"{outcome['bounces']} bounce(s)" in run.stdout
+    run = run_cli(cli, "sweep", model, "--sample-periods", "1e-5,2e-5", "--json")
+    assert run.returncode == 0, run.stderr
+    expected = json.loads(run.stdout)
+    table = reldesign.sweep(str(model), [1e-5, 2e-5])
+    rows = table.to_dict("records")
+    for row, line in zip(rows, expected["rows"]):
+        assert {k: row[k] for k in line if k != "design"} == {k: v for k, v in line.items() if k != "design"}
+    assert table.attrs["switching"] == expected["switching"]
