@@ -7,11 +7,14 @@ import pytest
 from conftest import ROOT
 
 
-def test_guide_notebook_executes():
+def test_guide_notebook_executes(tmp_path, monkeypatch):
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")
     path = ROOT / "docs" / "guide" / "python.ipynb"
     notebook = nbformat.read(path, as_version=4)
+    # the kernel inherits the environment: its files go to tmp_path, never
+    # into the checkout (an `out/` there would change what the Rust docs test checks)
+    monkeypatch.setenv("RELDESIGN_GUIDE_OUT", str(tmp_path))
     client = nbclient.NotebookClient(
         notebook,
         timeout=600,
@@ -27,4 +30,5 @@ def test_guide_notebook_executes():
         if output.get("output_type") == "error"
     ]
     assert not errors
-    assert (ROOT / "out" / "guide-python" / "resistances.png").exists()
+    assert (tmp_path / "resistances.png").exists()
+    assert not (ROOT / "out" / "guide-python").exists()
