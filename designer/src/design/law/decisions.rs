@@ -149,8 +149,8 @@ pub struct ControllerDesign {
     /// … up to `creep_max`·stroke beyond it.
     pub creep_max: f64,
     /// [s] after t_f: an armature not at its stop by then is driven there
-    /// (`reldesign_runtime::control::finish_stroke`): the takeoff stage's
-    /// length, so that an operation's window of [SM 45] is the planned one.
+    /// (`reldesign_runtime::control::finish_stroke`): the motion time
+    /// t_f − t₀, so that a slow landing is not pushed.
     pub arrival_margin: f64,
     /// In the order of `[trajectory].operations`, no operation twice.
     pub operations: Vec<DesignedOperation>,
@@ -187,9 +187,10 @@ impl ControllerDesign {
             press: PRESS_FRACTION,
             creep,
             creep_max: CREEP_MAX_FRACTION,
-            // no hover: driven to its stop when the operation's window of
-            // [SM 45] (as long a rest after landing as before takeoff) ends
-            arrival_margin: spec.takeoff,
+            // no hover: driven to its stop when it is late by a whole motion
+            // time (a slow but landing approach, e.g. sensorless creeping
+            // onto the stop, is left to land)
+            arrival_margin: spec.landing - spec.takeoff,
             operations,
         })
     }
