@@ -19,7 +19,10 @@ pub use predictor::TapePredictor;
 pub use reldesign_runtime::calibrate::{Outcome, Refusal};
 pub use runs::{run_runs, OperationRun, Run, RunsError, Update};
 
-use reldesign_runtime::calibrate::Settings;
+use reldesign_runtime::calibrate::{Record, Settings};
+
+use crate::closed_loop::LoopRun;
+use crate::description::Operation;
 
 use crate::description::{params, Description};
 use crate::design::{design_kalman, Design, Linearization};
@@ -177,4 +180,34 @@ pub(crate) fn symbols<'a, const P: usize>(
         .collect();
     ids.try_into()
         .unwrap_or_else(|v: Vec<_>| panic!("{} symbols for {P} parameters", v.len()))
+}
+
+/// The designer's record buffer: larger than any design's capacity (the
+/// design sizes its decimation so that an operation fits in its capacity).
+const RECORD: usize = 4096;
+
+/// The record the firmware keeps of `operation` (started at `start`): every
+/// sample of the operation's window pushed as measured.
+pub(crate) fn record<const P: usize>(
+    settings: &reldesign_runtime::calibrate::Settings<f64, P>,
+    looped: &LoopRun,
+    operation: Operation,
+    start: f64,
+    design: &Design,
+) -> Box<Record<f64, RECORD>> {
+    let m = &design.description.mechanics;
+    let z0 = match operation {
+        Operation::Closing => m.z_max,
+        Operation::Opening => m.z_min,
+    };
+    let end = start + looped.operation_length;
+    let tolerance = 1e-9 * looped.operation_length;
+    let mut record = Box::new(Record::<f64, RECORD>::new());
+    record.start(z0);
+    for s in &looped.measured {
+        if s.t >= start - tolerance && s.t < end - tolerance {
+            record.push(settings, s.commanded, s.voltage, s.current);
+        }
+    }
+    record
 }
