@@ -73,21 +73,18 @@ fn number(x: Option<f64>) -> Value {
 }
 
 fn update_json(update: &Option<Update>) -> Value {
-    match update {
-        None => Value::Null,
-        Some(Update::Replay(Outcome::Updated { before, after })) => json!({
+    let (error, outcome) = match update {
+        None => return Value::Null,
+        Some(Update::Replay(o)) => ("rms_current_error", o),
+        Some(Update::Innovations(o)) => ("rms_innovation", o),
+    };
+    match outcome {
+        Outcome::Updated { before, after } => json!({
             "updated": true,
-            "rms_current_error_before": before.sqrt(),
-            "rms_current_error_after": after.sqrt(),
+            format!("{error}_before"): before.sqrt(),
+            format!("{error}_after"): after.sqrt(),
         }),
-        Some(Update::Replay(Outcome::Refused(why))) => {
-            json!({ "updated": false, "refused": format!("{why:?}") })
-        }
-        Some(Update::Innovations(u)) => json!({
-            "updated": u.accepted,
-            "rms_innovation_before": u.before,
-            "rms_innovation_after": u.after,
-        }),
+        Outcome::Refused(why) => json!({ "updated": false, "refused": format!("{why:?}") }),
     }
 }
 

@@ -85,6 +85,11 @@ pub fn candidates(description: &Description) -> Vec<Candidate> {
         .collect()
 }
 
+/// The innovations update's forward-difference step, relative to θ_d: ν's
+/// change over it stands ~10³ above the f64 filter's rounding (the f32
+/// module emits 10⁻³: f32 rounds at 6·10⁻⁸).
+pub const DIFFERENCE_STEP: f64 = 1e-4;
+
 /// The calibration of `design` at `sample_period`: the identifiable
 /// parameters of its planned operations and the runtime's settings.
 pub fn choose(design: &Design, sample_period: f64) -> Result<CalibrationDesign, ChoiceError> {
@@ -117,11 +122,18 @@ pub fn choose(design: &Design, sample_period: f64) -> Result<CalibrationDesign, 
         dip_tolerance: 0.1 * d.supply.u_max,
         dip_share: 0.05,
         motion_evidence: 1.0,
+        difference_step: DIFFERENCE_STEP,
     };
     if design.kalman.is_some() && d.controller.as_ref().is_some_and(|c| c.estimator.is_some()) {
-        // the prediction-error update through the observer: every candidate
+        // the prediction-error update through the observer: every candidate,
+        // over a whole run (every operation) of every sample, as the filter
+        // ran it
+        let per_run = per_operation * t.operations.len().max(1);
         calibration.method = Method::Innovations;
         calibration.parameters = candidates.iter().map(|c| adapted(c, 1.0)).collect();
+        calibration.decimation = 1;
+        calibration.capacity = per_run + 1;
+        calibration.min_samples = per_run / 2;
         return Ok(calibration);
     }
     let information = information(design, &candidates, &calibration, sample_period)?;
@@ -217,6 +229,7 @@ fn information_with<const P: usize>(
         dip_tolerance: f64::INFINITY,
         dip_share: 1.0,
         motion_evidence: calibration.motion_evidence,
+        difference_step: calibration.difference_step,
     };
     for (n, c) in settings.nominal.iter_mut().zip(candidates) {
         *n = c.nominal;
