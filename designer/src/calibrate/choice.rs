@@ -85,10 +85,11 @@ pub fn candidates(description: &Description) -> Vec<Candidate> {
         .collect()
 }
 
-/// The innovations update's forward-difference step, relative to θ_d: ν's
-/// change over it stands ~10³ above the f64 filter's rounding (the f32
-/// module emits 10⁻³: f32 rounds at 6·10⁻⁸).
-pub const DIFFERENCE_STEP: f64 = 1e-4;
+/// The innovations update's forward-difference step, relative to θ_d: the
+/// emitted f32 filter rounds at ~6·10⁻⁸ of the current, and ν's change over
+/// a step of 10⁻³ stands ~10³ above it, while the curvature's error in the
+/// difference stays ~10⁻³ of the slope (f64 and f32 share the step).
+pub const DIFFERENCE_STEP: f64 = 1e-3;
 
 /// The calibration of `design` at `sample_period`: the identifiable
 /// parameters of its planned operations and the runtime's settings.
@@ -160,7 +161,13 @@ pub fn choose(design: &Design, sample_period: f64) -> Result<CalibrationDesign, 
 /// The domain an adapted parameter stays in: its design value ±[`TOLERANCE`]
 /// (its sign kept, so within the physical domain).
 fn adapted(c: &Candidate, new_information: f64) -> Adapted {
-    let (a, b) = ((1.0 - TOLERANCE) * c.nominal, (1.0 + TOLERANCE) * c.nominal);
+    // six significant digits: the emitted bounds read as written (0.0105, not
+    // 0.010499999999999999)
+    let round = |x: f64| format!("{x:.5e}").parse::<f64>().unwrap_or(x);
+    let (a, b) = (
+        round((1.0 - TOLERANCE) * c.nominal),
+        round((1.0 + TOLERANCE) * c.nominal),
+    );
     Adapted {
         key: c.key,
         symbol: c.symbol,
