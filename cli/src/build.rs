@@ -115,9 +115,13 @@ fn calibration_report(design: &designer::design::Design, sample_period: f64) -> 
             for (key, why) in &c.rejected {
                 let _ = writeln!(s, "  keeps  {key:<22} {why}");
             }
+            let per = match c.method {
+                designer::calibrate::Method::Innovations => "run (every operation)",
+                designer::calibrate::Method::Replay => "operation",
+            };
             let _ = writeln!(
                 s,
-                "  record: {} samples per operation, every {} sample(s)",
+                "  record: {} samples per {per}, every {} sample(s)",
                 c.capacity, c.decimation
             );
         }

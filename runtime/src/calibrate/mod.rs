@@ -21,9 +21,19 @@
 //!   the replay with the armature held at its start explains the current as
 //!   well as the free one) and keeps θ in its physical domain.
 //!
-//! Generated code holds the model ([`Predictor`]: f, i and their symbolic
-//! Jacobians, the design's [`Settings`]); this module the algorithm. The
-//! designer runs the same code on tapes (`reldesign loop --runs`).
+//! Two updates share the record, the settings, the bounds and the refusals:
+//!
+//! - the replay above ([`calibrate`]), for a design whose law reads measured
+//!   states: the model as a [`Predictor`] (f, i and their symbolic
+//!   Jacobians);
+//! - the innovations update ([`innovations`]), for a design an observer
+//!   drives, over a whole run: θ makes the UKF's one-step current predictions
+//!   right. It is what the emitted file carries (its UKF `Model` is
+//!   [`Adaptive`]).
+//!
+//! Generated code holds the model and the design's [`Settings`]; this module
+//! the algorithms. The designer runs the same code on tapes (`reldesign loop
+//! --runs`).
 
 pub mod innovations;
 mod record;
