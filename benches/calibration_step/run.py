@@ -15,7 +15,8 @@ designer with the example's noise.
 Measures (instructions: valgrind --tool=callgrind, total Ir of a run with 2N calls
 minus that of a run with N calls, / N):
 1. one control sample (UKF step + controller step), fixed and adaptive, f64 and f32,
-   N = 2002 (two passes over the record), net of the loop without the calls;
+   N = 2002 (two passes over the record), net of the loop without the calls; and the
+   record's push of one sample (the firmware's other per-sample addition);
 2. one whole update (calibrate on the run's record, from θ_d), f64 and f32, N = 1;
 3. wall clock of the update (best of R) on this machine;
 4. RAM of the emitted types (size_of).
@@ -69,8 +70,9 @@ def main() -> None:
         for f in ("64", "32"):
             fixed = per_call(f"step{f}fixed", 2 * RUN, work) - base[f]
             adaptive = per_call(f"step{f}adaptive", 2 * RUN, work) - base[f]
+            push = per_call(f"push{f}", 2 * RUN, work) - base[f]
             print(f"f{f:4} {fixed:10.0f} {adaptive:10.0f} {adaptive - fixed:+8.0f} "
-                  f"({100 * (adaptive / fixed - 1):+.1f} %)")
+                  f"({100 * (adaptive / fixed - 1):+.1f} %); Record::push {push:.0f}")
         print()
         print(f"one update over a run of {sizes['run_samples']} samples, "
               f"{sizes['parameters']} parameters")

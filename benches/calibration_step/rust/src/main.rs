@@ -10,6 +10,8 @@
 //!   (closing from its start, opening from its half): the file emitted with
 //!   every parameter a const (`fixed`) and with θ at run time (`adaptive`);
 //! - base{64,32}: the loop without the calls;
+//! - push{64,32}: `Record::push` of one sample (what the firmware adds to
+//!   each control sample);
 //! - update{64,32}: one whole update, `ukf::…::calibrate` on the run's record
 //!   (from θ_d every call: the same work each time).
 
@@ -109,6 +111,30 @@ macro_rules! update_loop {
         }
     };
 }
+macro_rules! push_loop {
+    ($name:ident, $filter:path, $f:ty) => {
+        fn $name(rec: &[[$f; 3]], n: usize) -> f64 {
+            use $filter as filter;
+            let mut record = filter::Record::new();
+            let mut k = 0;
+            for _ in 0..n {
+                if k == 0 {
+                    record.start(filter::Z_MAX);
+                }
+                let [c, u, i] = *black_box(&rec[k]);
+                record.push(&filter::CALIBRATION, c, u, i);
+                k += 1;
+                if k == rec.len() {
+                    k = 0;
+                }
+            }
+            black_box(&record).len() as f64
+        }
+    };
+}
+push_loop!(push64, adaptive::ukf::f64, f64);
+push_loop!(push32, adaptive::ukf::f32, f32);
+
 update_loop!(update64, adaptive::ukf::f64, f64);
 update_loop!(update32, adaptive::ukf::f32, f32);
 
@@ -185,6 +211,8 @@ fn main() {
             "base64" => base64(&rec64, n),
             "base32" => base32(&rec32, n),
             "update64" => update64(&rec64, n),
+            "push64" => push64(&rec64, n),
+            "push32" => push32(&rec32, n),
             "update32" => update32(&rec32, n),
             _ => {
                 eprintln!("unknown kind {kind}");
