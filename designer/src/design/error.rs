@@ -43,6 +43,19 @@ pub enum PlanError {
         operation: &'static str,
         message: String,
     },
+    #[error(
+        "the {operation} pre-movement stage is too short: driven at the supply's limit \
+         (supply.{key} = {input}) from its rest, the model's armature leaves its stop only \
+         {needed}, but trajectory.takeoff = {takeoff_ms:.4} ms; set trajectory.takeoff to at \
+         least that, or raise |supply.{key}|"
+    )]
+    TakeoffTooShort {
+        operation: &'static str,
+        key: &'static str,
+        input: f64,
+        needed: String,
+        takeoff_ms: f64,
+    },
     #[error("the controller has no operation")]
     NoOperation,
     #[error("the {0:?} operation is given twice")]

@@ -28,6 +28,7 @@ use super::trajectory::fit_segments::{fit_segments, SegmentTolerance};
 use super::trajectory::optimal::problem::{OptimalError, OptimalSpec};
 use super::trajectory::optimal::{energy_optimal, OptimalTrajectory};
 use super::trajectory::reference::{Polynomial, Reference};
+use super::trajectory::takeoff::{shortest_takeoff, Shortest};
 
 /// Instants of the sliding-mode supply check per operation.
 const ROBUSTNESS_SAMPLES: usize = 4000;
@@ -100,6 +101,7 @@ pub fn design_controller(
     let linearization = Linearization::derive(model)?;
     let mut operations = Vec::new();
     for &operation in &trajectory.operations {
+        check_takeoff(description, model, operation, trajectory.takeoff)?;
         operations.push(design_operation(
             description,
             model,
@@ -412,4 +414,38 @@ fn optimal_message(e: &OptimalError, description: &Description) -> String {
         ),
         other => other.to_string(),
     }
+}
+
+/// `operation`'s pre-movement stage against the shortest the supply allows
+/// (`trajectory/takeoff.rs`): refused, with that time and the key, where
+/// `takeoff` is shorter.
+fn check_takeoff(
+    description: &Description,
+    model: &mut Model,
+    operation: Operation,
+    takeoff: f64,
+) -> Result<(), PlanError> {
+    let (key, input) = match operation {
+        Operation::Closing => ("u_max", description.supply.u_max),
+        Operation::Opening => ("u_min", lowest_input(description)),
+    };
+    let shortest =
+        shortest_takeoff(description, model, operation, input, takeoff).map_err(|message| {
+            PlanError::Optimal {
+                operation: operation.name(),
+                message: format!("the shortest takeoff: {message}"),
+            }
+        })?;
+    let needed = match shortest {
+        Shortest::After(t) if t <= takeoff => return Ok(()),
+        Shortest::After(t) => format!("after {:.4} ms", t * 1e3),
+        Shortest::Longer(h) => format!("after more than {:.1} ms", h * 1e3),
+    };
+    Err(PlanError::TakeoffTooShort {
+        operation: operation.name(),
+        key,
+        input,
+        needed,
+        takeoff_ms: takeoff * 1e3,
+    })
 }
