@@ -128,14 +128,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
     if !holds && !positions {
         check_sample_period(&description, ts).map_err(|e| fail(format!("{file}: {e}")))?;
     }
-    let mut designed = description.clone();
-    if let Some(c) = &mut designed.controller {
-        c.sample_period = ts;
-    }
-    if let (Some(o), Some(_)) = (&mut designed.observer, args.sample_period) {
-        resample_observer(o, ts);
-    }
-    let design = Design::new(&designed).map_err(|e| fail(format!("{file}: {e}")))?;
+    let design = design_at(&description, args, ts, &file)?;
     if positions {
         let (run, summary) =
             crate::position_loop::run(&design, plant.as_ref(), ts, duration, noise, initial)
@@ -361,4 +354,22 @@ fn plot(run: &LoopRun, name: &str, ts: f64) -> Result<String, String> {
         root.present().map_err(e)?;
     }
     Ok(out)
+}
+
+/// `description` designed at the loop's sample period `ts` (the observer's
+/// process noise rescaled where `--sample-period` moved it).
+pub(crate) fn design_at(
+    description: &designer::description::Description,
+    args: &Args,
+    ts: f64,
+    file: &str,
+) -> Result<Design, Report> {
+    let mut designed = description.clone();
+    if let Some(c) = &mut designed.controller {
+        c.sample_period = ts;
+    }
+    if let (Some(o), Some(_)) = (&mut designed.observer, args.sample_period) {
+        resample_observer(o, ts);
+    }
+    Design::new(&designed).map_err(|e| fail(format!("{file}: {e}")))
 }

@@ -9,9 +9,8 @@
 use std::fmt::Write as _;
 
 use designer::calibrate::{choose, run_runs, CalibrationDesign, Outcome, Run, Update};
-use designer::closed_loop::{check_sample_period, resample_observer, switching_baseline};
+use designer::closed_loop::{check_sample_period, switching_baseline};
 use designer::description::Operation;
-use designer::design::Design;
 use designer::sim::Options;
 use miette::Report;
 
@@ -36,14 +35,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
     let ts = crate::closed_loop::positive("--sample-period", args.sample_period)?
         .unwrap_or(controller.sample_period);
     check_sample_period(&description, ts).map_err(|e| fail(format!("{file}: {e}")))?;
-    let mut designed = description.clone();
-    if let Some(c) = &mut designed.controller {
-        c.sample_period = ts;
-    }
-    if let (Some(o), Some(_)) = (&mut designed.observer, args.sample_period) {
-        resample_observer(o, ts);
-    }
-    let design = Design::new(&designed).map_err(|e| fail(format!("{file}: {e}")))?;
+    let design = crate::closed_loop::design_at(&description, args, ts, &file)?;
     let calibration = if controller.self_calibration {
         Some(choose(&design, ts).map_err(|e| fail(format!("{file}: self-calibration: {e}")))?)
     } else {

@@ -114,7 +114,7 @@ fn plan_consts(d: &ControllerDesign, float: Float) -> Result<TokenStream, Contro
             ("PRESS", d.press, "After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes\nthe last gap gently and the contact is certain."),
             ("CREEP", d.creep, "After t_f the reference creeps on beyond the stop at CREEP·stroke per second [1/s]:\nwhere the plant differs from the model and a pure hold would hover short of the\nstop, the armature still lands, at about that speed."),
             ("CREEP_MAX", d.creep_max, "The creep stops CREEP_MAX·stroke beyond the end stop."),
-            ("ARRIVAL_MARGIN", d.arrival_margin, "No hover [s]: an armature not at its end stop by t_f + ARRIVAL_MARGIN is driven\nthere (closing: u_max; opening: the flux quenched, then 0 V) and the operation is\nflagged late. A tenth of the motion time."),
+            ("ARRIVAL_MARGIN", d.arrival_margin, "No hover [s]: an armature not at its end stop by t_f + ARRIVAL_MARGIN is driven\nthere (closing: u_max; opening: the flux quenched, then 0 V) and the operation is\nflagged late. The motion time t_f − t₀: a slow landing is not pushed."),
         ],
     )
 }

@@ -4,6 +4,7 @@
 //! - [`sym`]: the symbolic core (hash-consed expression DAG, simplification,
 //!   differentiation, CSE, flat-tape evaluation). Knows nothing of actuators.
 //! - [`design`]: controller design: derivations, trajectories, laws, analyses.
+//! - [`design_json`]: the design figures as JSON (`build --report-json`).
 //! - [`backstepping_loop`]: the backstepping position controller in a sampled loop (`loop`).
 //! - [`closed_loop`]: the designed controller in a sampled loop on a plant (`loop`, `sweep`).
 //! - [`description`]: the validated actuator description (`valve.toml`).
@@ -20,6 +21,7 @@ pub mod calibrate;
 pub mod closed_loop;
 pub mod description;
 pub mod design;
+pub mod design_json;
 pub mod model;
 pub mod observe;
 mod parallel;

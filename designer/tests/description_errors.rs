@@ -371,9 +371,11 @@ fn with_sections(example: &str, sections: &str) -> Description {
 fn the_perfect_tracking_example_carries_the_papers_design() {
     for path in example_paths() {
         let d = parse_file(&path).unwrap_or_else(|e| panic!("{e}"));
-        let designed = path
-            .file_name()
-            .is_some_and(|n| n == "perfect-tracking-valve.toml" || n == "sliding-mode-valve.toml");
+        let designed = path.file_name().is_some_and(|n| {
+            n == "perfect-tracking-valve.toml"
+                || n == "sliding-mode-valve.toml"
+                || n == "self-calibrating-valve.toml"
+        });
         assert_eq!(
             d.trajectory.is_some() && d.controller.is_some(),
             designed,
@@ -391,6 +393,15 @@ fn the_perfect_tracking_example_carries_the_papers_design() {
                 panic!("sliding-mode-valve.toml: not the sliding-mode law");
             };
             assert_eq!((s.lambda1, s.lambda2, s.eta), (2000.0, 2000.0, 1e5));
+        } else if path.ends_with("self-calibrating-valve.toml") {
+            // sensorless at 50 µs, a longer motion under a lower bound (the guide)
+            let t = d.trajectory.unwrap();
+            assert_eq!(
+                (t.takeoff, t.landing, t.u_bound, t.shape),
+                (1e-3, 8e-3, 18.0, Shape::EnergyOptimal)
+            );
+            let c = d.controller.unwrap();
+            assert!(c.self_calibration && c.estimator.is_some());
         } else if designed {
             let t = d.trajectory.unwrap();
             assert_eq!(

@@ -277,8 +277,8 @@ pub mod f32 {
 
     /// No hover [s]: an armature not at its end stop by t_f + ARRIVAL_MARGIN is driven
     /// there (closing: u_max; opening: the flux quenched, then 0 V) and the operation is
-    /// flagged late. A tenth of the motion time.
-    pub const ARRIVAL_MARGIN: f32 = 0.0007;
+    /// flagged late. The motion time t_f − t₀: a slow landing is not pushed.
+    pub const ARRIVAL_MARGIN: f32 = 0.007;
 
     /// Reference of the closing motion z_m on [t₀, t_f] [PT 51]: one row
     /// [t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;
@@ -500,8 +500,8 @@ pub mod f64 {
 
     /// No hover [s]: an armature not at its end stop by t_f + ARRIVAL_MARGIN is driven
     /// there (closing: u_max; opening: the flux quenched, then 0 V) and the operation is
-    /// flagged late. A tenth of the motion time.
-    pub const ARRIVAL_MARGIN: f64 = 0.0007000000000000001;
+    /// flagged late. The motion time t_f − t₀: a slow landing is not pushed.
+    pub const ARRIVAL_MARGIN: f64 = 0.007;
 
     /// Reference of the closing motion z_m on [t₀, t_f] [PT 51]: one row
     /// [t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;

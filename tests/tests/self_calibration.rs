@@ -190,7 +190,7 @@ fn the_self_calibration_study_over_forty_plants() {
         println!("  plants with an operation that never reached its stop: {hovered}");
     }
     for s in &studies {
-        println!("{s:?}");
+        println!("plant {}: {s:?}", s.seed);
     }
     assert!(
         studies.iter().filter(|s| s.switches).all(|s| !s.hovered),

@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 /// The crates whose `src/` the module maps cover.
-const CRATES: [&str; 8] = [
-    "sym", "designer", "identify", "codegen", "runtime", "cli", "macros", "tests",
+const CRATES: [&str; 9] = [
+    "sym", "designer", "identify", "codegen", "runtime", "cli", "macros", "tests", "python",
 ];
 
 fn root() -> PathBuf {

@@ -14,10 +14,10 @@
 //! current cannot tell apart from the chosen ones (or barely sees) is left
 //! at its design value, with the reason in the report.
 
-use reldesign_runtime::calibrate::{replay, Record, Settings};
+use reldesign_runtime::calibrate::{replay, Settings};
 
 use crate::closed_loop::{run_spaced_loop, Noise};
-use crate::description::{params, Core, Description, Operation};
+use crate::description::{params, Core, Description};
 use crate::design::Design;
 use crate::sim::Options;
 
@@ -225,19 +225,7 @@ fn information_with<const P: usize>(
     let predictor = TapePredictor::<P>::new(&design.model, &ids);
     let mut total = vec![vec![0.0; P]; P];
     for &(operation, start) in &looped.operations {
-        let z0 = match operation {
-            Operation::Closing => calibration.z_max,
-            Operation::Opening => calibration.z_min,
-        };
-        let mut record = Box::new(Record::<f64, 4096>::new());
-        record.start(z0);
-        let end = start + looped.operation_length;
-        let tolerance = 1e-9 * looped.operation_length;
-        for s in &looped.measured {
-            if s.t >= start - tolerance && s.t < end - tolerance {
-                record.push(&settings, s.commanded, s.voltage, s.current);
-            }
-        }
+        let record = super::record(&settings, looped, operation, start, design);
         let r = replay(
             &predictor,
             &settings,

@@ -19,18 +19,22 @@ pub use predictor::TapePredictor;
 pub use reldesign_runtime::calibrate::{Outcome, Refusal};
 pub use runs::{run_runs, OperationRun, Run, RunsError, Update};
 
-use reldesign_runtime::calibrate::Settings;
+use reldesign_runtime::calibrate::{Record, Settings};
+
+use crate::closed_loop::LoopRun;
+use crate::description::Operation;
 
 use crate::description::{params, Description};
 use crate::design::{design_kalman, Design, Linearization};
 use crate::model::Model;
 
 /// The time [s] between two operations' starts in a run-to-run study (and
-/// the window a record covers): twice takeoff + landing, so that an
-/// operation the runtime had to finish ([`reldesign_runtime::control::finish_stroke`])
+/// the window a record covers): twice takeoff + landing and a motion time,
+/// so that an operation the runtime had to finish ([`reldesign_runtime::control::finish_stroke`])
 /// ends before the next one starts.
 pub fn operation_window(t: &crate::description::Trajectory) -> f64 {
-    2.0 * crate::design::operation_end(t.takeoff, t.landing)
+    // the push comes at 2·t_f − t₀; the window leaves as long again
+    2.0 * crate::design::operation_end(t.takeoff, t.landing) + (t.landing - t.takeoff)
 }
 
 /// One adapted parameter: its description key, the model's symbol, the
@@ -176,4 +180,34 @@ pub(crate) fn symbols<'a, const P: usize>(
         .collect();
     ids.try_into()
         .unwrap_or_else(|v: Vec<_>| panic!("{} symbols for {P} parameters", v.len()))
+}
+
+/// The designer's record buffer: larger than any design's capacity (the
+/// design sizes its decimation so that an operation fits in its capacity).
+const RECORD: usize = 4096;
+
+/// The record the firmware keeps of `operation` (started at `start`): every
+/// sample of the operation's window pushed as measured.
+pub(crate) fn record<const P: usize>(
+    settings: &reldesign_runtime::calibrate::Settings<f64, P>,
+    looped: &LoopRun,
+    operation: Operation,
+    start: f64,
+    design: &Design,
+) -> Box<Record<f64, RECORD>> {
+    let m = &design.description.mechanics;
+    let z0 = match operation {
+        Operation::Closing => m.z_max,
+        Operation::Opening => m.z_min,
+    };
+    let end = start + looped.operation_length;
+    let tolerance = 1e-9 * looped.operation_length;
+    let mut record = Box::new(Record::<f64, RECORD>::new());
+    record.start(z0);
+    for s in &looped.measured {
+        if s.t >= start - tolerance && s.t < end - tolerance {
+            record.push(settings, s.commanded, s.voltage, s.current);
+        }
+    }
+    record
 }

@@ -4,18 +4,14 @@
 //! adapted so far; then each operation's record, as the firmware's
 //! `Record` keeps it from the measured voltage and current, updates θ.
 
-use reldesign_runtime::calibrate::{Calibration, Outcome, Record};
+use reldesign_runtime::calibrate::{Calibration, Outcome};
 
 use crate::closed_loop::{run_spaced_loop, LoopError, LoopRun, Noise, OperationOutcome};
-use crate::description::{Description, Operation};
+use crate::description::Description;
 use crate::design::Design;
 use crate::sim::Options;
 
 use super::{adapted_design, CalibrationDesign, Method, TapePredictor};
-
-/// The designer's record buffer: larger than any design's capacity (the
-/// design sizes its decimation so that an operation fits in its capacity).
-const RECORD: usize = 4096;
 
 /// Why the runs stopped.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -162,7 +158,8 @@ impl Study<'_> {
             for (outcome, &(operation, start)) in outcomes.into_iter().zip(&looped.operations) {
                 let update = match (&settings, &predictor, &mut state) {
                     (Some(settings), Some(predictor), Some(state)) => {
-                        let record = record::<P>(settings, &looped, operation, start, design);
+                        let record =
+                            super::record::<P>(settings, &looped, operation, start, design);
                         Some(Update::Replay(state.update(predictor, settings, &record)))
                     }
                     _ => None,
@@ -219,30 +216,4 @@ impl Study<'_> {
         }
         Ok(out)
     }
-}
-
-/// The record the firmware keeps of `operation` (started at `start`): every
-/// sample of the operation's window pushed as measured.
-fn record<const P: usize>(
-    settings: &reldesign_runtime::calibrate::Settings<f64, P>,
-    looped: &LoopRun,
-    operation: Operation,
-    start: f64,
-    design: &Design,
-) -> Box<Record<f64, RECORD>> {
-    let m = &design.description.mechanics;
-    let z0 = match operation {
-        Operation::Closing => m.z_max,
-        Operation::Opening => m.z_min,
-    };
-    let end = start + looped.operation_length;
-    let tolerance = 1e-9 * looped.operation_length;
-    let mut record = Box::new(Record::<f64, RECORD>::new());
-    record.start(z0);
-    for s in &looped.measured {
-        if s.t >= start - tolerance && s.t < end - tolerance {
-            record.push(settings, s.commanded, s.voltage, s.current);
-        }
-    }
-    record
 }

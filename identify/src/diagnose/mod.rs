@@ -23,6 +23,7 @@ pub mod localise;
 mod polish;
 pub mod rank;
 pub mod recalibration;
+pub mod report;
 mod second_start;
 pub mod unexplained;
 mod waves;

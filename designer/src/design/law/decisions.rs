@@ -27,9 +27,6 @@ const PRESS_FRACTION: f64 = 1e-6;
 const CREEP_FRACTION: f64 = 2.5e-3;
 /// … up to this fraction of the stroke beyond it.
 const CREEP_MAX_FRACTION: f64 = 0.05;
-/// No hover: the armature is driven to its stop a tenth of the motion time
-/// after t_f at the latest.
-const ARRIVAL_FRACTION: f64 = 0.1;
 
 /// Reference samples per segment when searching the smallest flux.
 const FLUX_SAMPLES: usize = 64;
@@ -152,7 +149,8 @@ pub struct ControllerDesign {
     /// … up to `creep_max`·stroke beyond it.
     pub creep_max: f64,
     /// [s] after t_f: an armature not at its stop by then is driven there
-    /// (`reldesign_runtime::control::finish_stroke`); a tenth of the motion time.
+    /// (`reldesign_runtime::control::finish_stroke`): the motion time
+    /// t_f − t₀, so that a slow landing is not pushed.
     pub arrival_margin: f64,
     /// In the order of `[trajectory].operations`, no operation twice.
     pub operations: Vec<DesignedOperation>,
@@ -189,7 +187,10 @@ impl ControllerDesign {
             press: PRESS_FRACTION,
             creep,
             creep_max: CREEP_MAX_FRACTION,
-            arrival_margin: ARRIVAL_FRACTION * (spec.landing - spec.takeoff),
+            // no hover: driven to its stop when it is late by a whole motion
+            // time (a slow but landing approach, e.g. sensorless creeping
+            // onto the stop, is left to land)
+            arrival_margin: spec.landing - spec.takeoff,
             operations,
         })
     }
