@@ -421,7 +421,7 @@ fn optimal_message(e: &OptimalError, description: &Description) -> String {
 /// `takeoff` is shorter.
 fn check_takeoff(
     description: &Description,
-    model: &mut Model,
+    model: &Model,
     operation: Operation,
     takeoff: f64,
 ) -> Result<(), PlanError> {

@@ -31,14 +31,19 @@ pub enum Shortest {
 
 /// The shortest pre-movement stage of `operation` on `model`, driven at
 /// `input` [V or A] from its starting rest; `takeoff` [s] the design's, to
-/// size the horizon.
+/// size the horizon. Simulated on a copy of `model`: compiling a plant adds
+/// to the model's expression graph, which the design's later derivations
+/// would then evaluate in another order, and the emitted tables must keep
+/// their bits.
 pub fn shortest_takeoff(
     description: &Description,
-    model: &mut Model,
+    model: &Model,
     operation: Operation,
     input: f64,
     takeoff: f64,
 ) -> Result<Shortest, String> {
+    let mut model = model.clone();
+    let model = &mut model;
     let m = &description.mechanics;
     let mut x0 = [0.0; MAX_DIM];
     let mode = match operation {
