@@ -429,12 +429,11 @@ fn check_takeoff(
         Operation::Closing => ("u_max", description.supply.u_max),
         Operation::Opening => ("u_min", lowest_input(description)),
     };
-    let shortest =
-        shortest_takeoff(description, model, operation, input, takeoff).map_err(|message| {
-            PlanError::Optimal {
-                operation: operation.name(),
-                message: format!("the shortest takeoff: {message}"),
-            }
+    let hold_input = description.supply.u_max;
+    let shortest = shortest_takeoff(description, model, operation, input, hold_input, takeoff)
+        .map_err(|message| PlanError::Optimal {
+            operation: operation.name(),
+            message: format!("the shortest takeoff: {message}"),
         })?;
     let needed = match shortest {
         Shortest::After(t) if t <= takeoff => return Ok(()),

@@ -9,8 +9,14 @@
 //! the shortest takeoff:
 //!
 //! - closing, from z_max without flux, at u_max;
-//! - opening, from z_min with the flux that holding at u_max leaves
-//!   (`Statics::hold_flux`), at the lowest input.
+//! - opening, at the lowest input, from the hold the design's own cycle
+//!   leaves: landed at rest on z_min with the forces balanced (the
+//!   reference's end), then held for t₀ at u_max (the expert rule on
+//!   contact [SM 43] from t_f until the operation ends at t_f + t₀ [SM 45],
+//!   `operation_end`, where the next one starts). A longer hold builds more
+//!   flux, up to the steady flux at u_max, and needs a longer stage than
+//!   this: that is outside the timing the design is made for, and not
+//!   checked (the 12 V relay would need 3.54 ms from there).
 
 use crate::description::{Description, Operation};
 use crate::model::{Model, ModelPlant, Statics};
@@ -30,39 +36,68 @@ pub enum Shortest {
 }
 
 /// The shortest pre-movement stage of `operation` on `model`, driven at
-/// `input` [V or A] from its starting rest; `takeoff` [s] the design's, to
-/// size the horizon. Simulated on a copy of `model`: compiling a plant adds
-/// to the model's expression graph, which the design's later derivations
-/// would then evaluate in another order, and the emitted tables must keep
-/// their bits.
+/// `input` [V or A] from its starting rest (module docs; the opening's after
+/// the hold at `hold_input` the design's cycle gives it); `takeoff` [s] the
+/// design's, the hold's length and the horizon's scale. Simulated on a copy
+/// of `model`: compiling a plant adds to the model's expression graph, which
+/// the design's later derivations would then evaluate in another order, and
+/// the emitted tables must keep their bits.
 pub fn shortest_takeoff(
     description: &Description,
     model: &Model,
     operation: Operation,
     input: f64,
+    hold_input: f64,
     takeoff: f64,
 ) -> Result<Shortest, String> {
     let mut model = model.clone();
     let model = &mut model;
     let m = &description.mechanics;
     let mut x0 = [0.0; MAX_DIM];
-    let mode = match operation {
-        Operation::Closing => {
+    let balance = match operation {
+        Operation::Closing => None,
+        Operation::Opening => Some(Statics::of(model).drop_out.map_or(0.0, |p| p.flux)),
+    };
+    let plant = ModelPlant::new(model);
+    let constant = |u: f64, end: f64| {
+        PiecewiseLinear::new(vec![0.0, end], vec![u, u]).map_err(|e| e.to_string())
+    };
+    let mode = match balance {
+        None => {
             x0[0] = m.z_max;
             Mode::StuckMax
         }
-        Operation::Opening => {
+        Some(flux) => {
+            // landed at rest (the reference's end, forces balanced), then
+            // held at hold_input for t₀ [SM 45]
             x0[0] = m.z_min;
-            x0[2] = Statics::of(model).hold_flux;
-            Mode::StuckMin
+            x0[2] = flux;
+            let held = simulate(
+                &plant,
+                &constant(hold_input, takeoff)?,
+                x0,
+                Mode::StuckMin,
+                &[0.0, takeoff],
+                &Options::default(),
+            )
+            .map_err(|e| e.to_string())?;
+            let (Some(x), Some(&mode)) = (held.x.last(), held.mode.last()) else {
+                return Err("the hold before the opening has no state".to_string());
+            };
+            x0 = *x;
+            mode
         }
     };
     let horizon = HORIZON * takeoff;
-    let plant = ModelPlant::new(model);
-    let u =
-        PiecewiseLinear::new(vec![0.0, horizon], vec![input, input]).map_err(|e| e.to_string())?;
-    let trajectory = simulate(&plant, &u, x0, mode, &[0.0, horizon], &Options::default())
-        .map_err(|e| e.to_string())?;
+    let trajectory = simulate(
+        &plant,
+        &constant(input, horizon)?,
+        x0,
+        mode,
+        &[0.0, horizon],
+        &Options::default(),
+    )
+    .map_err(|e| e.to_string())?;
     Ok(trajectory
         .events
         .iter()
