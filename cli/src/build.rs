@@ -82,7 +82,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
 }
 
 /// What the self-calibration adapts and why (the identifiability of the
-/// planned operations), and what the emitted file does not carry yet.
+/// planned operations), and whether the emitted file carries the update.
 fn calibration_report(design: &designer::design::Design, sample_period: f64) -> String {
     use std::fmt::Write as _;
     let mut s = String::from("self-calibration (controller.self_calibration):\n");
@@ -115,9 +115,13 @@ fn calibration_report(design: &designer::design::Design, sample_period: f64) -> 
             for (key, why) in &c.rejected {
                 let _ = writeln!(s, "  keeps  {key:<22} {why}");
             }
+            let per = match c.method {
+                designer::calibrate::Method::Innovations => "run (every operation)",
+                designer::calibrate::Method::Replay => "operation",
+            };
             let _ = writeln!(
                 s,
-                "  record: {} samples per operation, every {} sample(s)",
+                "  record: {} samples per {per}, every {} sample(s)",
                 c.capacity, c.decimation
             );
         }
@@ -125,8 +129,14 @@ fn calibration_report(design: &designer::design::Design, sample_period: f64) -> 
             let _ = writeln!(s, "  not designed: {e}");
         }
     }
-    s.push_str(
-        "  warning: the emitted file does not carry the update yet; `reldesign loop --runs N` runs it",
+    let emitted = matches!(
+        designer::calibrate::choose(design, sample_period),
+        Ok(c) if c.method == designer::calibrate::Method::Innovations
     );
+    s.push_str(if emitted {
+        "  emitted: θ read at run time by the law and the filter; `ukf::…::calibrate` after each run"
+    } else {
+        "  warning: the emitted file does not carry the replay update; `reldesign loop --runs N` runs it"
+    });
     s
 }

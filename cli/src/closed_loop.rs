@@ -45,7 +45,8 @@ pub struct Args {
     /// Simulated time [s] (default: every operation once, takeoff + landing each)
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) duration: Option<f64>,
-    /// Also draw position and reference, input and current to this SVG file
+    /// Also draw position and reference, input and current to this SVG file (with
+    /// --runs: each run's first impact speeds and adapted parameters)
     #[arg(long)]
     pub(crate) plot: Option<PathBuf>,
     /// Seed of the measurement noise, where an observer drives the controller

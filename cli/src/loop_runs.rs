@@ -5,6 +5,8 @@
 //! the runtime's own code; per run the parameters used, per operation the
 //! first impact, the bounces and the highest bounce, against the
 //! uncontrolled switching (`../shared/spec/cli.md`, `loop --runs N --json`).
+//! `--out` writes the last run's samples, `--plot` the runs' picture
+//! (`runs_plot.rs`).
 
 use std::fmt::Write as _;
 
@@ -54,10 +56,28 @@ pub fn run(args: &Args) -> Result<(), Report> {
     .map_err(|e| fail(format!("{file}: {e}")))?;
     let baseline = switching_baseline(&description, plant.as_ref(), &options)
         .map_err(|e| fail(format!("{file}: {e}")))?;
-    if let (Some(out), Some(last)) = (&args.out, done.last()) {
-        let csv = crate::closed_loop::to_csv(&last.run_loop, design.model.dim() > 3, None);
-        crate::closed_loop::write_outputs(args, out, &csv, &last.run_loop, &description.name, ts)?;
+    // the last run's CSV (--out) and the runs' picture (--plot), together
+    let csv = match (&args.out, done.last()) {
+        (Some(_), Some(last)) => Some(crate::closed_loop::to_csv(
+            &last.run_loop,
+            design.model.dim() > 3,
+            None,
+        )),
+        _ => None,
+    };
+    let title = format!("{}: {runs} runs at T_s = {ts:e} s", description.name);
+    let svg = match &args.plot {
+        Some(_) => Some(crate::runs_plot::svg(&done, &baseline, &title).map_err(fail)?),
+        None => None,
+    };
+    let mut files: Vec<(&std::path::Path, &[u8])> = Vec::new();
+    if let (Some(out), Some(csv)) = (&args.out, &csv) {
+        files.push((out.as_path(), csv.as_bytes()));
     }
+    if let (Some(path), Some(svg)) = (&args.plot, &svg) {
+        files.push((path.as_path(), svg.as_bytes()));
+    }
+    crate::atomic::write_all(&files).map_err(fail)?;
     if args.json {
         println!("{}", to_json(&done, &baseline, calibration.as_ref()));
     } else {
@@ -73,21 +93,18 @@ fn number(x: Option<f64>) -> Value {
 }
 
 fn update_json(update: &Option<Update>) -> Value {
-    match update {
-        None => Value::Null,
-        Some(Update::Replay(Outcome::Updated { before, after })) => json!({
+    let (error, outcome) = match update {
+        None => return Value::Null,
+        Some(Update::Replay(o)) => ("rms_current_error", o),
+        Some(Update::Innovations(o)) => ("rms_innovation", o),
+    };
+    match outcome {
+        Outcome::Updated { before, after } => json!({
             "updated": true,
-            "rms_current_error_before": before.sqrt(),
-            "rms_current_error_after": after.sqrt(),
+            format!("{error}_before"): before.sqrt(),
+            format!("{error}_after"): after.sqrt(),
         }),
-        Some(Update::Replay(Outcome::Refused(why))) => {
-            json!({ "updated": false, "refused": format!("{why:?}") })
-        }
-        Some(Update::Innovations(u)) => json!({
-            "updated": u.accepted,
-            "rms_innovation_before": u.before,
-            "rms_innovation_after": u.after,
-        }),
+        Outcome::Refused(why) => json!({ "updated": false, "refused": format!("{why:?}") }),
     }
 }
 

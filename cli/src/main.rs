@@ -21,6 +21,7 @@ mod position_loop;
 mod progress;
 mod region_plot;
 mod robustness;
+mod runs_plot;
 mod simulate;
 mod sweep;
 

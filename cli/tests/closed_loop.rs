@@ -203,8 +203,10 @@ fn bad_input_is_named_and_nothing_is_written() {
 fn loop_runs_prints_the_contracts_json() {
     let dir = TempDir::new("loop-runs");
     let model = example_path("self-calibrating-valve.toml");
-    let out = dir.join("last.csv");
-    let text = rd!("loop", model, "--runs", "2", "--json", "--seed", "5", "--out", out).ok();
+    let (out, plot) = (dir.join("last.csv"), dir.join("runs.svg"));
+    let text =
+        rd!("loop", model, "--runs", "2", "--json", "--seed", "5", "--out", out, "--plot", plot)
+            .ok();
     let json: Value = serde_json::from_str(&text).unwrap();
     let runs = json["runs"].as_array().unwrap();
     assert_eq!(runs.len(), 2);
@@ -225,6 +227,17 @@ fn loop_runs_prints_the_contracts_json() {
     assert_eq!(json["calibration"], "innovations");
     let (header, _) = read_csv(&out);
     assert_eq!(header[0], "t");
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    for label in [
+        "|first impact| [mm/s]",
+        "θ / θ_d during the run",
+        "coil.resistance",
+        "closing switching",
+    ] {
+        assert!(svg.contains(label), "the runs' plot lacks {label}");
+    }
+    // the first update moved θ: run 2's resistance differs from the design's
+    assert_ne!(runs[1]["parameters"]["coil.resistance"], 75.0);
     rd!("loop", model, "--json").rejected(&["--json", "--runs"]);
     rd!("loop", model).rejected(&["--out"]);
     rd!("loop", model, "--runs", "0", "--json").rejected(&["--runs"]);

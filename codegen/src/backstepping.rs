@@ -113,7 +113,7 @@ fn law_macro(input: &BacksteppingInput, f32: bool) -> Result<String, ControllerE
         output_symbols: staged,
         float: Float::F64,
     };
-    let terms = function_tokens_as(&graph, &terms, &params, Inline::Always, scalar)?;
+    let terms = function_tokens_as(&graph, &terms, &params, Inline::Always, scalar, &[])?;
     // only the named subexpressions F_d reaches (the others' folded
     // parameter consts would be unused)
     let reached = graph.postorder(&[law.desired_force]);
@@ -135,7 +135,7 @@ fn law_macro(input: &BacksteppingInput, f32: bool) -> Result<String, ControllerE
         output_symbols: Vec::new(),
         float: Float::F64,
     };
-    let force = function_tokens_as(&graph, &force, &params, Inline::Always, scalar)?;
+    let force = function_tokens_as(&graph, &force, &params, Inline::Always, scalar, &[])?;
     let ty = scalar.ty();
     let state: Vec<_> = state_args(model)
         .into_iter()

@@ -45,6 +45,8 @@ pub enum BuildError {
     },
     #[error("{file}: the parameters: {source}")]
     Params { file: String, source: EmitError },
+    #[error("{file}: [controller] self_calibration: {message}")]
+    Calibration { file: String, message: String },
     #[error("{0}")]
     Io(String),
 }
@@ -58,8 +60,19 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
     let d = &design.description;
     let file = || d.source.file_name.clone();
     let mut modules = Vec::new();
-    // file-level macros besides `params!` (the filters' `kalman!` settings)
+    // file-level macros besides `params!` (the filters' `kalman!` settings,
+    // the self-calibration's `calibration!`)
     let mut macros = Vec::new();
+    let calibration = emitted_calibration(design)?;
+    if let Some(c) = &calibration {
+        let text = crate::calibration::calibration_macro(&d.name, c).map_err(|source| {
+            BuildError::Params {
+                file: file(),
+                source,
+            }
+        })?;
+        macros.push(text);
+    }
     if let Some(c) = &design.controller {
         let floats = d
             .controller
@@ -70,6 +83,7 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
             model: &design.model,
             design: c,
             floats,
+            calibration: calibration.as_ref(),
         };
         let emitted = match c.law {
             LawDesign::FeedbackLinearization { .. } | LawDesign::ModelSlidingMode { .. } => {
@@ -133,6 +147,7 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
             name: &d.name,
             discrete,
             floats: floats(&o.floats),
+            calibration: calibration.as_ref(),
         };
         macros.push(emit_kalman_macro(&input).map_err(|e| BuildError::Observer {
             file: file(),
@@ -173,6 +188,39 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
 }
 
 /// Whether an emitted module declares the parameters with `params!(…)`.
+/// The self-calibration the file carries: the innovations update of a
+/// design whose law the UKF drives (`designer::calibrate::choose`). A design
+/// without an observer calibrates by the replay, which `reldesign loop
+/// --runs` runs and the file does not carry (`None`).
+fn emitted_calibration(
+    design: &Design,
+) -> Result<Option<designer::calibrate::CalibrationDesign>, BuildError> {
+    let d = &design.description;
+    let Some(c) = d.controller.as_ref().filter(|c| c.self_calibration) else {
+        return Ok(None);
+    };
+    let fail = |message: String| BuildError::Calibration {
+        file: d.source.file_name.clone(),
+        message,
+    };
+    let calibration =
+        designer::calibrate::choose(design, c.sample_period).map_err(|e| fail(e.to_string()))?;
+    if calibration.method != designer::calibrate::Method::Innovations {
+        return Ok(None);
+    }
+    let ukf = d
+        .observer
+        .as_ref()
+        .is_some_and(|o| o.estimators.contains(&Estimator::Ukf));
+    if !ukf {
+        return Err(fail(
+            "the emitted update runs the unscented Kalman filter: add \"ukf\" to [observer] estimators"
+                .to_owned(),
+        ));
+    }
+    Ok(Some(calibration))
+}
+
 fn invokes_params(module: &str) -> bool {
     module
         .lines()

@@ -29,7 +29,8 @@ use designer::sym::{Graph, Id};
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
-use crate::emit::{function_tokens_as, FunctionSpec, Inline};
+use crate::calibration::{theta_args, theta_symbols};
+use crate::emit::{function_tokens_as, FunctionSpec, Inline, Theta};
 use crate::error::ControllerError;
 use crate::float::{Float, Scalar, MACRO_LITERALS};
 use crate::format::{comment_lets, format_items, macro_rules, space_items};
@@ -52,16 +53,21 @@ const GAIN_SYMBOLS: [&str; 3] = ["gain_k1", "gain_k2", "gain_k3"];
 /// them).
 pub fn emit_controller(input: &ControllerInput) -> Result<String, ControllerError> {
     let floats = checked_floats(input, GAIN_CONSTS)?;
+    let theta = match input.calibration {
+        Some(c) => theta_args(&input.model.params, c)?,
+        None => Vec::new(),
+    };
     let source = LawSource {
         model: input.model,
         linearization: &input.design.linearization,
         gains: fl_gains(input.design)?,
         guarded: true,
+        theta: &theta,
     };
     let mut out = law_macro_text(&source, floats.contains(&Float::F32))?;
     for float in floats {
         out.push('\n');
-        out.push_str(&float_module(input, float)?);
+        out.push_str(&float_module(input, float, theta.len())?);
     }
     Ok(out)
 }
@@ -74,6 +80,9 @@ pub struct LawSource<'a> {
     pub linearization: &'a Linearization,
     pub gains: [f64; 3],
     pub guarded: bool,
+    /// θ of a self-calibrating design (`calibration.rs`): the law reads
+    /// them from its `theta` argument; empty otherwise.
+    pub theta: &'a Theta,
 }
 
 /// The `law!` macro of `source`, its literals typed for `f32` too if asked.
@@ -206,7 +215,11 @@ fn law_terms(
     scalar: Scalar,
 ) -> Result<(TokenStream, Comments), ControllerError> {
     let model = source.model;
-    let mut params: Vec<Param> = model.params.iter().map(Param::from).collect();
+    let adapted = theta_symbols(source.theta);
+    let mut params: Vec<Param> = (model.params.iter())
+        .filter(|p| !adapted.contains(&p.1))
+        .map(Param::from)
+        .collect();
     params.extend_from_slice(physical);
     for ((&id, name), &k) in law.gains.iter().zip(GAIN_SYMBOLS).zip(&source.gains) {
         params.push(Param::from((name, id, k)));
@@ -260,7 +273,7 @@ fn law_terms(
         // written in `scalar` (function_tokens_as)
         float: Float::F64,
     };
-    let tokens = function_tokens_as(graph, &spec, &params, Inline::Always, scalar)?;
+    let tokens = function_tokens_as(graph, &spec, &params, Inline::Always, scalar, source.theta)?;
     Ok((tokens, comments))
 }
 
@@ -313,11 +326,23 @@ fn law_macro(
         .into_iter()
         .map(|(name, _)| format_ident!("{name}"))
         .collect();
-    let law_args = quote!(#(#state: #ty,)* zr: #ty, vr: #ty, ar: #ty, jr: #ty);
-    let call = quote!(#(#state,)* zr, vr, ar, jr);
-    // with H_c (a Jiles–Atherton core) `law` and `guarded_law` take 8
+    let p = source.theta.len();
+    let (theta_arg, theta_call, design) = if p > 0 {
+        let p = proc_macro2::Literal::usize_unsuffixed(p);
+        (
+            quote!(, theta: &[#ty; #p]),
+            quote!(, theta),
+            quote!(Design { theta: *theta }),
+        )
+    } else {
+        (quote!(), quote!(), quote!(Design))
+    };
+    let law_args = quote!(#(#state: #ty,)* zr: #ty, vr: #ty, ar: #ty, jr: #ty #theta_arg);
+    let call = quote!(#(#state,)* zr, vr, ar, jr #theta_call);
+    // with H_c (a Jiles–Atherton core) or θ, `law` and `guarded_law` take 8
     // arguments: clippy's limit is 7 (as `law_terms`, emit.rs)
-    let allow = (state.len() + 4 > 7).then(|| quote!(#[allow(clippy::too_many_arguments)]));
+    let arity = state.len() + 4 + usize::from(p > 0);
+    let allow = (arity > 7).then(|| quote!(#[allow(clippy::too_many_arguments)]));
     // the runtime's state [z, v, φ, H_c]: H_c = 0 where the core has none
     let runtime_state = if state.len() == 4 {
         quote!([#(#state),*])
@@ -334,7 +359,7 @@ fn law_macro(
             #[must_use]
             #allow
             pub fn guarded_law(#law_args) -> #ty {
-                control::guarded_law(&Design, #runtime_state, [zr, vr, ar, jr])
+                control::guarded_law(&#design, #runtime_state, [zr, vr, ar, jr])
             }
         }
     });
@@ -397,7 +422,11 @@ pub fn compensation_doc(model: &Model, limits: &str) -> String {
 }
 
 /// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.
-fn float_module(input: &ControllerInput, float: Float) -> Result<String, ControllerError> {
+fn float_module(
+    input: &ControllerInput,
+    float: Float,
+    adapted: usize,
+) -> Result<String, ControllerError> {
     let ty = float.ty();
     let module = format_ident!("{}", float.name());
     let design = input.design;
@@ -421,13 +450,20 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
         design,
         float,
         "This module's design (limits, timing, guards, tables; the law [PT 50] of\n`law!`) as the runtime's soft-landing logic reads it.",
+        adapted,
     )?;
+    let (calibration, theta) = if adapted > 0 {
+        (quote!(calibration!(#ty);), quote!(, &self.theta))
+    } else {
+        (quote!(), quote!())
+    };
     let tokens = quote! {
         #[doc = " The controller in this float type."]
         pub mod #module {
             use reldesign_runtime::control;
 
             params!(#ty);
+            #calibration
             law!(#ty);
 
             #gains
@@ -437,7 +473,7 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
             impl control::Law<#ty> for Design {
                 #[inline(always)]
                 fn law(&self, #pattern: [#ty; 4], [zr, vr, ar, jr]: [#ty; 4]) -> #ty {
-                    law_terms(#args, zr, vr, ar, jr).u
+                    law_terms(#args, zr, vr, ar, jr #theta).u
                 }
             }
 

@@ -180,8 +180,22 @@ pub fn function_tokens(
     spec: &FunctionSpec,
     params: &[Param],
 ) -> Result<TokenStream, EmitError> {
-    function_tokens_as(graph, spec, params, Inline::Hint, Scalar::One(spec.float))
+    function_tokens_as(
+        graph,
+        spec,
+        params,
+        Inline::Hint,
+        Scalar::One(spec.float),
+        &[],
+    )
 }
+
+/// The adapted parameters θ of a self-calibrating design as a function
+/// reads them: one `theta: &[f; P]` argument, destructured into locals
+/// (`let [r, k_e, …] = *theta;`, `_` where unused), one (local name,
+/// symbol) each in θ's order. Their symbols are not among the function's
+/// `params`: nothing is folded from them.
+pub(crate) type Theta = [(String, Id)];
 
 /// How an emitted function is offered to the inliner.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -206,6 +220,7 @@ pub(crate) fn function_tokens_as(
     params: &[Param],
     inline: Inline,
     scalar: Scalar,
+    theta: &Theta,
 ) -> Result<TokenStream, EmitError> {
     crate::names::check_local(spec.name)?;
     let roots: Vec<Id> = spec
@@ -228,7 +243,7 @@ pub(crate) fn function_tokens_as(
         None => (graph, roots),
     };
     let const_by_id = const_names(graph, &all_params)?;
-    let request = Request::new(spec, &roots, &const_by_id);
+    let request = Request::new(spec, &roots, &const_by_id, theta);
     let plan = plan(graph, &request.plan(), &mut request.namer()?)?;
 
     let param_ids: HashSet<Id> = const_by_id.keys().copied().collect();
@@ -247,7 +262,7 @@ pub(crate) fn function_tokens_as(
             .collect(),
         named: Vec::new(),
     };
-    let mut lets = TokenStream::new();
+    let mut lets = theta_prologue(spec.inputs.len(), theta, &plan.input_used);
     for b in &plan.lets {
         let name = ident(&b.name);
         let rhs = lower.definition(b.id)?;
@@ -287,6 +302,24 @@ pub(crate) fn function_tokens_as(
     Ok(assemble(spec, &request, &plan.input_used, body, attrs))
 }
 
+/// `let [r, _, k_s] = *theta;`: the adapted parameters the function reads
+/// (`input_used` past the `plain` inputs), nothing where it reads none.
+fn theta_prologue(plain: usize, theta: &Theta, input_used: &[bool]) -> TokenStream {
+    let used = input_used.iter().skip(plain);
+    if !used.clone().any(|&u| u) {
+        return TokenStream::new();
+    }
+    let names = theta.iter().zip(used).map(|((n, _), &u)| {
+        if u {
+            let n = ident(n);
+            quote!(#n)
+        } else {
+            quote!(_)
+        }
+    });
+    quote!(let [#(#names),*] = *theta;)
+}
+
 /// The names of one function's plan: inputs, outputs (as mapped by the
 /// rewrites), caller-named subexpressions and output symbols.
 struct Request<'a> {
@@ -300,12 +333,18 @@ struct Request<'a> {
 
 impl<'a> Request<'a> {
     /// `roots`: the images of the outputs, then of the named subexpressions.
-    fn new(spec: &'a FunctionSpec, roots: &[Id], const_by_id: &'a HashMap<Id, String>) -> Self {
+    fn new(
+        spec: &'a FunctionSpec,
+        roots: &[Id],
+        const_by_id: &'a HashMap<Id, String>,
+        theta: &Theta,
+    ) -> Self {
         let (output_roots, named_roots) = roots.split_at(spec.outputs.len());
+        let theta = theta.iter().map(|(n, id)| (n.as_str(), *id));
         Request {
             spec,
             const_by_id,
-            inputs: owned(spec.inputs.iter().copied()),
+            inputs: owned(spec.inputs.iter().copied().chain(theta)),
             outputs: owned(
                 spec.outputs
                     .iter()
@@ -330,7 +369,7 @@ impl<'a> Request<'a> {
     /// A namer with every caller-given name reserved.
     fn namer(&self) -> Result<Namer, EmitError> {
         let mut namer = Namer::default();
-        let given = (self.spec.inputs.iter().map(|i| i.0))
+        let given = (self.inputs.iter().map(|i| i.0.as_str()))
             .chain(self.spec.outputs.iter().map(|o| o.0))
             .chain(self.spec.named.iter().map(|n| n.0));
         for name in given {
@@ -364,10 +403,12 @@ fn assemble(
     let ty = attrs.scalar.ty();
     let out_ty = ident(&format!("{}Output", camel(spec.name)));
     let fn_name = ident(spec.name);
-    let args = request
+    let plain = spec.inputs.len();
+    let mut args: Vec<TokenStream> = request
         .inputs
         .iter()
         .zip(input_used)
+        .take(plain)
         .map(|((n, _), &used)| {
             let n = if used {
                 ident(n)
@@ -375,7 +416,15 @@ fn assemble(
                 ident(&format!("_{n}"))
             };
             quote!(#n: #ty)
-        });
+        })
+        .collect();
+    let adapted = request.inputs.len() - plain;
+    if adapted > 0 {
+        let used = input_used.iter().skip(plain).any(|&u| u);
+        let name = ident(if used { "theta" } else { "_theta" });
+        let p = proc_macro2::Literal::usize_unsuffixed(adapted);
+        args.push(quote!(#name: &[#ty; #p]));
+    }
     let fields = spec.outputs.iter().map(|&(n, _, doc)| {
         let n = ident(n);
         let docs = doc_attrs(doc);
@@ -384,7 +433,7 @@ fn assemble(
     let field_names = request.outputs.iter().map(|(n, _)| ident(n));
     let fn_doc = doc_attrs(spec.doc);
     let struct_doc = format!(" Outputs of [`{}`].", spec.name);
-    let mut allow = if request.inputs.len() > 7 {
+    let mut allow = if args.len() > 7 {
         quote!(#[allow(clippy::too_many_arguments)])
     } else {
         quote!()

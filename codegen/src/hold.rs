@@ -54,6 +54,7 @@ pub fn emit_hold(input: &HoldInput) -> Result<String, ControllerError> {
         linearization: &input.design.linearization,
         gains: input.design.gains(),
         guarded: false,
+        theta: &[],
     };
     let mut out = law_macro_text(&source, floats.contains(&Float::F32))?;
     for float in floats {

@@ -33,9 +33,11 @@
 //! | `sliding.rs` | the model-free sliding-mode controller: λ₁, λ₂ and the float modules (over `reldesign_runtime::sliding`) |
 //! | `semera.rs` | the SEMERA and integral estimator modules |
 //! | `observer/` | the EKF and UKF: `model!` macros and float modules |
+//! | `calibration.rs` | the self-calibration: the `calibration!` macro and θ as the law's and the filter model's argument |
 
 mod backstepping;
 mod build;
+mod calibration;
 mod controller;
 mod emit;
 mod error;

@@ -28,6 +28,9 @@ pub struct ControllerInput<'a> {
     pub design: &'a ControllerDesign,
     /// Emitted float types, in this order (duplicates ignored).
     pub floats: Vec<Float>,
+    /// The self-calibration (`[controller] self_calibration`): the law reads
+    /// the adapted parameters at run time.
+    pub calibration: Option<&'a designer::calibrate::CalibrationDesign>,
 }
 
 /// Names of the plan's constants (checked against the parameters' const names).
@@ -127,9 +130,11 @@ pub fn plan_items(
     design: &ControllerDesign,
     float: Float,
     design_doc: &str,
+    adapted: usize,
 ) -> Result<TokenStream, ControllerError> {
     let ty = float.ty();
     let consts = plan_consts(design, float)?;
+    let design_type = design_type(adapted, &ty);
     let Operations {
         tables,
         variants,
@@ -148,12 +153,7 @@ pub fn plan_items(
         }
 
         #design_doc
-        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-        pub struct Design;
-
-        impl control::ConstPlan for Design {
-            const PLAN: Self = Design;
-        }
+        #design_type
 
         impl control::Plan<#ty> for Design {
             type Operation = Operation;
@@ -181,6 +181,40 @@ pub fn plan_items(
             }
         }
     })
+}
+
+/// `Design` and its `control::ConstPlan`: zero-sized, or (a self-calibrating
+/// design) carrying θ, the adapted parameters the law reads, θ_d its default.
+fn design_type(adapted: usize, ty: &proc_macro2::Ident) -> TokenStream {
+    if adapted == 0 {
+        return quote! {
+            #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+            pub struct Design;
+
+            impl control::ConstPlan for Design {
+                const PLAN: Self = Design;
+            }
+        };
+    }
+    let p = proc_macro2::Literal::usize_unsuffixed(adapted);
+    quote! {
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Design {
+            /// θ: the adapted parameters, in the order of `ADAPTED` (set from
+            /// `ukf::…::Calibration::theta` after an update).
+            pub theta: [#ty; #p],
+        }
+
+        impl control::ConstPlan for Design {
+            const PLAN: Self = Design { theta: THETA_DESIGN };
+        }
+
+        impl Default for Design {
+            fn default() -> Self {
+                <Self as control::ConstPlan>::PLAN
+            }
+        }
+    }
 }
 
 /// Every table of `design` spliced into the formatted module `text`.

@@ -70,6 +70,7 @@ fn float_module(input: &ControllerInput, float: Float) -> Result<String, Control
         input.design,
         float,
         "This module's design (limits, timing, tables, the surface's λ₁, λ₂) as the\nruntime's sliding-mode law reads it.",
+        0,
     )?;
     let current_doc = if nonnegative_current {
         " The step reads the coil current, takes sgn φ = +1 and never drives the current\n below 0 ([SM §5])."

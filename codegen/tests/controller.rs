@@ -130,6 +130,7 @@ fn emit_ops(v: &Valve, floats: &[Float], both: bool) -> String {
         model: &v.model,
         design: &design,
         floats: floats.to_vec(),
+        calibration: None,
     };
     let header = Header {
         what: "controller",

@@ -87,6 +87,7 @@ fn emit(d: &Description, resistance: bool, flux_step: FluxStep, floats: &[Float]
         name: &d.name,
         discrete: &dm,
         floats: floats.to_vec(),
+        calibration: None,
     };
     let ok =
         |r: Result<String, reldesign_build::ObserverError>| r.unwrap_or_else(|e| panic!("{e}"));

@@ -77,6 +77,7 @@ fn settings<const P: usize>(nominal: [f64; P], ts: f64) -> Settings<f64, P> {
         dip_tolerance: 2.4,
         dip_share: 0.05,
         motion_evidence: 1.0,
+        difference_step: 1e-4,
     }
 }
 
@@ -320,12 +321,13 @@ fn every_operation_reaches_its_stop_on_a_plant_the_design_cannot_follow() {
 /// The prediction-error update (`calibrate::innovations`) on one noise-free
 /// run of the design on a plant 10 % more resistive with a 5 % smaller gap
 /// and a 10 % weaker preload: four updates over the same run lower the
-/// innovations every time, bring R and the gap to the plant's within 3 % and
+/// innovations every time until no step lowers them, bring R and the gap to the plant's within 3 % and
 /// the preload closer to it (its part of the current is small beside the
 /// bounces the filter does not model).
 #[test]
 fn the_innovations_update_moves_towards_the_plant() {
-    use designer::calibrate::{candidates, innovations, Adapted};
+    use designer::calibrate::{candidates, choose, innovations, Adapted, Outcome};
+    use reldesign_runtime::calibrate::Calibration;
     let design = design();
     let plant = plant(&[
         ("resistance = 75.0", "resistance = 82.5"),
@@ -346,14 +348,22 @@ fn the_innovations_update_moves_towards_the_plant() {
             new_information: 1.0,
         })
         .collect();
-    let mut theta: Vec<f64> = adapted.iter().map(|a| a.nominal).collect();
-    for _ in 0..4 {
-        let u = innovations::update(&design, &adapted, &mut theta, &run.measured, 0.2, 4)
+    let mut c = choose(&design, 5e-5).unwrap_or_else(|e| panic!("{e}"));
+    c.parameters = adapted;
+    c.iterations = 4;
+    let mut calibration = Calibration::<f64, 3>::new(&c.settings());
+    for k in 0..4 {
+        let u = innovations::update(&design, &c, &mut calibration, &run.measured)
             .unwrap_or_else(|e| panic!("{e}"));
-        assert!(u.after <= u.before, "{u:?}");
+        match u {
+            Outcome::Updated { before, after } => assert!(after < before, "{u:?}"),
+            // converged: no step lowers the error any more
+            Outcome::Refused(Refusal::NoProgress) if k > 0 => {}
+            _ => panic!("update {k}: {u:?}"),
+        }
     }
     let truth = [82.5, 19e-6, -0.675];
-    for ((a, fitted), truth) in adapted.iter().zip(&theta).zip(truth) {
+    for ((a, fitted), truth) in c.parameters.iter().zip(&calibration.theta).zip(truth) {
         let closer = (fitted - truth).abs() < (a.nominal - truth).abs();
         let near = (fitted / truth - 1.0).abs() < 0.03 || a.key == "mechanics.preload";
         assert!(

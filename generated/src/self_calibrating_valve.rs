@@ -40,6 +40,108 @@ macro_rules! params {
     };
 }
 
+/// The run-to-run self-calibration of `self_calibrating_valve` (`[controller] self_calibration`,
+/// the innovations update: θ chosen so that the filter's one-step current
+/// predictions over a run are right), declared in each float module as
+/// `calibration!(f64)` / `calibration!(f32)` after `params!`.
+macro_rules! calibration {
+    ($f:ident) => {
+        /// The parameters θ the self-calibration adapts, in θ's order (their
+        /// description keys): every physics parameter the filter's model reads, each
+        /// from the design's value within its physical domain:
+        /// - `coil.resistance` (`R`): 75.0 within [52.5, 97.5]
+        /// - `coil.eddy` (`k_e`): 1500.0 within [1050.0, 1950.0]
+        /// - `gap.area` (`A_gap`): 2e-5 within [1.4e-5, 2.6e-5]
+        /// - `gap.winding_length` (`l_w`): 0.015 within [0.0105, 0.0195]
+        /// - `core.r0` (`R_core0`): 3000000.0 within [2100000.0, 3900000.0]
+        /// - `core.phi_sat` (`phi_sat`): 2.5e-5 within [1.75e-5, 3.25e-5]
+        /// - `mechanics.mass` (`m`): 0.002 within [0.0014, 0.0026]
+        /// - `mechanics.stiffness` (`k_s`): 50.0 within [35.0, 65.0]
+        /// - `mechanics.damping` (`c`): 0.1 within [0.07, 0.13]
+        /// - `mechanics.preload` (`F0`): -0.75 within [-0.975, -0.525]
+        pub const ADAPTED: [&str; 10] = [
+            "coil.resistance",
+            "coil.eddy",
+            "gap.area",
+            "gap.winding_length",
+            "core.r0",
+            "core.phi_sat",
+            "mechanics.mass",
+            "mechanics.stiffness",
+            "mechanics.damping",
+            "mechanics.preload",
+        ];
+        /// θ_d: the design's values (the `params!` consts); `Design` and `Model` start there.
+        pub const THETA_DESIGN: [$f; 10] = [
+            R,
+            K_E,
+            A_GAP,
+            L_W,
+            R_CORE0,
+            PHI_SAT,
+            M,
+            K_S,
+            C,
+            F0,
+        ];
+        /// The lower end of θ's domain: the update never leaves [THETA_LOWER, THETA_UPPER].
+        #[allow(clippy::excessive_precision)]
+        pub const THETA_LOWER: [$f; 10] = [
+            52.5,
+            1050.0,
+            1.4e-5,
+            0.0105,
+            2100000.0,
+            1.75e-5,
+            0.0014,
+            35.0,
+            0.07,
+            -0.975,
+        ];
+        /// The upper end of θ's domain.
+        #[allow(clippy::excessive_precision)]
+        pub const THETA_UPPER: [$f; 10] = [
+            97.5,
+            1950.0,
+            2.6e-5,
+            0.0195,
+            3900000.0,
+            3.25e-5,
+            0.0026,
+            65.0,
+            0.13,
+            -0.525,
+        ];
+        /// Samples a run's `Record` holds: every sample of every operation's window.
+        /// RAM: 2·RECORD_CAPACITY floats.
+        pub const RECORD_CAPACITY: usize = 1001;
+        /// The update's settings (`reldesign_runtime::calibrate::innovations`): steps of at
+        /// most `max_step`·θ_d, `iterations` Levenberg–Marquardt steps, forward differences
+        /// of `difference_step`·θ_d; a record shorter than `min_samples`, with a current
+        /// at `current_limit` [A] (a saturated ADC) or more than `dip_share` of its samples
+        /// `dip_tolerance` [V] below the command (a supply dip) is refused.
+        #[allow(clippy::excessive_precision)]
+        pub const CALIBRATION: reldesign_runtime::calibrate::Settings<$f, 10> =
+            reldesign_runtime::calibrate::Settings {
+                nominal: THETA_DESIGN,
+                lower: THETA_LOWER,
+                upper: THETA_UPPER,
+                max_step: 0.2,
+                sample_period: 5e-5,
+                decimation: 1,
+                z_min: Z_MIN,
+                z_max: Z_MAX,
+                iterations: 8,
+                min_samples: 500,
+                current_limit: 0.64,
+                dip_tolerance: 2.4000000000000004,
+                dip_share: 0.05,
+                motion_evidence: 1.0,
+                difference_step: 0.001,
+            };
+    };
+}
+
 /// The Kalman filters' settings of `self_calibrating_valve` (`[observer]`, `[observer.kalman]`), one per
 /// line, and the filters' `Settings` derived from them; declared in each filter module
 /// as `kalman!(f64)` / `kalman!(f32)`.
@@ -146,7 +248,7 @@ macro_rules! law {
         /// φ = 0 makes β infinite, see [`guarded_law`]).
         #[inline(always)]
         #[must_use]
-        #[allow(clippy::excessive_precision)]
+        #[allow(clippy::too_many_arguments)]
         pub fn law_terms(
             z: $f,
             v: $f,
@@ -155,41 +257,41 @@ macro_rules! law {
             vr: $f,
             ar: $f,
             jr: $f,
+            theta: &[$f; 10],
         ) -> LawTermsOutput {
             use reldesign_runtime::math::Real;
-
-            /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-            const INV_SQRT_A_GAP: $f = 223.60679774997894;
-            let inv_m = 1.0 / M;
-            let f_passive = F0 + K_S * z + C * v;
-            let inv_a_gap = 1.0 / A_GAP;
-            let phi_sq = phi * phi;
+            let [r, k_e, a_gap, l_w, r_core0, phi_sat, m, k_s, c, f0] = *theta;
+            let inv_m = 1.0 / m;
+            let f_passive = f0 + z * k_s + v * c;
+            let inv_a_gap = 1.0 / a_gap;
             let z_reg = z + Z_EPS;
             let inv_z_reg = 1.0 / z_reg;
-            let fringe_log = Real::ln(2.0 * L_W * inv_z_reg);
-            let fringe_den = INV_SQRT_A_GAP * z * fringe_log + 1.0;
+            let fringe_log = Real::ln(2.0 * l_w * inv_z_reg);
+            let inv_sqrt_a_gap = 1.0 / Real::sqrt(a_gap);
+            let fringe_den = z * fringe_log * inv_sqrt_a_gap + 1.0;
             let inv_fringe_den = 1.0 / fringe_den;
+            let phi_sq = phi * phi;
             let t0 = fringe_log - z * inv_z_reg;
-            let t1 = 1.0 - INV_SQRT_A_GAP * z * t0 * inv_fringe_den;
-            let f_mag = -0.5 / MU0 * inv_a_gap * phi_sq * inv_fringe_den * t1;
+            let t1 = 1.0 - z * inv_sqrt_a_gap * inv_fringe_den * t0;
+            let f_mag = -0.5 / MU0 * inv_a_gap * inv_fringe_den * phi_sq * t1;
             let f_net = f_mag - f_passive;
             // [PT 41] ξ₃ = a(x) = L_f²h
             let xi3 = inv_m * f_net;
-            let flux_den = N * N + R * K_E;
-            let r_gap = 1.0 / MU0 * inv_a_gap * z * inv_fringe_den;
+            let flux_den = N * N + r * k_e;
+            let r_gap = 1.0 / MU0 * z * inv_a_gap * inv_fringe_den;
             // [PT 31] L_f³h
             let lf3h = inv_m
                 * (v
-                    * (-K_S
-                        - 0.5 / MU0 * INV_SQRT_A_GAP * inv_a_gap * phi_sq
-                            * (inv_fringe_den * inv_fringe_den)
-                            * (2.0 * INV_SQRT_A_GAP * z * (t0 * t0) * inv_fringe_den
+                    * (-k_s
+                        - 0.5 / MU0 * inv_sqrt_a_gap * inv_a_gap
+                            * (inv_fringe_den * inv_fringe_den) * phi_sq
+                            * (2.0 * z * inv_sqrt_a_gap * inv_fringe_den * (t0 * t0)
                                 - z * inv_z_reg * (z * inv_z_reg - 2.0) - 2.0 * t0))
-                    - C * inv_m * f_net
-                    + 1.0 / MU0 * R * inv_a_gap / flux_den * phi_sq * inv_fringe_den * t1
-                        * (R_CORE0 / (1.0 - 1.0 / PHI_SAT * Real::abs(phi)) + r_gap));
+                    - c * inv_m * f_net
+                    + 1.0 / MU0 * r * inv_a_gap * inv_fringe_den * phi_sq * t1
+                        * (r_gap + r_core0 / (1.0 - Real::abs(phi) / phi_sat)) / flux_den);
             // [PT 32] β(x) = 1 / L_g L_f²h
-            let beta = -MU0 * A_GAP * M * flux_den / N * fringe_den / (phi * t1);
+            let beta = -MU0 / N * a_gap * m * fringe_den * flux_den / (phi * t1);
             // [PT 48] w = K·(ξ_r − T(x)) + z_r⁽³⁾, T(x) = [z, v, ξ₃] [PT 41]
             let w = jr + GAIN_K1 * (zr - z) + GAIN_K2 * (vr - v) + GAIN_K3 * (ar - xi3);
             // [PT 32] α(x) = −L_f³h / L_g L_f²h = −L_f³h·β
@@ -208,8 +310,18 @@ macro_rules! law {
 
         /// u of the tracking law [PT 50], not saturated and not guarded.
         #[must_use]
-        pub fn law(z: $f, v: $f, phi: $f, zr: $f, vr: $f, ar: $f, jr: $f) -> $f {
-            law_terms(z, v, phi, zr, vr, ar, jr).u
+        #[allow(clippy::too_many_arguments)]
+        pub fn law(
+            z: $f,
+            v: $f,
+            phi: $f,
+            zr: $f,
+            vr: $f,
+            ar: $f,
+            jr: $f,
+            theta: &[$f; 10],
+        ) -> $f {
+            law_terms(z, v, phi, zr, vr, ar, jr, theta).u
         }
 
         /// The law [PT 50] as applied (`reldesign_runtime::control::guarded_law`): if
@@ -218,8 +330,18 @@ macro_rules! law {
         /// of [PT 50]. Saturated to [u_min, u_max] (a NaN maps to the bound nearest 0,
         /// ±∞ to the bounds).
         #[must_use]
-        pub fn guarded_law(z: $f, v: $f, phi: $f, zr: $f, vr: $f, ar: $f, jr: $f) -> $f {
-            control::guarded_law(&Design, [z, v, phi, 0.0], [zr, vr, ar, jr])
+        #[allow(clippy::too_many_arguments)]
+        pub fn guarded_law(
+            z: $f,
+            v: $f,
+            phi: $f,
+            zr: $f,
+            vr: $f,
+            ar: $f,
+            jr: $f,
+            theta: &[$f; 10],
+        ) -> $f {
+            control::guarded_law(&Design { theta: *theta }, [z, v, phi, 0.0], [zr, vr, ar, jr])
         }
     };
 }
@@ -228,6 +350,7 @@ macro_rules! law {
 pub mod f32 {
     use reldesign_runtime::control;
     params!(f32);
+    calibration!(f32);
     law!(f32);
 
     /// k1 of K = [k1, k2, k3] [PT 48]: s³ + k3·s² + k2·s + k1 is the characteristic polynomial of [PT 49].
@@ -384,11 +507,21 @@ pub mod f32 {
 
     /// This module's design (limits, timing, guards, tables; the law [PT 50] of
     /// `law!`) as the runtime's soft-landing logic reads it.
-    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-    pub struct Design;
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Design {
+        /// θ: the adapted parameters, in the order of `ADAPTED` (set from
+        /// `ukf::…::Calibration::theta` after an update).
+        pub theta: [f32; 10],
+    }
 
     impl control::ConstPlan for Design {
-        const PLAN: Self = Design;
+        const PLAN: Self = Design { theta: THETA_DESIGN };
+    }
+
+    impl Default for Design {
+        fn default() -> Self {
+            <Self as control::ConstPlan>::PLAN
+        }
     }
 
     impl control::Plan<f32> for Design {
@@ -435,7 +568,7 @@ pub mod f32 {
     impl control::Law<f32> for Design {
         #[inline(always)]
         fn law(&self, [z, v, phi, _]: [f32; 4], [zr, vr, ar, jr]: [f32; 4]) -> f32 {
-            law_terms(z, v, phi, zr, vr, ar, jr).u
+            law_terms(z, v, phi, zr, vr, ar, jr, &self.theta).u
         }
     }
 
@@ -451,6 +584,7 @@ pub mod f32 {
 pub mod f64 {
     use reldesign_runtime::control;
     params!(f64);
+    calibration!(f64);
     law!(f64);
 
     /// k1 of K = [k1, k2, k3] [PT 48]: s³ + k3·s² + k2·s + k1 is the characteristic polynomial of [PT 49].
@@ -607,11 +741,21 @@ pub mod f64 {
 
     /// This module's design (limits, timing, guards, tables; the law [PT 50] of
     /// `law!`) as the runtime's soft-landing logic reads it.
-    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-    pub struct Design;
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Design {
+        /// θ: the adapted parameters, in the order of `ADAPTED` (set from
+        /// `ukf::…::Calibration::theta` after an update).
+        pub theta: [f64; 10],
+    }
 
     impl control::ConstPlan for Design {
-        const PLAN: Self = Design;
+        const PLAN: Self = Design { theta: THETA_DESIGN };
+    }
+
+    impl Default for Design {
+        fn default() -> Self {
+            <Self as control::ConstPlan>::PLAN
+        }
     }
 
     impl control::Plan<f64> for Design {
@@ -658,7 +802,7 @@ pub mod f64 {
     impl control::Law<f64> for Design {
         #[inline(always)]
         fn law(&self, [z, v, phi, _]: [f64; 4], [zr, vr, ar, jr]: [f64; 4]) -> f64 {
-            law_terms(z, v, phi, zr, vr, ar, jr).u
+            law_terms(z, v, phi, zr, vr, ar, jr, &self.theta).u
         }
     }
 
@@ -696,7 +840,13 @@ pub mod ukf {
             #[inline]
             #[must_use]
             #[allow(clippy::excessive_precision)]
-            pub fn transition(z: $f, z_prev: $f, phi: $f, u: $f) -> TransitionOutput {
+            pub fn transition(
+                z: $f,
+                z_prev: $f,
+                phi: $f,
+                u: $f,
+                theta: &[$f; 10],
+            ) -> TransitionOutput {
                 use reldesign_runtime::math::Real;
 
                 /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -704,41 +854,40 @@ pub mod ukf {
 
                 /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
                 const MU0: $f = 1.2566370614359173e-6;
-
-                /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-                const INV_SQRT_A_GAP: $f = 223.60679774997894;
-                let inv_m = 1.0 / M;
+                let [r, k_e, a_gap, l_w, r_core0, phi_sat, m, k_s, c, f0] = *theta;
+                let inv_m = 1.0 / m;
                 // [JA 84b] z_prev,{k+1} = sat_{z_min}^{z_max}(z)
                 let zp_next = Real::min(Real::max(z, Z_MIN), Z_MAX);
                 let inv_t_s = 1.0 / T_S;
-                let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-                let inv_a_gap = 1.0 / A_GAP;
+                let inv_a_gap = 1.0 / a_gap;
+                let inv_sqrt_a_gap = 1.0 / Real::sqrt(a_gap);
                 let t0 = 1.0 / (zp_next + Z_EPS);
-                let ln = Real::ln(2.0 * L_W * t0);
-                let t1 = INV_SQRT_A_GAP * zp_next * ln + 1.0;
-                let t2 = -(F0 + K_S * zp_next + C * inv_t_s * (z - z_prev))
-                    - 0.5 * (min * min)
+                let ln = Real::ln(2.0 * l_w * t0);
+                let t1 = inv_sqrt_a_gap * zp_next * ln + 1.0;
+                let min = Real::min(Real::max(phi, -0.999 * phi_sat), 0.999 * phi_sat);
+                let t2 = -(f0 + k_s * zp_next + inv_t_s * c * (z - z_prev))
+                    - 0.5
                         * (1.0 / MU0 * inv_a_gap / t1
                             - 1.0 / MU0 * inv_a_gap * zp_next
-                                * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * zp_next * t0) / (t1 * t1));
+                                * (inv_sqrt_a_gap * ln - inv_sqrt_a_gap * zp_next * t0) / (t1 * t1))
+                        * (min * min);
                 // [JA 84a] z_{k+1} = sat_{z_min}^{z_max}(2·z − z_prev + T_s²·f_v(z, v, φ)), v = (z − z_prev)/T_s [JA 85]
                 let z_next = Real::min(
-                    Real::max(2.0 * z - z_prev + inv_m * (T_S * T_S) * t2, Z_MIN),
+                    Real::max(2.0 * z - z_prev + T_S * T_S * inv_m * t2, Z_MIN),
                     Z_MAX,
                 );
-                let t3 = 1.0 / (N * N + R * K_E);
-                let inv_phi_sat = 1.0 / PHI_SAT;
+                let t3 = 1.0 / (N * N + r * k_e);
+                let inv_phi_sat = 1.0 / phi_sat;
                 let t4 = 1.0 - inv_phi_sat * Real::abs(min);
                 let inv_t4 = 1.0 / t4;
                 let t5 = 0.5 * (z_next - zp_next);
                 let t6 = zp_next + t5;
                 let t7 = 1.0
-                    / (INV_SQRT_A_GAP * t6 * Real::ln(2.0 * L_W / (zp_next + t5 + Z_EPS)) + 1.0);
+                    / (inv_sqrt_a_gap * t6 * Real::ln(2.0 * l_w / (zp_next + t5 + Z_EPS)) + 1.0);
                 let min_2 = Real::min(
-                    -R * t3
-                        * (R_CORE0 * inv_t4
-                            + R_CORE0 * inv_phi_sat * min * Real::signum0(min) * (inv_t4 * inv_t4)
-                            + 1.0 / MU0 * inv_a_gap * t6 * t7),
+                    -r * t3
+                        * (1.0 / MU0 * inv_a_gap * t6 * t7 + r_core0 * inv_t4
+                            + r_core0 * inv_phi_sat * min * Real::signum0(min) * (inv_t4 * inv_t4)),
                     0.0,
                 );
                 let sel = if -T_S * min_2 - 0.05 >= 0.0 {
@@ -755,7 +904,7 @@ pub mod ukf {
                 let phi_next = phi
                     + T_S * t3
                         * (N * u
-                            - R * (R_CORE0 * min * inv_t4 + 1.0 / MU0 * inv_a_gap * min * t6 * t7))
+                            - r * (r_core0 * min * inv_t4 + 1.0 / MU0 * inv_a_gap * min * t6 * t7))
                         * sel;
                 // [JA 87] a = f_v(z, v, φ), the free-motion acceleration at v of [JA 85]
                 let accel = inv_m * t2;
@@ -780,7 +929,13 @@ pub mod ukf {
             #[inline]
             #[must_use]
             #[allow(clippy::excessive_precision)]
-            pub fn measurement(z: $f, _z_prev: $f, phi: $f, u: $f) -> MeasurementOutput {
+            pub fn measurement(
+                z: $f,
+                _z_prev: $f,
+                phi: $f,
+                u: $f,
+                theta: &[$f; 10],
+            ) -> MeasurementOutput {
                 use reldesign_runtime::math::Real;
 
                 /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -788,22 +943,21 @@ pub mod ukf {
 
                 /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
                 const MU0: $f = 1.2566370614359173e-6;
-
-                /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-                const INV_SQRT_A_GAP: $f = 223.60679774997894;
-                let t0 = 1.0 / (N * N + R * K_E);
-                let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
+                let [r, k_e, a_gap, l_w, r_core0, phi_sat, _, _, _, _] = *theta;
+                let t0 = 1.0 / (N * N + r * k_e);
+                let min = Real::min(Real::max(phi, -0.999 * phi_sat), 0.999 * phi_sat);
                 let min_2 = Real::min(Real::max(z, Z_MIN), Z_MAX);
                 // i = (N·(R_gap(z)·φ + MMF_core) + k_e·u)/(N² + R·k_e), the coil current [JA 41]
                 let i = t0
-                    * (K_E * u
+                    * (u * k_e
                         + N
-                            * (R_CORE0 * min / (1.0 - 1.0 / PHI_SAT * Real::abs(min))
-                                + 1.0 / MU0 / A_GAP * min_2 * min
-                                    / (INV_SQRT_A_GAP * min_2 * Real::ln(2.0 * L_W / (min_2 + Z_EPS))
-                                        + 1.0)));
+                            * (r_core0 * min / (1.0 - Real::abs(min) / phi_sat)
+                                + 1.0 / MU0 * min_2 * min
+                                    / (a_gap
+                                        * (min_2 * Real::ln(2.0 * l_w / (min_2 + Z_EPS))
+                                            / Real::sqrt(a_gap) + 1.0))));
                 // ∂i/∂u (the input's noise in the measurement variance)
-                let di_du = K_E * t0;
+                let di_du = k_e * t0;
                 MeasurementOutput { i, di_du }
             }
 
@@ -819,7 +973,13 @@ pub mod ukf {
             #[inline]
             #[must_use]
             #[allow(clippy::excessive_precision)]
-            pub fn acceleration(z: $f, z_prev: $f, phi: $f, _u: $f) -> AccelerationOutput {
+            pub fn acceleration(
+                z: $f,
+                z_prev: $f,
+                phi: $f,
+                _u: $f,
+                theta: &[$f; 10],
+            ) -> AccelerationOutput {
                 use reldesign_runtime::math::Real;
 
                 /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -827,23 +987,21 @@ pub mod ukf {
 
                 /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
                 const MU0: $f = 1.2566370614359173e-6;
-
-                /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-                const INV_SQRT_A_GAP: $f = 223.60679774997894;
+                let [_, _, a_gap, l_w, _, phi_sat, m, k_s, c, f0] = *theta;
                 let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
-                let min_2 = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-                let inv_a_gap = 1.0 / A_GAP;
+                let inv_a_gap = 1.0 / a_gap;
+                let inv_sqrt_a_gap = 1.0 / Real::sqrt(a_gap);
                 let t0 = 1.0 / (min + Z_EPS);
-                let ln = Real::ln(2.0 * L_W * t0);
-                let t1 = INV_SQRT_A_GAP * min * ln + 1.0;
+                let ln = Real::ln(2.0 * l_w * t0);
+                let t1 = inv_sqrt_a_gap * min * ln + 1.0;
+                let min_2 = Real::min(Real::max(phi, -0.999 * phi_sat), 0.999 * phi_sat);
                 // [JA 87] a = f_v(z, v, φ), the free-motion acceleration at v of [JA 85]
-                let accel = 1.0 / M
-                    * (-(F0 + K_S * min + C / T_S * (z - z_prev))
-                        - 0.5 * (min_2 * min_2)
-                            * (1.0 / MU0 * inv_a_gap / t1
-                                - 1.0 / MU0 * inv_a_gap * min
-                                    * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min * t0)
-                                    / (t1 * t1)));
+                let accel = (-(f0 + k_s * min + 1.0 / T_S * c * (z - z_prev))
+                    - 0.5
+                        * (1.0 / MU0 * inv_a_gap / t1
+                            - 1.0 / MU0 * inv_a_gap * min
+                                * (inv_sqrt_a_gap * ln - inv_sqrt_a_gap * min * t0) / (t1 * t1))
+                        * (min_2 * min_2)) / m;
                 AccelerationOutput { accel }
             }
 
@@ -859,7 +1017,13 @@ pub mod ukf {
             #[inline]
             #[must_use]
             #[allow(clippy::excessive_precision)]
-            pub fn input_gain(z: $f, z_prev: $f, phi: $f, _u: $f) -> InputGainOutput {
+            pub fn input_gain(
+                z: $f,
+                z_prev: $f,
+                phi: $f,
+                _u: $f,
+                theta: &[$f; 10],
+            ) -> InputGainOutput {
                 use reldesign_runtime::math::Real;
 
                 /// Z_EPS [m], the regularisation of the McLyman logarithm ln(k/(z + Z_EPS))
@@ -867,42 +1031,40 @@ pub mod ukf {
 
                 /// μ0 = 4π·10⁻⁷ H/m, the vacuum permeability
                 const MU0: $f = 1.2566370614359173e-6;
-
-                /// sqrt(A_gap)^(-1.0) (parameters only: evaluated when generated, so it changes with them)
-                const INV_SQRT_A_GAP: $f = 223.60679774997894;
-                let t0 = 1.0 / (N * N + R * K_E);
-                let inv_phi_sat = 1.0 / PHI_SAT;
-                let min = Real::min(Real::max(phi, -PHI_LIM), PHI_LIM);
-                let t1 = 1.0 - inv_phi_sat * Real::abs(min);
-                let inv_a_gap = 1.0 / A_GAP;
-                let min_2 = Real::min(Real::max(z, Z_MIN), Z_MAX);
+                let [r, k_e, a_gap, l_w, r_core0, phi_sat, m, k_s, c, f0] = *theta;
+                let t0 = 1.0 / (N * N + r * k_e);
+                let inv_a_gap = 1.0 / a_gap;
+                let min = Real::min(Real::max(z, Z_MIN), Z_MAX);
                 let inv_t_s = 1.0 / T_S;
-                let t2 = 1.0 / (min_2 + Z_EPS);
-                let ln = Real::ln(2.0 * L_W * t2);
-                let t3 = INV_SQRT_A_GAP * min_2 * ln + 1.0;
-                let t4 = 0.5
+                let inv_sqrt_a_gap = 1.0 / Real::sqrt(a_gap);
+                let t1 = 1.0 / (min + Z_EPS);
+                let ln = Real::ln(2.0 * l_w * t1);
+                let t2 = inv_sqrt_a_gap * min * ln + 1.0;
+                let min_2 = Real::min(Real::max(phi, -0.999 * phi_sat), 0.999 * phi_sat);
+                let t3 = 0.5
                     * (Real::min(
                         Real::max(
                             2.0 * z - z_prev
-                                + T_S * T_S / M
-                                    * (-(F0 + K_S * min_2 + C * inv_t_s * (z - z_prev))
-                                        - 0.5 * (min * min)
-                                            * (1.0 / MU0 * inv_a_gap / t3
-                                                - 1.0 / MU0 * inv_a_gap * min_2
-                                                    * (INV_SQRT_A_GAP * ln - INV_SQRT_A_GAP * min_2 * t2)
-                                                    / (t3 * t3))),
+                                + T_S * T_S
+                                    * (-(f0 + k_s * min + inv_t_s * c * (z - z_prev))
+                                        - 0.5
+                                            * (1.0 / MU0 * inv_a_gap / t2
+                                                - 1.0 / MU0 * inv_a_gap * min
+                                                    * (inv_sqrt_a_gap * ln - inv_sqrt_a_gap * min * t1)
+                                                    / (t2 * t2)) * (min_2 * min_2)) / m,
                             Z_MIN,
                         ),
                         Z_MAX,
-                    ) - min_2);
-                let t5 = min_2 + t4;
+                    ) - min);
+                let t4 = min + t3;
+                let inv_phi_sat = 1.0 / phi_sat;
+                let t5 = 1.0 - inv_phi_sat * Real::abs(min_2);
                 let min_3 = Real::min(
-                    -R * t0
-                        * (R_CORE0 / t1
-                            + R_CORE0 * inv_phi_sat * min * Real::signum0(min) / (t1 * t1)
-                            + 1.0 / MU0 * inv_a_gap * t5
-                                / (INV_SQRT_A_GAP * t5 * Real::ln(2.0 * L_W / (min_2 + t4 + Z_EPS))
-                                    + 1.0)),
+                    -r * t0
+                        * (1.0 / MU0 * inv_a_gap * t4
+                            / (inv_sqrt_a_gap * t4 * Real::ln(2.0 * l_w / (min + t3 + Z_EPS)) + 1.0)
+                            + r_core0 / t5
+                            + r_core0 * inv_phi_sat * min_2 * Real::signum0(min_2) / (t5 * t5)),
                     0.0,
                 );
                 let sel = if -T_S * min_3 - 0.05 >= 0.0 {
@@ -930,15 +1092,20 @@ pub mod ukf {
     pub mod f32 {
         use reldesign_runtime::observe::{self, Prediction, Reading};
         params!(f32);
+        calibration!(f32);
         kalman!(f32);
         model!(f32);
 
-        /// The discretised model: the functions of `model!`, for the runtime's filter.
+        /// The discretised model: the functions of `model!` at the adapted parameters
+        /// θ, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Model;
+        pub struct Model {
+            /// θ: the adapted parameters, in the order of `ADAPTED`.
+            pub theta: [f32; 10],
+        }
 
         impl observe::Stateless<f32, 3> for Model {
-            const MODEL: Self = Model;
+            const MODEL: Self = Model { theta: THETA_DESIGN };
             const SETTINGS: observe::Settings<f32, 3> = SETTINGS;
         }
 
@@ -946,7 +1113,7 @@ pub mod ukf {
             #[inline]
             fn acceleration(&mut self, x: &[f32; 3], u: f32, _t: f32) -> f32 {
                 let [z, z_prev, phi] = *x;
-                acceleration(z, z_prev, phi, u).accel
+                acceleration(z, z_prev, phi, u, &self.theta).accel
             }
         }
 
@@ -954,7 +1121,7 @@ pub mod ukf {
             #[inline]
             fn transition(&mut self, x: &[f32; 3], u: f32, _t: f32) -> Prediction<f32, 3> {
                 let [z, z_prev, phi] = *x;
-                let o = transition(z, z_prev, phi, u);
+                let o = transition(z, z_prev, phi, u, &self.theta);
                 Prediction {
                     next: [o.z_next, o.zp_next, o.phi_next],
                     accel: o.accel,
@@ -964,14 +1131,14 @@ pub mod ukf {
             #[inline]
             fn measurement(&mut self, x: &[f32; 3], u: f32, _t: f32) -> Reading<f32> {
                 let [z, z_prev, phi] = *x;
-                let m = measurement(z, z_prev, phi, u);
+                let m = measurement(z, z_prev, phi, u, &self.theta);
                 Reading { y: m.i, dy_du: m.di_du }
             }
 
             #[inline]
             fn input_gain(&mut self, x: &[f32; 3], u: f32, _t: f32) -> [f32; 3] {
                 let [z, z_prev, phi] = *x;
-                let g = input_gain(z, z_prev, phi, u);
+                let g = input_gain(z, z_prev, phi, u, &self.theta);
                 [0.0, 0.0, g.dphi_du]
             }
         }
@@ -982,6 +1149,41 @@ pub mod ukf {
 
         /// What [`Filter`] reports at each sample.
         pub type Estimate = observe::Estimate<f32>;
+
+        impl reldesign_runtime::calibrate::Adaptive<f32, 3, 10> for Model {
+            #[inline]
+            fn with_theta(&self, theta: &[f32; 10]) -> Self {
+                Model { theta: *theta }
+            }
+        }
+
+        /// What the firmware keeps of a run for the self-calibration: every sample's
+        /// measured voltage and current (`Record::start` at the run's start, `push`
+        /// once per sample). RAM: 2·RECORD_CAPACITY floats.
+        pub type Record = reldesign_runtime::calibrate::Record<f32, RECORD_CAPACITY>;
+
+        /// θ carried from run to run (`Calibration::new(&CALIBRATION)` at θ_d,
+        /// `reset` back to it).
+        pub type Calibration = reldesign_runtime::calibrate::Calibration<f32, 10>;
+
+        /// The self-calibration after a run (between operations, never inside one):
+        /// θ updated from the run's `record` so that the filter's one-step current
+        /// predictions are right (`reldesign_runtime::calibrate::innovations`: P + 1
+        /// filter passes per Levenberg–Marquardt step, bounded steps, θ kept in
+        /// [THETA_LOWER, THETA_UPPER], a record that does not look like a run refused).
+        /// Then hand `calibration.theta` to the controller's `Design` and this `Model`.
+        pub fn calibrate(
+            calibration: &mut Calibration,
+            record: &Record,
+        ) -> reldesign_runtime::calibrate::Outcome<f32> {
+            calibration
+                .update_innovations::<
+                    Model,
+                    3,
+                    7,
+                    RECORD_CAPACITY,
+                >(&<Model as observe::Stateless<f32, 3>>::MODEL, &CALIBRATION, record)
+        }
     }
 
     /// The unscented Kalman filter of `self_calibrating_valve` in f64, on the discretised model of
@@ -992,15 +1194,20 @@ pub mod ukf {
     pub mod f64 {
         use reldesign_runtime::observe::{self, Prediction, Reading};
         params!(f64);
+        calibration!(f64);
         kalman!(f64);
         model!(f64);
 
-        /// The discretised model: the functions of `model!`, for the runtime's filter.
+        /// The discretised model: the functions of `model!` at the adapted parameters
+        /// θ, for the runtime's filter.
         #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Model;
+        pub struct Model {
+            /// θ: the adapted parameters, in the order of `ADAPTED`.
+            pub theta: [f64; 10],
+        }
 
         impl observe::Stateless<f64, 3> for Model {
-            const MODEL: Self = Model;
+            const MODEL: Self = Model { theta: THETA_DESIGN };
             const SETTINGS: observe::Settings<f64, 3> = SETTINGS;
         }
 
@@ -1008,7 +1215,7 @@ pub mod ukf {
             #[inline]
             fn acceleration(&mut self, x: &[f64; 3], u: f64, _t: f64) -> f64 {
                 let [z, z_prev, phi] = *x;
-                acceleration(z, z_prev, phi, u).accel
+                acceleration(z, z_prev, phi, u, &self.theta).accel
             }
         }
 
@@ -1016,7 +1223,7 @@ pub mod ukf {
             #[inline]
             fn transition(&mut self, x: &[f64; 3], u: f64, _t: f64) -> Prediction<f64, 3> {
                 let [z, z_prev, phi] = *x;
-                let o = transition(z, z_prev, phi, u);
+                let o = transition(z, z_prev, phi, u, &self.theta);
                 Prediction {
                     next: [o.z_next, o.zp_next, o.phi_next],
                     accel: o.accel,
@@ -1026,14 +1233,14 @@ pub mod ukf {
             #[inline]
             fn measurement(&mut self, x: &[f64; 3], u: f64, _t: f64) -> Reading<f64> {
                 let [z, z_prev, phi] = *x;
-                let m = measurement(z, z_prev, phi, u);
+                let m = measurement(z, z_prev, phi, u, &self.theta);
                 Reading { y: m.i, dy_du: m.di_du }
             }
 
             #[inline]
             fn input_gain(&mut self, x: &[f64; 3], u: f64, _t: f64) -> [f64; 3] {
                 let [z, z_prev, phi] = *x;
-                let g = input_gain(z, z_prev, phi, u);
+                let g = input_gain(z, z_prev, phi, u, &self.theta);
                 [0.0, 0.0, g.dphi_du]
             }
         }
@@ -1044,5 +1251,40 @@ pub mod ukf {
 
         /// What [`Filter`] reports at each sample.
         pub type Estimate = observe::Estimate<f64>;
+
+        impl reldesign_runtime::calibrate::Adaptive<f64, 3, 10> for Model {
+            #[inline]
+            fn with_theta(&self, theta: &[f64; 10]) -> Self {
+                Model { theta: *theta }
+            }
+        }
+
+        /// What the firmware keeps of a run for the self-calibration: every sample's
+        /// measured voltage and current (`Record::start` at the run's start, `push`
+        /// once per sample). RAM: 2·RECORD_CAPACITY floats.
+        pub type Record = reldesign_runtime::calibrate::Record<f64, RECORD_CAPACITY>;
+
+        /// θ carried from run to run (`Calibration::new(&CALIBRATION)` at θ_d,
+        /// `reset` back to it).
+        pub type Calibration = reldesign_runtime::calibrate::Calibration<f64, 10>;
+
+        /// The self-calibration after a run (between operations, never inside one):
+        /// θ updated from the run's `record` so that the filter's one-step current
+        /// predictions are right (`reldesign_runtime::calibrate::innovations`: P + 1
+        /// filter passes per Levenberg–Marquardt step, bounded steps, θ kept in
+        /// [THETA_LOWER, THETA_UPPER], a record that does not look like a run refused).
+        /// Then hand `calibration.theta` to the controller's `Design` and this `Model`.
+        pub fn calibrate(
+            calibration: &mut Calibration,
+            record: &Record,
+        ) -> reldesign_runtime::calibrate::Outcome<f64> {
+            calibration
+                .update_innovations::<
+                    Model,
+                    3,
+                    7,
+                    RECORD_CAPACITY,
+                >(&<Model as observe::Stateless<f64, 3>>::MODEL, &CALIBRATION, record)
+        }
     }
 }

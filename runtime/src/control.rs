@@ -335,6 +335,12 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
         }
     }
 
+    /// The law, e.g. to hand a self-calibrating design its adapted
+    /// parameters between operations.
+    pub fn law_mut(&mut self) -> &mut L {
+        &mut self.law
+    }
+
     /// Starts the operation at `t_start` [s]: reference times count from here.
     pub fn start(&mut self, t_start: T) {
         self.tracker.start(t_start);

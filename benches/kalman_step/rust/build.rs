@@ -73,6 +73,7 @@ fn main() {
         name: &d.name,
         discrete: &dm,
         floats: vec![Float::F64, Float::F32],
+        calibration: None,
     };
     let ok = |r: Result<String, reldesign_build::ObserverError>| r.unwrap_or_else(|e| panic!("{e}"));
     let code = ok(emit_observer_params(&input))

@@ -9,7 +9,9 @@ use designer::sym::{Graph, Id};
 use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::emit::{function_tokens_as, FunctionSpec, Inline};
+use std::collections::HashMap;
+
+use crate::emit::{function_tokens_as, FunctionSpec, Inline, Theta};
 use crate::error::EmitError;
 use crate::float::{Float, Scalar};
 use crate::param::Param;
@@ -55,6 +57,7 @@ impl Function {
         dm: &DiscreteModel,
         params: &[Param],
         scalar: Scalar,
+        theta: &Theta,
     ) -> Result<TokenStream, EmitError> {
         let mut inputs: Vec<(&str, Id)> = state_names(dm)
             .iter()
@@ -79,7 +82,22 @@ impl Function {
             // written in `scalar` (function_tokens_as)
             float: Float::F64,
         };
-        function_tokens_as(graph, &spec, params, Inline::Hint, scalar)
+        function_tokens_as(graph, &spec, params, Inline::Hint, scalar, theta)
+    }
+
+    /// This function with `map` applied to its outputs (in `graph`, the one
+    /// they live in or a clone of it).
+    pub(super) fn substituted(&self, graph: &mut Graph, map: &HashMap<Id, Id>) -> Function {
+        let outputs = self
+            .outputs
+            .iter()
+            .map(|(n, id, d)| (n.clone(), graph.substitute(*id, map), d.clone()))
+            .collect();
+        Function {
+            name: self.name,
+            doc: self.doc.clone(),
+            outputs,
+        }
     }
 
     pub(super) fn comments(&self) -> Vec<(&str, &str)> {

@@ -36,12 +36,15 @@ use designer::observe::discrete::DiscreteModel;
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
+use crate::calibration::{theta_args, theta_symbols};
 use crate::emit::doc_attrs;
+use crate::emit::Theta;
 use crate::error::EmitError;
 use crate::float::{Float, Scalar, MACRO_LITERALS};
 use crate::format::{comment_lets, format_items, macro_rules, space_items};
 use crate::names::const_name;
 use crate::param::Param;
+use std::collections::HashMap;
 
 use layout::{state_names, vector_tokens, Function, Layout};
 pub use settings::{emit_kalman_macro, emit_observer_params};
@@ -56,6 +59,10 @@ pub struct ObserverInput<'a> {
     pub discrete: &'a DiscreteModel,
     /// Emitted float types, in this order (duplicates dropped).
     pub floats: Vec<Float>,
+    /// The self-calibration (`[controller] self_calibration`): the model
+    /// reads the adapted parameters θ at run time, and the UKF module holds
+    /// the update.
+    pub calibration: Option<&'a designer::calibrate::CalibrationDesign>,
 }
 
 /// Why an observer could not be emitted.
@@ -134,10 +141,14 @@ fn emit(input: &ObserverInput, kind: Kind) -> Result<String, ObserverError> {
     }
     let layout = Layout::new(input.discrete, kind);
     let f32 = floats.contains(&Float::F32);
-    let mut out = model_macro(input, &layout, Scalar::Macro { f32 })?;
+    let theta = match input.calibration {
+        Some(c) => theta_args(&input.discrete.params, c)?,
+        None => Vec::new(),
+    };
+    let mut out = model_macro(input, &layout, Scalar::Macro { f32 }, &theta)?;
     for float in floats {
         out.push('\n');
-        out.push_str(&float_module(input, &layout, kind, float)?);
+        out.push_str(&float_module(input, &layout, kind, float, theta.len())?);
     }
     Ok(out)
 }
@@ -170,12 +181,19 @@ fn model_macro(
     input: &ObserverInput,
     layout: &Layout,
     scalar: Scalar,
+    theta: &Theta,
 ) -> Result<String, ObserverError> {
     let dm = input.discrete;
-    let params: Vec<Param> = dm.param_list().into_iter().map(Param::from).collect();
+    let adapted = theta_symbols(theta);
+    let params: Vec<Param> = (dm.param_list().into_iter())
+        .filter(|p| !adapted.contains(&p.1))
+        .map(Param::from)
+        .collect();
+    let (mut graph, follows) = phi_lim_follows(dm, &adapted);
     let mut items = TokenStream::new();
     for f in functions(layout) {
-        items.extend(f.tokens(&dm.graph, dm, &params, scalar)?);
+        let f = f.substituted(&mut graph, &follows);
+        items.extend(f.tokens(&graph, dm, &params, scalar, theta)?);
     }
     let mut text = space_items(&format_items(items)?);
     for f in functions(layout) {
@@ -190,17 +208,42 @@ fn model_macro(
     Ok(macro_rules("model", &doc, &text))
 }
 
+/// The model's graph with φ_lim = (1 − margin)·φ_sat where φ_sat is adapted
+/// (the filter's flux domain follows θ, as the designer's adaptive tapes'),
+/// and the substitution to apply to the functions' outputs.
+fn phi_lim_follows(
+    dm: &DiscreteModel,
+    adapted: &[designer::sym::Id],
+) -> (
+    designer::sym::Graph,
+    HashMap<designer::sym::Id, designer::sym::Id>,
+) {
+    let mut graph = dm.graph.clone();
+    let mut map = HashMap::new();
+    let lim = dm.params.symbol(designer::observe::discrete::PHI_LIM);
+    if let (Some(lim), Some(sat)) = (lim, dm.params.symbol("phi_sat")) {
+        if adapted.contains(&sat) {
+            let margin = graph.constant(1.0 - designer::observe::discrete::FLUX_DOMAIN_MARGIN);
+            let follows = graph.mul(margin, sat);
+            map.insert(lim, follows);
+        }
+    }
+    (graph, map)
+}
+
 /// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.
 fn float_module(
     input: &ObserverInput,
     layout: &Layout,
     kind: Kind,
     float: Float,
+    adapted: usize,
 ) -> Result<String, ObserverError> {
     let dm = input.discrete;
     let ty = float.ty();
     let module = format_ident!("{}", float.name());
-    let items = model_impl(dm, layout, kind, float)?;
+    let items = model_impl(dm, layout, kind, float, adapted)?;
+    let calibration = (adapted > 0).then(|| quote!(calibration!(#ty);));
 
     let state_doc = state_names(dm)
         .iter()
@@ -241,6 +284,7 @@ fn float_module(
             #imports
 
             params!(#ty);
+            #calibration
             kalman!(#ty);
             model!(#ty);
 
@@ -268,7 +312,8 @@ struct Method {
 }
 
 impl Method {
-    fn new(dm: &DiscreteModel, layout: &Layout, float: Float) -> Method {
+    /// `adapted`: the model functions take θ (`&self.theta`).
+    fn new(dm: &DiscreteModel, layout: &Layout, float: Float, adapted: bool) -> Method {
         let ty = float.ty();
         let dim = Literal::usize_unsuffixed(layout.n);
         let names: Vec<Ident> = state_names(dm)
@@ -291,7 +336,11 @@ impl Method {
         Method {
             args: quote!(&mut self, x: &[#ty; #dim], u: #ty, #t: #ty),
             states: quote!(let [#(#names),*] = *x;),
-            call: quote!(#(#names),*, u #t_arg),
+            call: if adapted {
+                quote!(#(#names),*, u #t_arg, &self.theta)
+            } else {
+                quote!(#(#names),*, u #t_arg)
+            },
             prediction: quote!(Prediction { next: [#(#next),*], accel: o.accel }),
             reading: quote!(Reading { y: m.#y, dy_du: m.#dy_du }),
             ty,
@@ -307,8 +356,9 @@ fn model_impl(
     layout: &Layout,
     kind: Kind,
     float: Float,
+    adapted: usize,
 ) -> Result<TokenStream, ObserverError> {
-    let f = Method::new(dm, layout, float);
+    let f = Method::new(dm, layout, float, adapted > 0);
     let (ty, dim) = (&f.ty, &f.dim);
     let (filter, model_trait, what) = match kind {
         Kind::Ekf => (
@@ -335,15 +385,11 @@ fn model_impl(
     let Method {
         args, states, call, ..
     } = &f;
+    let model = model_type(ty, dim, adapted);
+    let update =
+        (kind == Kind::Ukf && adapted > 0).then(|| update_items(ty, dim, layout.n, adapted));
     Ok(quote! {
-        /// The discretised model: the functions of `model!`, for the runtime's filter.
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct Model;
-
-        impl observe::Stateless<#ty, #dim> for Model {
-            const MODEL: Self = Model;
-            const SETTINGS: observe::Settings<#ty, #dim> = SETTINGS;
-        }
+        #model
 
         impl observe::DiscreteModel<#ty, #dim> for Model {
             #[inline] fn acceleration(#args) -> #ty {
@@ -360,7 +406,82 @@ fn model_impl(
 
         /// What [`Filter`] reports at each sample.
         pub type Estimate = observe::Estimate<#ty>;
+
+        #update
     })
+}
+
+/// `Model` and its `observe::Stateless`: zero-sized, or (a self-calibrating
+/// design) carrying θ, θ_d its `const` default.
+fn model_type(ty: &Ident, dim: &Literal, adapted: usize) -> TokenStream {
+    if adapted == 0 {
+        return quote! {
+            /// The discretised model: the functions of `model!`, for the runtime's filter.
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct Model;
+
+            impl observe::Stateless<#ty, #dim> for Model {
+                const MODEL: Self = Model;
+                const SETTINGS: observe::Settings<#ty, #dim> = SETTINGS;
+            }
+        };
+    }
+    let p = Literal::usize_unsuffixed(adapted);
+    quote! {
+        /// The discretised model: the functions of `model!` at the adapted parameters
+        /// θ, for the runtime's filter.
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct Model {
+            /// θ: the adapted parameters, in the order of `ADAPTED`.
+            pub theta: [#ty; #p],
+        }
+
+        impl observe::Stateless<#ty, #dim> for Model {
+            const MODEL: Self = Model { theta: THETA_DESIGN };
+            const SETTINGS: observe::Settings<#ty, #dim> = SETTINGS;
+        }
+    }
+}
+
+/// The self-calibration's update in the UKF module: `Model` at θ, the run's
+/// `Record`, the carried `Calibration` and `calibrate`.
+fn update_items(ty: &Ident, dim: &Literal, n: usize, adapted: usize) -> TokenStream {
+    let p = Literal::usize_unsuffixed(adapted);
+    let points = Literal::usize_unsuffixed(2 * n + 1);
+    quote! {
+        impl reldesign_runtime::calibrate::Adaptive<#ty, #dim, #p> for Model {
+            #[inline]
+            fn with_theta(&self, theta: &[#ty; #p]) -> Self {
+                Model { theta: *theta }
+            }
+        }
+
+        /// What the firmware keeps of a run for the self-calibration: every sample's
+        /// measured voltage and current (`Record::start` at the run's start, `push`
+        /// once per sample). RAM: 2·RECORD_CAPACITY floats.
+        pub type Record = reldesign_runtime::calibrate::Record<#ty, RECORD_CAPACITY>;
+
+        /// θ carried from run to run (`Calibration::new(&CALIBRATION)` at θ_d,
+        /// `reset` back to it).
+        pub type Calibration = reldesign_runtime::calibrate::Calibration<#ty, #p>;
+
+        /// The self-calibration after a run (between operations, never inside one):
+        /// θ updated from the run's `record` so that the filter's one-step current
+        /// predictions are right (`reldesign_runtime::calibrate::innovations`: P + 1
+        /// filter passes per Levenberg–Marquardt step, bounded steps, θ kept in
+        /// [THETA_LOWER, THETA_UPPER], a record that does not look like a run refused).
+        /// Then hand `calibration.theta` to the controller's `Design` and this `Model`.
+        pub fn calibrate(
+            calibration: &mut Calibration,
+            record: &Record,
+        ) -> reldesign_runtime::calibrate::Outcome<#ty> {
+            calibration.update_innovations::<Model, #dim, #points, RECORD_CAPACITY>(
+                &<Model as observe::Stateless<#ty, #dim>>::MODEL,
+                &CALIBRATION,
+                record,
+            )
+        }
+    }
 }
 
 /// The EKF's model: F with ∂F/∂x and g, h with ∂h/∂x (constant entries as

@@ -85,6 +85,12 @@ pub fn candidates(description: &Description) -> Vec<Candidate> {
         .collect()
 }
 
+/// The innovations update's forward-difference step, relative to θ_d: the
+/// emitted f32 filter rounds at ~6·10⁻⁸ of the current, and ν's change over
+/// a step of 10⁻³ stands ~10³ above it, while the curvature's error in the
+/// difference stays ~10⁻³ of the slope (f64 and f32 share the step).
+pub const DIFFERENCE_STEP: f64 = 1e-3;
+
 /// The calibration of `design` at `sample_period`: the identifiable
 /// parameters of its planned operations and the runtime's settings.
 pub fn choose(design: &Design, sample_period: f64) -> Result<CalibrationDesign, ChoiceError> {
@@ -117,11 +123,18 @@ pub fn choose(design: &Design, sample_period: f64) -> Result<CalibrationDesign, 
         dip_tolerance: 0.1 * d.supply.u_max,
         dip_share: 0.05,
         motion_evidence: 1.0,
+        difference_step: DIFFERENCE_STEP,
     };
     if design.kalman.is_some() && d.controller.as_ref().is_some_and(|c| c.estimator.is_some()) {
-        // the prediction-error update through the observer: every candidate
+        // the prediction-error update through the observer: every candidate,
+        // over a whole run (every operation) of every sample, as the filter
+        // ran it
+        let per_run = per_operation * t.operations.len().max(1);
         calibration.method = Method::Innovations;
         calibration.parameters = candidates.iter().map(|c| adapted(c, 1.0)).collect();
+        calibration.decimation = 1;
+        calibration.capacity = per_run + 1;
+        calibration.min_samples = per_run / 2;
         return Ok(calibration);
     }
     let information = information(design, &candidates, &calibration, sample_period)?;
@@ -148,7 +161,13 @@ pub fn choose(design: &Design, sample_period: f64) -> Result<CalibrationDesign, 
 /// The domain an adapted parameter stays in: its design value ±[`TOLERANCE`]
 /// (its sign kept, so within the physical domain).
 fn adapted(c: &Candidate, new_information: f64) -> Adapted {
-    let (a, b) = ((1.0 - TOLERANCE) * c.nominal, (1.0 + TOLERANCE) * c.nominal);
+    // six significant digits: the emitted bounds read as written (0.0105, not
+    // 0.010499999999999999)
+    let round = |x: f64| format!("{x:.5e}").parse::<f64>().unwrap_or(x);
+    let (a, b) = (
+        round((1.0 - TOLERANCE) * c.nominal),
+        round((1.0 + TOLERANCE) * c.nominal),
+    );
     Adapted {
         key: c.key,
         symbol: c.symbol,
@@ -217,6 +236,7 @@ fn information_with<const P: usize>(
         dip_tolerance: f64::INFINITY,
         dip_share: 1.0,
         motion_evidence: calibration.motion_evidence,
+        difference_step: calibration.difference_step,
     };
     for (n, c) in settings.nominal.iter_mut().zip(candidates) {
         *n = c.nominal;

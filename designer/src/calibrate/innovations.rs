@@ -1,163 +1,76 @@
-//! The prediction-error update: θ chosen to make the observer's own
-//! one-step-ahead current predictions right, i.e. to minimise Σ νₖ², νₖ the
-//! UKF's innovations over a run's measured voltage and current with the
-//! model at θ. Unlike the open-loop replay (`reldesign_runtime::calibrate`),
-//! whose lift-off from the pre-movement's force balance makes the error a
-//! narrow valley in θ, the filter keeps its state near the valve's, so the
-//! error is smooth and its minimum wide.
-//!
-//! A designer-side study: the Jacobian by forward differences (one filter
-//! pass per parameter), bounded Levenberg–Marquardt steps in relative
-//! coordinates, the same bounds as the runtime's update.
+//! The prediction-error update of an observer-driven design, as the emitted
+//! code runs it: `reldesign_runtime::calibrate::innovations` (θ chosen so
+//! that the UKF's one-step current predictions over a run are right) on the
+//! design's discretised model compiled to tapes with θ as inputs
+//! (`TapeModel::adaptive`), over the record the firmware keeps of a run.
+
+use reldesign_runtime::calibrate::{Calibration, Outcome, Record};
 
 use crate::closed_loop::Measured;
-use crate::description::params;
-use crate::design::{design_kalman, Design};
-use crate::model::Model;
-use crate::observe::ukf::Ukf;
+use crate::design::Design;
+use crate::observe::discrete::{DiscreteModel, TapeModel};
 
-use super::Adapted;
+use super::CalibrationDesign;
 
-/// The innovations of a UKF on `design`'s model at `values` over `measured`.
-pub fn innovations(
-    design: &Design,
-    values: &[(&str, f64)],
+/// The designer's run record: larger than any design's capacity at the
+/// sample periods `loop --runs` accepts (a run of 25 ms windows at 1 µs).
+pub const RUN_RECORD: usize = 65_536;
+
+/// The record the firmware keeps of a run: every sample as measured.
+pub fn run_record<const P: usize>(
+    settings: &reldesign_runtime::calibrate::Settings<f64, P>,
     measured: &[Measured],
-) -> Result<Vec<f64>, String> {
-    let mut d = design.description.clone();
-    for (key, value) in values {
-        params::set(&mut d, key, *value).map_err(|e| e.to_string())?;
+    z0: f64,
+) -> Box<Record<f64, RUN_RECORD>> {
+    let mut record = Box::new(Record::<f64, RUN_RECORD>::new());
+    record.start(z0);
+    for m in measured {
+        record.push(settings, m.commanded, m.voltage, m.current);
     }
-    let model = Model::build(&d);
-    let kalman = design_kalman(&d, &model)
-        .map_err(|e| e.to_string())?
+    record
+}
+
+/// The filter's model with the adapted parameters as tape inputs.
+fn adaptive<const N: usize>(
+    discrete: &DiscreteModel,
+    c: &CalibrationDesign,
+) -> Result<TapeModel<N>, String> {
+    let names: Vec<&str> = c.parameters.iter().map(|a| a.symbol).collect();
+    let free = discrete
+        .param_symbols(&names)
+        .ok_or("an adapted parameter is not one of the filter's model")?;
+    Ok(TapeModel::adaptive(discrete, &free))
+}
+
+/// One update of `calibration` from a run's `measured` samples by the
+/// runtime's innovations update on the design's filter model.
+pub fn update<const P: usize>(
+    design: &Design,
+    c: &CalibrationDesign,
+    calibration: &mut Calibration<f64, P>,
+    measured: &[Measured],
+) -> Result<Outcome<f64>, String> {
+    let discrete = design
+        .kalman
+        .as_ref()
         .ok_or("the design has no Kalman filter")?;
-    let mut ukf = Ukf::new(&kalman);
-    Ok(measured
-        .iter()
-        .map(|m| {
-            ukf.step(m.voltage, m.current);
-            ukf.innovation().0
-        })
-        .collect())
-}
-
-/// What one update did: the RMS innovation before and after [A].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Update {
-    pub before: f64,
-    pub after: f64,
-    pub accepted: bool,
-}
-
-/// Up to `iterations` bounded Levenberg–Marquardt steps on Σ νₖ² from
-/// `theta` (the values of `adapted`, in order); θ changes only on a lower
-/// error. Each run's update stands on its own data: carrying the earlier
-/// runs' information as a prior (recursive least squares, forgetting 0.7)
-/// was tried and kept the first, worst-linearised run's directions from
-/// moving (three hand-made plants: no plant got softer).
-pub fn update(
-    design: &Design,
-    adapted: &[Adapted],
-    theta: &mut [f64],
-    measured: &[Measured],
-    max_step: f64,
-    iterations: usize,
-) -> Result<Update, String> {
-    let keys: Vec<&str> = adapted.iter().map(|a| a.key).collect();
-    let at = |t: &[f64]| -> Result<Vec<f64>, String> {
-        let values: Vec<(&str, f64)> = keys.iter().copied().zip(t.iter().copied()).collect();
-        innovations(design, &values, measured)
-    };
-    let cost = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>() / r.len().max(1) as f64;
-    let mut r = at(theta)?;
-    let before = cost(&r).sqrt();
-    let mut damping = 1e-3;
-    let mut accepted = false;
-    for _ in 0..iterations {
-        let jacobian = forward_differences(&at, theta, &r, adapted)?;
-        let mut stepped = false;
-        for _ in 0..5 {
-            let Some(step) = lm_step(&jacobian, &r, damping) else {
-                break;
-            };
-            let trial: Vec<f64> = theta
-                .iter()
-                .zip(&step)
-                .zip(adapted)
-                .map(|((t, s), a)| {
-                    (t + s.clamp(-max_step, max_step) * a.nominal.abs()).clamp(a.lower, a.upper)
-                })
-                .collect();
-            let rt = at(&trial)?;
-            if cost(&rt) < cost(&r) {
-                theta.copy_from_slice(&trial);
-                r = rt;
-                damping /= 4.0;
-                stepped = true;
-                accepted = true;
-                break;
-            }
-            damping *= 8.0;
-        }
-        if !stepped {
-            break;
-        }
-    }
-    Ok(Update {
-        before,
-        after: cost(&r).sqrt(),
-        accepted,
+    let settings = c.settings::<P>();
+    let record = run_record(&settings, measured, design.description.mechanics.z_max);
+    Ok(match discrete.dim() {
+        3 => calibration.update_innovations::<_, 3, 7, RUN_RECORD>(
+            &adaptive::<3>(discrete, c)?,
+            &settings,
+            &record,
+        ),
+        4 => calibration.update_innovations::<_, 4, 9, RUN_RECORD>(
+            &adaptive::<4>(discrete, c)?,
+            &settings,
+            &record,
+        ),
+        _ => calibration.update_innovations::<_, 5, 11, RUN_RECORD>(
+            &adaptive::<5>(discrete, c)?,
+            &settings,
+            &record,
+        ),
     })
-}
-
-/// JᵀJ (J by columns).
-fn normal_matrix(columns: &[Vec<f64>]) -> Vec<Vec<f64>> {
-    columns
-        .iter()
-        .map(|a| {
-            columns
-                .iter()
-                .map(|b| a.iter().zip(b).map(|(x, y)| x * y).sum())
-                .collect()
-        })
-        .collect()
-}
-
-/// ∂νₖ/∂δⱼ (δ relative to the design's values) by forward differences.
-fn forward_differences(
-    at: &dyn Fn(&[f64]) -> Result<Vec<f64>, String>,
-    theta: &[f64],
-    r: &[f64],
-    adapted: &[Adapted],
-) -> Result<Vec<Vec<f64>>, String> {
-    let mut columns = Vec::with_capacity(theta.len());
-    for (j, a) in adapted.iter().enumerate() {
-        let h = 1e-4 * a.nominal.abs();
-        let mut t = theta.to_vec();
-        t[j] += h;
-        let rj = at(&t)?;
-        columns.push(
-            rj.iter()
-                .zip(r)
-                .map(|(p, q)| (p - q) / h * a.nominal.abs())
-                .collect(),
-        );
-    }
-    Ok(columns)
-}
-
-/// (JᵀJ + μ·diag JᵀJ)·δ = −Jᵀr (J by columns).
-fn lm_step(columns: &[Vec<f64>], r: &[f64], damping: f64) -> Option<Vec<f64>> {
-    let p = columns.len();
-    let mut a = normal_matrix(columns);
-    let b: Vec<f64> = columns
-        .iter()
-        .map(|c| -c.iter().zip(r).map(|(x, y)| x * y).sum::<f64>())
-        .collect();
-    let floor = 1e-6 * (0..p).map(|i| a[i][i]).fold(0.0, f64::max);
-    for (i, row) in a.iter_mut().enumerate() {
-        row[i] = row[i] * (1.0 + damping) + floor;
-    }
-    super::choice::solve(&a, &b)
 }

@@ -96,6 +96,8 @@ pub struct CalibrationDesign {
     pub dip_tolerance: f64,
     pub dip_share: f64,
     pub motion_evidence: f64,
+    /// The innovations update's forward-difference step, relative to θ_d.
+    pub difference_step: f64,
 }
 
 impl CalibrationDesign {
@@ -127,6 +129,7 @@ impl CalibrationDesign {
             dip_tolerance: self.dip_tolerance,
             dip_share: self.dip_share,
             motion_evidence: self.motion_evidence,
+            difference_step: self.difference_step,
         }
     }
 }

@@ -20,17 +20,17 @@ pub enum RunsError {
     Loop(#[from] LoopError),
     #[error("run {run}: the adapted design: {message}")]
     Adapted { run: usize, message: String },
-    #[error("the calibration adapts {0} parameters; at most 8 are supported")]
+    #[error("the calibration adapts {0} parameters; at most 12 are supported")]
     TooMany(usize),
 }
 
-/// What an update did.
+/// What an update did, and by which method.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Update {
     /// The runtime's replay update of one operation's record.
     Replay(Outcome<f64>),
-    /// The prediction-error update of a whole run.
-    Innovations(super::innovations::Update),
+    /// The runtime's innovations update of a whole run's record.
+    Innovations(Outcome<f64>),
 }
 
 /// One operation of one run.
@@ -73,21 +73,18 @@ pub fn run_runs(
         seed,
         options,
     };
-    match calibration {
-        Some(c) if c.method == Method::Innovations => study.innovations(c, runs),
-        _ => {
-            let p = calibration.map_or(0, |c| c.parameters.len());
-            macro_rules! with_p {
-                ($($n:literal)*) => {
-                    match p {
-                        $($n => study.replays::<$n>(calibration, runs),)*
-                        n => Err(RunsError::TooMany(n)),
-                    }
-                };
+    let p = calibration.map_or(0, |c| c.parameters.len());
+    let innovations = calibration.filter(|c| c.method == Method::Innovations);
+    macro_rules! with_p {
+        ($($n:literal)*) => {
+            match (p, innovations) {
+                $(($n, Some(c)) => study.innovations::<$n>(c, runs),)*
+                $(($n, None) => study.replays::<$n>(calibration, runs),)*
+                (n, _) => Err(RunsError::TooMany(n)),
             }
-            with_p!(0 1 2 3 4 5 6 7 8)
-        }
+        };
     }
+    with_p!(0 1 2 3 4 5 6 7 8 9 10 11 12)
 }
 
 /// What every run shares.
@@ -176,27 +173,25 @@ impl Study<'_> {
         Ok(out)
     }
 
-    /// The prediction-error update after every run, over the whole run.
-    fn innovations(&self, c: &CalibrationDesign, runs: usize) -> Result<Vec<Run>, RunsError> {
-        let mut theta: Vec<f64> = c.parameters.iter().map(|a| a.nominal).collect();
+    /// The runtime's innovations update after every run, over the whole run.
+    fn innovations<const P: usize>(
+        &self,
+        c: &CalibrationDesign,
+        runs: usize,
+    ) -> Result<Vec<Run>, RunsError> {
+        let settings = c.settings::<P>();
+        let mut state = Calibration::new(&settings);
         let mut out = Vec::with_capacity(runs);
         for run in 1..=runs {
             let values: Vec<(&'static str, f64)> = c
                 .parameters
                 .iter()
                 .map(|a| a.key)
-                .zip(theta.iter().copied())
+                .zip(state.theta)
                 .collect();
             let (looped, outcomes) = self.run(run, &values)?;
-            let update = super::innovations::update(
-                self.design,
-                &c.parameters,
-                &mut theta,
-                &looped.measured,
-                c.max_step,
-                c.iterations as usize,
-            )
-            .map_err(|message| RunsError::Adapted { run, message })?;
+            let update = super::innovations::update(self.design, c, &mut state, &looped.measured)
+                .map_err(|message| RunsError::Adapted { run, message })?;
             let last = outcomes.len().saturating_sub(1);
             let operations = outcomes
                 .into_iter()

@@ -21,13 +21,25 @@
 //!   the replay with the armature held at its start explains the current as
 //!   well as the free one) and keeps θ in its physical domain.
 //!
-//! Generated code holds the model ([`Predictor`]: f, i and their symbolic
-//! Jacobians, the design's [`Settings`]); this module the algorithm. The
-//! designer runs the same code on tapes (`reldesign loop --runs`).
+//! Two updates share the record, the settings, the bounds and the refusals:
+//!
+//! - the replay above ([`calibrate`]), for a design whose law reads measured
+//!   states: the model as a [`Predictor`] (f, i and their symbolic
+//!   Jacobians);
+//! - the innovations update ([`innovations`]), for a design an observer
+//!   drives, over a whole run: θ makes the UKF's one-step current predictions
+//!   right. It is what the emitted file carries (its UKF `Model` is
+//!   [`Adaptive`]).
+//!
+//! Generated code holds the model and the design's [`Settings`]; this module
+//! the algorithms. The designer runs the same code on tapes (`reldesign loop
+//! --runs`).
 
+pub mod innovations;
 mod record;
 mod replay;
 
+pub use innovations::Adaptive;
 pub use record::Record;
 pub use replay::{replay, Replay};
 
@@ -98,6 +110,9 @@ pub struct Settings<T, const P: usize> {
     /// Motion is evident where the free replay leaves less than this share
     /// of the squared error the replay held at its start stop leaves.
     pub motion_evidence: T,
+    /// The innovations update's forward-difference step h, relative to θ_d
+    /// (unused by the replay, whose sensitivities are symbolic).
+    pub difference_step: T,
 }
 
 /// Why a record changed nothing.
@@ -161,11 +176,16 @@ impl<T: Scalar, const P: usize> Calibration<T, P> {
         record: &Record<T, S>,
     ) -> Outcome<T> {
         let outcome = calibrate(model, settings, record, &mut self.theta);
+        self.count(outcome);
+        outcome
+    }
+
+    /// Counts an update's outcome.
+    fn count(&mut self, outcome: Outcome<T>) {
         match outcome {
             Outcome::Updated { .. } => self.updates = self.updates.saturating_add(1),
             Outcome::Refused(_) => self.refusals = self.refusals.saturating_add(1),
         }
-        outcome
     }
 }
 

@@ -84,6 +84,12 @@ impl<M, T: Scalar, const N: usize> Ekf<M, T, N> {
     pub const fn innovation(&self) -> (T, T) {
         self.post.innovation
     }
+
+    /// The model, e.g. to hand a self-calibrating model its adapted
+    /// parameters between runs (the state and covariance are kept).
+    pub fn model_mut(&mut self) -> &mut M {
+        &mut self.model
+    }
 }
 
 impl<M: Linearised<T, N>, T: Scalar, const N: usize> Ekf<M, T, N> {

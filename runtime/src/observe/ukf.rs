@@ -109,6 +109,12 @@ impl<M, T: Scalar, const N: usize, const P: usize> Ukf<M, T, N, P> {
     pub const fn innovation(&self) -> (T, T) {
         self.post.innovation
     }
+
+    /// The model, e.g. to hand a self-calibrating model its adapted
+    /// parameters between runs (the state and covariance are kept).
+    pub fn model_mut(&mut self) -> &mut M {
+        &mut self.model
+    }
 }
 
 impl<M: Sampled<T, N>, T: Jitter, const N: usize, const P: usize> Ukf<M, T, N, P> {

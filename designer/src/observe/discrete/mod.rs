@@ -401,11 +401,40 @@ impl DiscreteModel {
 
     /// Compiles `exprs` (parameters bound) to a tape of (x, u, t).
     pub fn compile(&self, exprs: &[Id]) -> Tape {
+        self.compile_adaptive(exprs, &[])
+    }
+
+    /// Compiles `exprs` to a tape of (x, u, t, θ): the parameters `free`
+    /// (θ, in order) left as inputs, every other one bound. φ_lim follows a
+    /// free φ_sat (φ_lim = (1 − margin)·φ_sat) as the emitted adaptive model's.
+    ///
+    /// # Panics
+    /// Where a free symbol is not a parameter of the model.
+    pub fn compile_adaptive(&self, exprs: &[Id], free: &[Id]) -> Tape {
         let mut g = self.graph.clone();
-        let map = self.params.bindings(&mut g);
+        let mut map = self.params.bindings(&mut g);
+        for id in free {
+            assert!(map.remove(id).is_some(), "θ holds a parameter");
+        }
+        if let (Some(lim), Some(sat)) = (self.params.symbol(PHI_LIM), self.params.symbol("phi_sat"))
+        {
+            if free.contains(&sat) {
+                let margin = g.constant(1.0 - FLUX_DOMAIN_MARGIN);
+                let follows = g.mul(margin, sat);
+                map.insert(lim, follows);
+            }
+        }
         let bound = g.substitute_all(exprs, &map);
-        Tape::compile(&g, &self.tape_inputs(), &bound)
+        let mut inputs = self.tape_inputs();
+        inputs.extend_from_slice(free);
+        Tape::compile(&g, &inputs, &bound)
             .expect("the discretised model only uses x, u, t and parameters")
+    }
+
+    /// The symbol of each named parameter (`None` for a name that is not one,
+    /// e.g. R where the filter estimates it).
+    pub fn param_symbols(&self, names: &[&str]) -> Option<Vec<Id>> {
+        names.iter().map(|n| self.params.symbol(n)).collect()
     }
 
     /// The tapes both filters evaluate.

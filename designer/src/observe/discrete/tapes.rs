@@ -4,7 +4,7 @@
 
 use reldesign_runtime::observe::{self as rt, Configured, Linearisation, Reading, Settings};
 
-use crate::sym::Tape;
+use crate::sym::{Id, Tape};
 
 use super::{DiscreteModel, MAX_DIM};
 
@@ -24,7 +24,8 @@ pub struct DiscreteTapes {
     /// f_v [JA 87].
     acceleration: Tape,
     scratch: [Vec<f64>; 5],
-    inputs: [f64; MAX_DIM + 2],
+    /// x (n), u, t, then θ (the adapted parameters, if any).
+    inputs: Vec<f64>,
 }
 
 /// F(x, u) and the acceleration f_v at x.
@@ -49,6 +50,12 @@ pub struct MeasurementEval {
 impl DiscreteTapes {
     /// `discrete` compiled.
     pub fn new(discrete: &DiscreteModel) -> DiscreteTapes {
+        Self::adaptive(discrete, &[])
+    }
+
+    /// `discrete` compiled with the parameters `free` as inputs θ (at their
+    /// model values until [`DiscreteTapes::set_theta`]).
+    pub fn adaptive(discrete: &DiscreteModel, free: &[Id]) -> DiscreteTapes {
         let dm = discrete;
         let mut prediction = dm.transition.clone();
         prediction.push(dm.acceleration);
@@ -57,12 +64,18 @@ impl DiscreteTapes {
         let mut measurement = vec![dm.measurement, dm.measurement_input_gain];
         measurement.extend(&dm.measurement_jacobian);
         let (prediction, jacobian, measurement, input_gain, acceleration) = (
-            dm.compile(&prediction),
-            dm.compile(&jacobian),
-            dm.compile(&measurement),
-            dm.compile(&dm.input_gain),
-            dm.compile(&[dm.acceleration]),
+            dm.compile_adaptive(&prediction, free),
+            dm.compile_adaptive(&jacobian, free),
+            dm.compile_adaptive(&measurement, free),
+            dm.compile_adaptive(&dm.input_gain, free),
+            dm.compile_adaptive(&[dm.acceleration], free),
         );
+        let mut inputs = vec![0.0; dm.dim() + 2];
+        // θ at the model's values
+        inputs.extend(free.iter().map(|&f| {
+            let value = dm.params.iter().find(|&(_, id, _)| id == f);
+            value.map_or(f64::NAN, |(_, _, v)| v)
+        }));
         DiscreteTapes {
             n: dm.dim(),
             scratch: [
@@ -77,8 +90,22 @@ impl DiscreteTapes {
             measurement,
             input_gain,
             acceleration,
-            inputs: [0.0; MAX_DIM + 2],
+            inputs,
         }
+    }
+
+    /// The adapted parameters' values θ (in the order they were freed).
+    ///
+    /// # Panics
+    /// Where θ's length is not the number of freed parameters.
+    pub fn set_theta(&mut self, theta: &[f64]) {
+        let first = self.n + 2;
+        assert_eq!(
+            self.inputs.len() - first,
+            theta.len(),
+            "one value per adapted parameter"
+        );
+        self.inputs[first..].copy_from_slice(theta);
     }
 
     pub fn dim(&self) -> usize {
@@ -90,7 +117,7 @@ impl DiscreteTapes {
         self.inputs[..n].copy_from_slice(&x[..n]);
         self.inputs[n] = u;
         self.inputs[n + 1] = t;
-        n + 2
+        self.inputs.len()
     }
 
     /// [JA 84], and f_v at x.
@@ -185,6 +212,25 @@ impl<const N: usize> TapeModel<N> {
             tapes: discrete.tapes(),
             settings: discrete.filter_settings(),
         }
+    }
+
+    /// `discrete` with the parameters `free` read at run time, θ of
+    /// [`reldesign_runtime::calibrate::Adaptive`] (the emitted self-calibrating model's).
+    pub fn adaptive(discrete: &DiscreteModel, free: &[Id]) -> TapeModel<N> {
+        TapeModel {
+            tapes: DiscreteTapes::adaptive(discrete, free),
+            settings: discrete.filter_settings(),
+        }
+    }
+}
+
+impl<const N: usize, const P: usize> reldesign_runtime::calibrate::Adaptive<f64, N, P>
+    for TapeModel<N>
+{
+    fn with_theta(&self, theta: &[f64; P]) -> Self {
+        let mut model = self.clone();
+        model.tapes.set_theta(theta);
+        model
     }
 }
 

@@ -1,0 +1,204 @@
+//! Bench driver of `benches/calibration_step.sh` (see `benches/calibration_step/run.py`).
+//!
+//!     calibration-step-bench sizes        RAM of the emitted types, bytes
+//!     calibration-step-bench KIND N REPS  N calls of KIND, REPS times; prints
+//!                                         `best_ns_per_call=<f> checksum=<f>`
+//!
+//! KIND:
+//! - step{64,32}{fixed,adaptive}: one control sample, the UKF's `step(u, i)`
+//!   then the controller's `step(t, ẑ, v̂, φ̂)`, over the run's record, cycled
+//!   (closing from its start, opening from its half): the file emitted with
+//!   every parameter a const (`fixed`) and with θ at run time (`adaptive`);
+//! - base{64,32}: the loop without the calls;
+//! - update{64,32}: one whole update, `ukf::…::calibrate` on the run's record
+//!   (from θ_d every call: the same work each time).
+
+use std::hint::black_box;
+use std::time::Instant;
+
+mod record {
+    include!(concat!(env!("OUT_DIR"), "/record.rs"));
+}
+#[allow(dead_code, clippy::all)]
+mod adaptive {
+    include!(concat!(env!("OUT_DIR"), "/adaptive.rs"));
+}
+#[allow(dead_code, clippy::all)]
+mod fixed {
+    include!(concat!(env!("OUT_DIR"), "/fixed.rs"));
+}
+
+use record::RECORD;
+
+macro_rules! step_loop {
+    ($name:ident, $law:path, $filter:path, $f:ty) => {
+        fn $name(rec: &[[$f; 3]], n: usize) -> f64 {
+            use $filter as filter;
+            use $law as law;
+            let half = rec.len() / 2;
+            let mut observer = filter::Filter::new();
+            let mut controller = law::Controller::new(law::Operation::Closing);
+            let mut acc: $f = 0.0;
+            let mut k = 0;
+            for _ in 0..n {
+                if k == 0 {
+                    observer = filter::Filter::new();
+                    controller = law::Controller::new(law::Operation::Closing);
+                    controller.start(0.0);
+                } else if k == half {
+                    controller = law::Controller::new(law::Operation::Opening);
+                    controller.start(0.0);
+                }
+                let [_, u, i] = *black_box(&rec[k]);
+                let e = observer.step(u, i);
+                let t = (if k < half { k } else { k - half }) as $f * law::SAMPLE_PERIOD;
+                acc += black_box(controller.step(t, e.z, e.v, e.phi));
+                k += 1;
+                if k == rec.len() {
+                    k = 0;
+                }
+            }
+            acc as f64
+        }
+    };
+}
+step_loop!(step64fixed, fixed::f64, fixed::ukf::f64, f64);
+step_loop!(step32fixed, fixed::f32, fixed::ukf::f32, f32);
+step_loop!(step64adaptive, adaptive::f64, adaptive::ukf::f64, f64);
+step_loop!(step32adaptive, adaptive::f32, adaptive::ukf::f32, f32);
+
+macro_rules! base_loop {
+    ($name:ident, $f:ty) => {
+        fn $name(rec: &[[$f; 3]], n: usize) -> f64 {
+            let mut acc: $f = 0.0;
+            let mut k = 0;
+            for _ in 0..n {
+                let [_, u, _] = *black_box(&rec[k]);
+                acc += black_box(u);
+                k += 1;
+                if k == rec.len() {
+                    k = 0;
+                }
+            }
+            acc as f64
+        }
+    };
+}
+base_loop!(base64, f64);
+base_loop!(base32, f32);
+
+macro_rules! update_loop {
+    ($name:ident, $filter:path, $f:ty) => {
+        fn $name(rec: &[[$f; 3]], n: usize) -> f64 {
+            use $filter as filter;
+            let mut record = filter::Record::new();
+            record.start(filter::Z_MAX);
+            for [c, u, i] in rec {
+                record.push(&filter::CALIBRATION, *c, *u, *i);
+            }
+            let mut acc = 0.0;
+            for _ in 0..n {
+                let mut calibration = filter::Calibration::new(&filter::CALIBRATION);
+                let outcome = filter::calibrate(&mut calibration, black_box(&record));
+                if let reldesign_runtime::calibrate::Outcome::Updated { after, .. } = outcome {
+                    acc += f64::from(after);
+                }
+                acc += f64::from(black_box(calibration.theta)[0]);
+            }
+            acc
+        }
+    };
+}
+update_loop!(update64, adaptive::ukf::f64, f64);
+update_loop!(update32, adaptive::ukf::f32, f32);
+
+fn sizes() {
+    use adaptive::ukf::{f32 as a32, f64 as a64};
+    use std::mem::size_of;
+    println!("record32={}", size_of::<a32::Record>());
+    println!("record64={}", size_of::<a64::Record>());
+    println!("calibration32={}", size_of::<a32::Calibration>());
+    println!("calibration64={}", size_of::<a64::Calibration>());
+    println!("filter32_adaptive={}", size_of::<a32::Filter>());
+    println!("filter32_fixed={}", size_of::<fixed::ukf::f32::Filter>());
+    println!(
+        "controller32_adaptive={}",
+        size_of::<adaptive::f32::Controller>()
+    );
+    println!("controller32_fixed={}", size_of::<fixed::f32::Controller>());
+    println!("filter64_adaptive={}", size_of::<a64::Filter>());
+    println!("parameters={}", a32::ADAPTED.len());
+    println!("record_samples={}", a32::RECORD_CAPACITY);
+    println!("run_samples={}", RECORD.len());
+}
+
+/// f32: the fixed and the adaptive file's estimates and inputs over the record.
+fn compare() {
+    let rec32: Vec<[f32; 3]> = RECORD.iter().map(|s| s.map(|x| x as f32)).collect();
+    let (mut of, mut oa) = (
+        fixed::ukf::f32::Filter::new(),
+        adaptive::ukf::f32::Filter::new(),
+    );
+    let mut cf = fixed::f32::Controller::new(fixed::f32::Operation::Closing);
+    let mut ca = adaptive::f32::Controller::new(adaptive::f32::Operation::Closing);
+    cf.start(0.0);
+    ca.start(0.0);
+    for (k, [_, u, i]) in rec32.iter().enumerate().take(500) {
+        let (ef, ea) = (of.step(*u, *i), oa.step(*u, *i));
+        let t = k as f32 * 5e-5;
+        let (uf, ua) = (
+            cf.step(t, ef.z, ef.v, ef.phi),
+            ca.step(t, ea.z, ea.v, ea.phi),
+        );
+        println!(
+            "{k} z {:e} {:e} phi {:e} {:e} u {uf} {ua}",
+            ef.z, ea.z, ef.phi, ea.phi
+        );
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() == 2 && args[1] == "compare" {
+        compare();
+        return;
+    }
+    if args.len() == 2 && args[1] == "sizes" {
+        sizes();
+        return;
+    }
+    if args.len() != 4 {
+        eprintln!("usage: {} sizes | KIND N REPS", args[0]);
+        std::process::exit(2);
+    }
+    let rec64: Vec<[f64; 3]> = RECORD.to_vec();
+    let rec32: Vec<[f32; 3]> = RECORD.iter().map(|s| s.map(|x| x as f32)).collect();
+    let kind = args[1].as_str();
+    let n: usize = args[2].parse().expect("N");
+    let reps: usize = args[3].parse().expect("REPS");
+    let run = |n: usize| -> f64 {
+        match kind {
+            "step64fixed" => step64fixed(&rec64, n),
+            "step32fixed" => step32fixed(&rec32, n),
+            "step64adaptive" => step64adaptive(&rec64, n),
+            "step32adaptive" => step32adaptive(&rec32, n),
+            "base64" => base64(&rec64, n),
+            "base32" => base32(&rec32, n),
+            "update64" => update64(&rec64, n),
+            "update32" => update32(&rec32, n),
+            _ => {
+                eprintln!("unknown kind {kind}");
+                std::process::exit(2);
+            }
+        }
+    };
+    let mut best = f64::INFINITY;
+    let mut checksum = 0.0;
+    for _ in 0..reps {
+        let start = Instant::now();
+        checksum = run(n);
+        let ns = start.elapsed().as_nanos() as f64 / n as f64;
+        best = best.min(ns);
+    }
+    println!("best_ns_per_call={best} checksum={checksum:e}");
+}
