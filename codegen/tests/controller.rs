@@ -99,6 +99,7 @@ fn design(v: &Valve, both: bool) -> ControllerDesign {
             feasibility: check_feasibility(&mut model, &v.lin, &reference, bounds, 100),
             table: table.clone(),
             optimal: None,
+            takeoff: None,
         }
     };
     let mut operations = vec![operation(Operation::Closing, z_max, z_min, &v.segments)];

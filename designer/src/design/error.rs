@@ -43,6 +43,26 @@ pub enum PlanError {
         operation: &'static str,
         message: String,
     },
+    #[error(
+        "the {operation} pre-movement stage is too short: driven at the supply's limit \
+         (supply.{key} = {input}) from its rest, the model's armature leaves its stop only \
+         {needed}, but the reference starts to move at {planned_ms:.4} ms \
+         (trajectory.takeoff = {takeoff_ms:.4} ms), so the motion would start with errors of \
+         {velocity_error:.1} % of max|v_r| and {acceleration_error:.1} % of max|a_r|, beyond \
+         the {bound:.0} % the design assumes [SM 52]; set trajectory.takeoff to at least that \
+         (and trajectory.landing with it, to keep the motion time), or raise |supply.{key}|"
+    )]
+    TakeoffTooShort {
+        operation: &'static str,
+        key: &'static str,
+        input: f64,
+        needed: String,
+        planned_ms: f64,
+        takeoff_ms: f64,
+        velocity_error: f64,
+        acceleration_error: f64,
+        bound: f64,
+    },
     #[error("the controller has no operation")]
     NoOperation,
     #[error("the {0:?} operation is given twice")]

@@ -70,3 +70,4 @@ pub use trajectory::optimal::problem::{
 pub use trajectory::optimal::{energy_optimal, OptimalTrajectory, Switch};
 pub use trajectory::reference::{Flat, Polynomial, Reference};
 pub use trajectory::segments::{Segment, Segments};
+pub use trajectory::takeoff::{Shortest, Takeoff, Verdict};

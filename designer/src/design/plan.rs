@@ -28,6 +28,7 @@ use super::trajectory::fit_segments::{fit_segments, SegmentTolerance};
 use super::trajectory::optimal::problem::{OptimalError, OptimalSpec};
 use super::trajectory::optimal::{energy_optimal, OptimalTrajectory};
 use super::trajectory::reference::{Polynomial, Reference};
+use super::trajectory::takeoff::{shortest_takeoff, Shortest, Takeoff, Verdict};
 
 /// Instants of the sliding-mode supply check per operation.
 const ROBUSTNESS_SAMPLES: usize = 4000;
@@ -209,7 +210,7 @@ fn design_bounds(
 }
 
 /// One operation of `[trajectory]`: its reference (polynomial or
-/// energy-optimal), feasibility and table.
+/// energy-optimal), feasibility, takeoff and table.
 fn design_operation(
     description: &Description,
     model: &mut Model,
@@ -222,6 +223,7 @@ fn design_operation(
     let name = operation.name();
     let (bounds, polynomial) = design_bounds(description, trajectory, operation);
     let (z0, zf) = (polynomial.z0, polynomial.zf);
+    let supply = supply_takeoff(description, model, operation, trajectory)?;
     let (reference, optimal) = design_reference(description, model, linearization, operation)?;
     let feasibility = check_feasibility(model, linearization, reference.as_ref(), bounds, 4000);
     if !feasibility.is_feasible() {
@@ -239,6 +241,10 @@ fn design_operation(
             report,
         });
     }
+    let planned = optimal
+        .as_ref()
+        .map_or(trajectory.takeoff, |o| o.arc.0.max(trajectory.takeoff));
+    let takeoff = check_takeoff(operation, supply, reference.as_ref(), planned)?;
     let breaks: Vec<f64> = optimal.iter().flat_map(|o| o.breaks()).collect();
     let fit =
         fit_segments(reference.as_ref(), &breaks, &SegmentTolerance::default()).map_err(|e| {
@@ -254,6 +260,7 @@ fn design_operation(
         feasibility,
         table: fit.table,
         optimal,
+        takeoff: Some(takeoff),
     })
 }
 
@@ -412,4 +419,78 @@ fn optimal_message(e: &OptimalError, description: &Description) -> String {
         ),
         other => other.to_string(),
     }
+}
+
+/// The shortest takeoff the supply allows `operation` (`trajectory/takeoff.rs`)
+/// with the key and the input it was driven at; refused already where it is
+/// not before t_f (no reference can be followed from a lift-off after its
+/// end: the clearly impossible case, whatever the reference).
+fn supply_takeoff(
+    description: &Description,
+    model: &Model,
+    operation: Operation,
+    trajectory: &Trajectory,
+) -> Result<(&'static str, f64, Shortest), PlanError> {
+    let (key, input) = match operation {
+        Operation::Closing => ("u_max", description.supply.u_max),
+        Operation::Opening => ("u_min", lowest_input(description)),
+    };
+    let timing = (trajectory.takeoff, trajectory.landing);
+    let hold_input = description.supply.u_max;
+    let shortest = shortest_takeoff(description, model, operation, input, hold_input, timing)
+        .map_err(|message| PlanError::Optimal {
+            operation: operation.name(),
+            message: format!("the shortest takeoff: {message}"),
+        })?;
+    if shortest.at_least() < trajectory.landing {
+        return Ok((key, input, shortest));
+    }
+    let bound = ErrorBounds::default();
+    Err(PlanError::TakeoffTooShort {
+        operation: operation.name(),
+        key,
+        input,
+        needed: shortest.text(),
+        planned_ms: trajectory.takeoff * 1e3,
+        takeoff_ms: trajectory.takeoff * 1e3,
+        velocity_error: 100.0,
+        acceleration_error: 100.0,
+        bound: bound.velocity.max(bound.acceleration) * 1e2,
+    })
+}
+
+/// `operation`'s pre-movement stage against the shortest the supply allows
+/// (`supply`, from [`supply_takeoff`]): `reference` planned to lift off at
+/// `planned`; refused, with that time and the key, where the lift-off the
+/// supply allows starts the motion with errors beyond the robustness
+/// analysis's bounds [SM 52]; a later one within them is reported.
+fn check_takeoff(
+    operation: Operation,
+    (key, input, shortest): (&'static str, f64, Shortest),
+    reference: &dyn Reference,
+    planned: f64,
+) -> Result<Takeoff, PlanError> {
+    let bounds = ErrorBounds::default();
+    let takeoff = Takeoff::assess(
+        key,
+        input,
+        shortest,
+        reference,
+        planned,
+        (bounds.velocity, bounds.acceleration),
+    );
+    if takeoff.verdict() != Verdict::TooShort {
+        return Ok(takeoff);
+    }
+    Err(PlanError::TakeoffTooShort {
+        operation: operation.name(),
+        key,
+        input,
+        needed: shortest.text(),
+        planned_ms: planned * 1e3,
+        takeoff_ms: reference.motion().0 * 1e3,
+        velocity_error: takeoff.velocity_error * 1e2,
+        acceleration_error: takeoff.acceleration_error * 1e2,
+        bound: bounds.velocity.max(bounds.acceleration) * 1e2,
+    })
 }

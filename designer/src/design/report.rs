@@ -1,6 +1,6 @@
 //! The human-readable design report `reldesign build` prints: gains, the
 //! linearization's singularity, per operation the reference, its
-//! feasibility and its table, and the observers.
+//! feasibility, its takeoff and its table, and the observers.
 
 use std::fmt::Write as _;
 
@@ -55,6 +55,12 @@ impl Design {
                     }
                 }
                 let _ = write!(s, "{}", o.feasibility.report());
+                if let Some(takeoff) = &o.takeoff {
+                    let _ = writeln!(s, "  {}", takeoff.report_line());
+                    if let Some(warning) = takeoff.warning() {
+                        let _ = writeln!(s, "  {warning}");
+                    }
+                }
                 let _ = writeln!(s, "  reference table: {} segments", o.table.segments.len());
             }
         }

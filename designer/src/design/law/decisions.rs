@@ -13,6 +13,7 @@ use crate::design::error::PlanError;
 use crate::design::trajectory::feasibility::Feasibility;
 use crate::design::trajectory::optimal::OptimalTrajectory;
 use crate::design::trajectory::segments::Segments;
+use crate::design::trajectory::takeoff::Takeoff;
 
 /// Fraction of the smallest reference flux below which the law is not
 /// evaluated (before rounding down to one significant digit).
@@ -49,6 +50,9 @@ pub struct DesignedOperation {
     pub table: Segments,
     /// The energy-optimal solution when the shape is `energy-optimal`.
     pub optimal: Option<OptimalTrajectory>,
+    /// The shortest takeoff the supply allows against the planned one
+    /// (`trajectory/takeoff.rs`); `None` in a design not made by `plan.rs`.
+    pub takeoff: Option<Takeoff>,
 }
 
 /// The law's own design values.

@@ -5,6 +5,7 @@
 //!   [PT 58–66]) on the collocation solver `bvp.rs` (and `bvp/`, generic);
 //! - `feasibility.rs`: conditions [PT 54], [PT 56], [PT 57] along a reference;
 //! - `limits.rs`: the shortest motion and J against the motion time;
+//! - `takeoff.rs`: the shortest pre-movement stage the supply allows;
 //! - `segments.rs`, `fit_segments.rs`: a reference as the table of
 //!   polynomial segments generated code stores, and its knots.
 
@@ -15,3 +16,4 @@ pub(super) mod limits;
 pub(super) mod optimal;
 pub(super) mod reference;
 pub(super) mod segments;
+pub(super) mod takeoff;
