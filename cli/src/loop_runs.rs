@@ -78,10 +78,19 @@ pub fn run(args: &Args) -> Result<(), Report> {
         files.push((path.as_path(), svg.as_bytes()));
     }
     crate::atomic::write_all(&files).map_err(fail)?;
+    // the runtime pushes an armature not at its stop by t_f + (t_f − t₀)
+    let late_after = (description.trajectory.as_ref())
+        .map_or(f64::INFINITY, |t| t.landing + (t.landing - t.takeoff));
     if args.json {
-        println!("{}", to_json(&done, &baseline, calibration.as_ref()));
+        println!(
+            "{}",
+            to_json(&done, &baseline, calibration.as_ref(), late_after)
+        );
     } else {
-        print!("{}", text(&done, &baseline, calibration.as_ref()));
+        print!(
+            "{}",
+            text(&done, &baseline, calibration.as_ref(), late_after)
+        );
     }
     Ok(())
 }
@@ -108,10 +117,16 @@ fn update_json(update: &Option<Update>) -> Value {
     }
 }
 
+/// Whether an arrival [s from the operation's start] came after the push.
+fn late(arrival: Option<f64>, late_after: f64) -> bool {
+    arrival.is_some_and(|t| t > late_after)
+}
+
 fn to_json(
     runs: &[Run],
     baseline: &[(Operation, Option<f64>)],
     calibration: Option<&CalibrationDesign>,
+    late_after: f64,
 ) -> String {
     let runs: Vec<Value> = runs
         .iter()
@@ -130,6 +145,8 @@ fn to_json(
                         "impact_velocity": number(o.outcome.impact_velocity),
                         "bounces": o.outcome.bounces,
                         "max_bounce_height": o.outcome.highest_bounce,
+                        "arrival_time": number(o.outcome.arrival),
+                        "late": late(o.outcome.arrival, late_after),
                         "calibration": update_json(&o.update),
                     })
                 })
@@ -163,6 +180,7 @@ fn text(
     runs: &[Run],
     baseline: &[(Operation, Option<f64>)],
     calibration: Option<&CalibrationDesign>,
+    late_after: f64,
 ) -> String {
     let mut s = String::new();
     match calibration {
@@ -191,9 +209,14 @@ fn text(
                 .outcome
                 .impact_velocity
                 .map_or("never reached the stop".into(), |v| format!("{v:+.4e} m/s"));
+            let pushed = if late(o.outcome.arrival, late_after) {
+                " (late: pushed to its stop)"
+            } else {
+                ""
+            };
             let _ = writeln!(
                 s,
-                "  {:<8} first impact {v}, {} bounce(s), highest {:.2e} m",
+                "  {:<8} first impact {v}, {} bounce(s), highest {:.2e} m{pushed}",
                 o.outcome.operation.name(),
                 o.outcome.bounces,
                 o.outcome.highest_bounce

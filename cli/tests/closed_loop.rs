@@ -220,6 +220,9 @@ fn loop_runs_prints_the_contracts_json() {
             assert_eq!(op["operation"], name);
             assert!(op["impact_velocity"].is_number(), "{op}");
             assert!(op["bounces"].is_u64() && op["max_bounce_height"].is_number());
+            // landed within the operation, so an arrival time; late or not
+            assert!(op["arrival_time"].as_f64().is_some_and(|t| t > 0.0), "{op}");
+            assert!(op["late"].is_boolean(), "{op}");
         }
     }
     assert_eq!(runs[0]["parameters"]["coil.resistance"], 75.0);

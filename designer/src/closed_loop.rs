@@ -683,6 +683,11 @@ pub struct OperationOutcome {
     /// the RMS of z − z_r over the samples of the motion [t₀, t_f]; `None`
     /// when no sample falls there (a run cut short).
     pub rmse_z: Option<f64>,
+    /// The time [s from the operation's start] of the first impact (or
+    /// arrival at rest) at the end stop after takeoff; `None` with
+    /// `impact_velocity`. Later than t_f + the arrival margin, the runtime
+    /// pushed the armature there (`SoftLanding::finished_late`).
+    pub arrival: Option<f64>,
     /// Impacts at the end stop within the operation that bounced.
     pub bounces: usize,
     /// The highest bounce [m]: the largest distance from the end stop, at
@@ -712,6 +717,8 @@ impl LoopRun {
                 OperationOutcome {
                     operation,
                     impact_velocity,
+                    arrival: first_arrival(&self.trajectory, operation, start + takeoff, end)
+                        .map(|t| t - start),
                     rmse_z: (n > 0).then(|| (sum / n as f64).sqrt()),
                     bounces,
                     highest_bounce,
@@ -779,6 +786,20 @@ fn destination(operation: Operation) -> Limit {
 
 /// The first impact's velocity at `operation`'s end stop in (from, to], and
 /// the number of bouncing impacts there.
+/// The time of the first impact or stick at `operation`'s end stop within
+/// (from, to].
+fn first_arrival(tr: &Trajectory, operation: Operation, from: f64, to: f64) -> Option<f64> {
+    let destination = destination(operation);
+    tr.events
+        .iter()
+        .filter(|e| e.t > from && e.t <= to)
+        .find(|e| {
+            matches!(e.kind, EventKind::Impact { limit, .. } | EventKind::Stick { limit }
+                if limit == destination)
+        })
+        .map(|e| e.t)
+}
+
 fn impacts(tr: &Trajectory, operation: Operation, from: f64, to: f64) -> (Option<f64>, usize) {
     let destination = destination(operation);
     let mut first = None;
