@@ -137,7 +137,7 @@ macro_rules! calibration {
                 dip_tolerance: 2.4000000000000004,
                 dip_share: 0.05,
                 motion_evidence: 1.0,
-                difference_step: 0.001,
+                difference_step: 0.05,
             };
     };
 }
