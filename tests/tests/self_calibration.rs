@@ -7,12 +7,16 @@
 //! stop (no hover, run 1 included). The whole study, with the distribution of
 //! the landings over 40 plants (seeds 20–39 never looked at while choosing
 //! the calibration's settings), is `#[ignore]`d:
-//! `cargo test --release -p reldesign-tests --test self_calibration -- --ignored --nocapture`.
+//! `cargo test --release -p reldesign-tests --test self_calibration -- --ignored --nocapture`
+//! (both: the update on the designer's tapes in f64, and the emitted file's
+//! own in f32).
 
-use designer::calibrate::{choose, run_runs, Run};
+use designer::calibrate::{choose, run_runs, run_runs_updated_by, Outcome, Run};
 use designer::closed_loop::switching_baseline;
+use designer::closed_loop::Measured;
 use designer::description::{parse_str, Description, Operation};
 use designer::design::Design;
+use reldesign_generated::self_calibrating_valve::ukf::f32 as emitted;
 use reldesign_tests::example_path;
 use reldesign_tests::variants::{physics_of, variant, Variant};
 
@@ -26,23 +30,73 @@ fn example() -> (String, Description, Design) {
     (text, d, design)
 }
 
-fn runs(design: &Design, plant: &Variant, n: usize) -> Vec<Run> {
+/// Which update runs between runs.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Updater {
+    /// The runtime's, on the designer's tapes in f64 (`loop --runs`).
+    Tapes,
+    /// The emitted file's own in f32 (`ukf::f32::calibrate` on its `Record`).
+    EmittedF32,
+}
+
+/// The emitted f32 update of θ from a run's measured samples.
+fn emitted_f32(measured: &[Measured], theta: &mut [f64]) -> Result<Outcome<f64>, String> {
+    let mut record = emitted::Record::new();
+    record.start(emitted::Z_MAX);
+    for m in measured {
+        let (c, v, i) = (m.commanded as f32, m.voltage as f32, m.current as f32);
+        record.push(&emitted::CALIBRATION, c, v, i);
+    }
+    let mut calibration = emitted::Calibration::new(&emitted::CALIBRATION);
+    for (t, x) in calibration.theta.iter_mut().zip(theta.iter()) {
+        *t = *x as f32;
+    }
+    let outcome = emitted::calibrate(&mut calibration, &record);
+    for (x, t) in theta.iter_mut().zip(calibration.theta) {
+        *x = f64::from(t);
+    }
+    Ok(match outcome {
+        Outcome::Updated { before, after } => Outcome::Updated {
+            before: f64::from(before),
+            after: f64::from(after),
+        },
+        Outcome::Refused(why) => Outcome::Refused(why),
+    })
+}
+
+fn runs_by(design: &Design, plant: &Variant, n: usize, updater: Updater) -> Vec<Run> {
     let ts = design
         .controller
         .as_ref()
         .expect("controller")
         .sample_period;
     let calibration = choose(design, ts).unwrap_or_else(|e| panic!("{e}"));
-    run_runs(
-        design,
-        Some(&calibration),
-        Some(&plant.description),
-        n,
-        ts,
-        plant.seed,
-        &Default::default(),
-    )
-    .unwrap_or_else(|e| panic!("plant {}: {e}", plant.seed))
+    let done = match updater {
+        Updater::Tapes => run_runs(
+            design,
+            Some(&calibration),
+            Some(&plant.description),
+            n,
+            ts,
+            plant.seed,
+            &Default::default(),
+        ),
+        Updater::EmittedF32 => run_runs_updated_by(
+            design,
+            &calibration,
+            Some(&plant.description),
+            n,
+            ts,
+            plant.seed,
+            &Default::default(),
+            &mut emitted_f32,
+        ),
+    };
+    done.unwrap_or_else(|e| panic!("plant {}: {e}", plant.seed))
+}
+
+fn runs(design: &Design, plant: &Variant, n: usize) -> Vec<Run> {
+    runs_by(design, plant, n, Updater::Tapes)
 }
 
 #[test]
@@ -80,7 +134,7 @@ struct Study {
     switches: bool,
 }
 
-fn study(design: &Design, d: &Description, plant: &Variant, n: usize) -> Study {
+fn study(design: &Design, d: &Description, plant: &Variant, n: usize, updater: Updater) -> Study {
     let baseline = switching_baseline(d, Some(&plant.description), &Default::default())
         .unwrap_or_else(|e| panic!("{e}"));
     let switching = |op: Operation| {
@@ -90,7 +144,7 @@ fn study(design: &Design, d: &Description, plant: &Variant, n: usize) -> Study {
             .and_then(|(_, v)| *v)
             .map_or(f64::NAN, f64::abs)
     };
-    let done = runs(design, plant, n);
+    let done = runs_by(design, plant, n, updater);
     let softness = |run: &Run, k: usize| {
         let o = &run.operations[k].outcome;
         o.impact_velocity
@@ -136,10 +190,22 @@ fn quantiles(mut x: Vec<f64>) -> String {
 #[test]
 #[ignore = "the whole study: 40 plants × 10 runs; run with --ignored --nocapture"]
 fn the_self_calibration_study_over_forty_plants() {
+    forty_plants(Updater::Tapes);
+}
+
+/// The same study with the emitted file's own f32 update between runs (what
+/// a Cortex-M4F firmware runs).
+#[test]
+#[ignore = "the whole study in f32: 40 plants × 10 runs; run with --ignored --nocapture"]
+fn the_emitted_f32_update_over_forty_plants() {
+    forty_plants(Updater::EmittedF32);
+}
+
+fn forty_plants(updater: Updater) {
     let (text, d, design) = example();
     let n = 10;
     let studies: Vec<Study> = (0..40)
-        .map(|seed| study(&design, &d, &variant(physics_of(&text), seed), n))
+        .map(|seed| study(&design, &d, &variant(physics_of(&text), seed), n, updater))
         .collect();
     for (name, range) in [
         ("tuning seeds 0–19", 0..20),

@@ -17,7 +17,7 @@ mod runs;
 pub use choice::{candidates, choose, Candidate, ChoiceError};
 pub use predictor::TapePredictor;
 pub use reldesign_runtime::calibrate::{Outcome, Refusal};
-pub use runs::{run_runs, OperationRun, Run, RunsError, Update};
+pub use runs::{run_runs, run_runs_updated_by, OperationRun, Run, RunUpdate, RunsError, Update};
 
 use reldesign_runtime::calibrate::{Record, Settings};
 

@@ -6,7 +6,7 @@
 
 use reldesign_runtime::calibrate::{Calibration, Outcome};
 
-use crate::closed_loop::{run_spaced_loop, LoopError, LoopRun, Noise, OperationOutcome};
+use crate::closed_loop::{run_spaced_loop, LoopError, LoopRun, Measured, Noise, OperationOutcome};
 use crate::description::Description;
 use crate::design::Design;
 use crate::sim::Options;
@@ -85,6 +85,35 @@ pub fn run_runs(
         };
     }
     with_p!(0 1 2 3 4 5 6 7 8 9 10 11 12)
+}
+
+/// An update of θ (the adapted parameters' values, in the order of
+/// `CalibrationDesign::parameters`) from a run's measured samples.
+pub type RunUpdate<'a> = dyn FnMut(&[Measured], &mut [f64]) -> Result<Outcome<f64>, String> + 'a;
+
+/// `runs` runs of `design` with its innovations calibration `c`, like
+/// [`run_runs`], θ updated after each run by `update` instead of the
+/// designer's (e.g. by the emitted f32 code's own: the self-calibration
+/// study, `tests/tests/self_calibration.rs`).
+#[allow(clippy::too_many_arguments)]
+pub fn run_runs_updated_by(
+    design: &Design,
+    c: &CalibrationDesign,
+    plant: Option<&Description>,
+    runs: usize,
+    sample_period: f64,
+    seed: u64,
+    options: &Options,
+    update: &mut RunUpdate,
+) -> Result<Vec<Run>, RunsError> {
+    let study = Study {
+        design,
+        plant,
+        sample_period,
+        seed,
+        options,
+    };
+    study.updated_by(c, runs, update)
 }
 
 /// What every run shares.
@@ -173,33 +202,49 @@ impl Study<'_> {
         Ok(out)
     }
 
-    /// The runtime's innovations update after every run, over the whole run.
+    /// The runtime's innovations update (on tapes, f64) after every run,
+    /// over the whole run.
     fn innovations<const P: usize>(
         &self,
         c: &CalibrationDesign,
         runs: usize,
     ) -> Result<Vec<Run>, RunsError> {
-        let settings = c.settings::<P>();
-        let mut state = Calibration::new(&settings);
+        let mut state = Calibration::<f64, P>::new(&c.settings());
+        let design = self.design;
+        let mut update = |measured: &[Measured], theta: &mut [f64]| {
+            state.theta.copy_from_slice(theta);
+            let outcome = super::innovations::update(design, c, &mut state, measured)?;
+            theta.copy_from_slice(&state.theta);
+            Ok(outcome)
+        };
+        self.updated_by(c, runs, &mut update)
+    }
+
+    /// Runs with `update` after each (θ in the order of `c.parameters`).
+    fn updated_by(
+        &self,
+        c: &CalibrationDesign,
+        runs: usize,
+        update: &mut RunUpdate,
+    ) -> Result<Vec<Run>, RunsError> {
+        let mut theta: Vec<f64> = c.parameters.iter().map(|a| a.nominal).collect();
         let mut out = Vec::with_capacity(runs);
         for run in 1..=runs {
-            let values: Vec<(&'static str, f64)> = c
-                .parameters
-                .iter()
+            let values: Vec<(&'static str, f64)> = (c.parameters.iter())
                 .map(|a| a.key)
-                .zip(state.theta)
+                .zip(theta.iter().copied())
                 .collect();
             let (looped, outcomes) = self.run(run, &values)?;
-            let update = super::innovations::update(self.design, c, &mut state, &looped.measured)
+            let outcome = update(&looped.measured, &mut theta)
                 .map_err(|message| RunsError::Adapted { run, message })?;
             let last = outcomes.len().saturating_sub(1);
             let operations = outcomes
                 .into_iter()
                 .enumerate()
-                .map(|(k, outcome)| OperationRun {
-                    outcome,
+                .map(|(k, outcome_of_run)| OperationRun {
+                    outcome: outcome_of_run,
                     // one update per run, after its last operation
-                    update: (k == last).then_some(Update::Innovations(update)),
+                    update: (k == last).then_some(Update::Innovations(outcome)),
                 })
                 .collect();
             out.push(Run {
