@@ -375,6 +375,7 @@ fn the_perfect_tracking_example_carries_the_papers_design() {
             n == "perfect-tracking-valve.toml"
                 || n == "sliding-mode-valve.toml"
                 || n == "self-calibrating-valve.toml"
+                || n == "uncertain-stop-valve.toml"
         });
         assert_eq!(
             d.trajectory.is_some() && d.controller.is_some(),
@@ -382,6 +383,16 @@ fn the_perfect_tracking_example_carries_the_papers_design() {
             "{}",
             path.display()
         );
+        if path.ends_with("uncertain-stop-valve.toml") {
+            // the perfect-tracking design with stops spread 1 % of the stroke
+            let t = d.trajectory.as_ref().unwrap();
+            assert_eq!(
+                (t.shape, t.contact_uncertainty),
+                (Shape::EnergyOptimal, 0.01 * d.mechanics.z_max)
+            );
+        } else if let Some(t) = &d.trajectory {
+            assert_eq!(t.contact_uncertainty, 0.0, "{}", path.display());
+        }
         if path.ends_with("sliding-mode-valve.toml") {
             // model-free-sliding-mode §4.2: τ_mov = 4 ms, λ₁ = λ₂ = 2000, η = 1e5
             let t = d.trajectory.unwrap();
@@ -430,6 +441,7 @@ fn both_sections_parse_into_the_expected_values() {
             landing: 6e-3,
             shape: Shape::EnergyOptimal,
             u_bound: 20.0,
+            contact_uncertainty: 0.0,
         })
     );
     assert_eq!(

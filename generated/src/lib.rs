@@ -40,3 +40,9 @@ pub mod backstepping_valve;
 /// update is not in this file yet (`docs/guide/self-calibration.md`).
 #[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
 pub mod self_calibrating_valve;
+
+/// `examples/uncertain-stop-valve.toml`: the perfect-tracking valve and its
+/// design on sensors, with the probability-based energy-optimal references
+/// for stops spread σ = 10 µm (1 % of the stroke) into the stroke.
+#[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
+pub mod uncertain_stop_valve;

@@ -198,6 +198,9 @@ pub struct Trajectory {
     /// Input bound used to design the trajectory [V or A] (> 0, at most the
     /// supply limits' magnitude), leaving the rest to the feedback.
     pub u_bound: f64,
+    /// σ [m]: the spread of each designed stop's position into the stroke
+    /// (half-normal of scale σ); 0: the stops are where the mechanics says.
+    pub contact_uncertainty: f64,
 }
 
 impl Trajectory {

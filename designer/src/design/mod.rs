@@ -67,6 +67,9 @@ pub use trajectory::limits::{motion_limits, CostPoint, MotionLimits};
 pub use trajectory::optimal::problem::{
     CostateGuess, HamiltonianSystem, OptimalError, OptimalSpec,
 };
+pub use trajectory::optimal::robust::{
+    contact_figures, ContactDesign, ContactFigures, CONTACT_WEIGHT,
+};
 pub use trajectory::optimal::{energy_optimal, OptimalTrajectory, Switch};
 pub use trajectory::reference::{Flat, Polynomial, Reference};
 pub use trajectory::segments::{Segment, Segments};

@@ -165,6 +165,7 @@ pub fn design_reference(
         Shape::EnergyOptimal => {
             let spec = OptimalSpec {
                 u_max_limit: description.supply.u_max,
+                contact_uncertainty: trajectory.contact_uncertainty,
                 ..OptimalSpec::new(
                     polynomial.z0,
                     polynomial.zf,

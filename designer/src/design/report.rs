@@ -53,6 +53,9 @@ impl Design {
                     if let Some(what) = &opt.smoothed_gap {
                         let _ = writeln!(s, "  note: {what}");
                     }
+                    if let Some(c) = &opt.contact {
+                        let _ = write!(s, "{}", contact_text(c));
+                    }
                 }
                 let _ = write!(s, "{}", o.feasibility.report());
                 if let Some(takeoff) = &o.takeoff {
@@ -182,4 +185,43 @@ fn law_text(law: &LawDesign) -> String {
             )
         }
     }
+}
+
+/// The probability-based design beside the deterministic one: the cost and
+/// the contact speeds over the stop's distribution.
+fn contact_text(c: &crate::design::trajectory::optimal::robust::ContactDesign) -> String {
+    let mut s = String::new();
+    let mm = |v: f64| v * 1e3;
+    let _ = writeln!(
+        s,
+        "  contact uncertainty σ = {:.3e} m (half-normal into the stroke): J = ∫u² dt + W·E[v_c²], W = {:.4e}, {} continuation step(s)",
+        c.sigma, c.weight, c.steps
+    );
+    let _ = writeln!(
+        s,
+        "    {:<14} {:>12} {:>12} {:>12} {:>12} {:>12} {:>12}",
+        "reference", "J", "E|v_c| mm/s", "worst mm/s", "at σ mm/s", "at 2σ mm/s", "at 3σ mm/s"
+    );
+    for (name, j, f) in [
+        ("robust", c.cost, &c.robust),
+        ("deterministic", c.deterministic_cost, &c.deterministic),
+    ] {
+        let _ = writeln!(
+            s,
+            "    {:<14} {:>12.6e} {:>12.3} {:>12.3} {:>12.3} {:>12.3} {:>12.3}",
+            name,
+            j,
+            mm(f.expected_speed),
+            mm(f.worst_speed),
+            mm(f.speed_at[0]),
+            mm(f.speed_at[1]),
+            mm(f.speed_at[2])
+        );
+    }
+    let _ = writeln!(
+        s,
+        "    (worst: over the stops within 3σ; the deterministic reference's ∫u² dt = {:.6e})",
+        c.deterministic_energy
+    );
+    s
 }

@@ -143,6 +143,44 @@ pub(super) fn check_trajectory_core(
     Ok(())
 }
 
+/// `contact_uncertainty` (σ of the stops' positions) only with the
+/// energy-optimal shape (the probability-based design is a Pontryagin
+/// problem), and at most a tenth of the stroke: 3σ of the half-normal, where
+/// 99.7 % of the stops lie, within a third of it.
+pub(super) fn check_contact_uncertainty(
+    trajectory_sect: &Sect,
+    trajectory: &Trajectory,
+    mechanics: &Mechanics,
+) -> Res<()> {
+    let sigma = trajectory.contact_uncertainty;
+    if sigma <= 0.0 {
+        return Ok(());
+    }
+    let key = "contact_uncertainty";
+    let found = trajectory_sect
+        .entry(key)
+        .map_or_else(|| sigma.to_string(), |(_, v)| trajectory_sect.ctx.found(v));
+    if trajectory.shape != Shape::EnergyOptimal {
+        let msg = format!(
+            "found {found} [m] with shape = \"polynomial\": the probability-based reference \
+             (the expected contact speed over the stop's distribution) is an energy-optimal \
+             design; set shape = \"energy-optimal\", or contact_uncertainty = 0"
+        );
+        return Err(trajectory_sect.err(key, msg, "needs the energy-optimal shape"));
+    }
+    let stroke = mechanics.z_max - mechanics.z_min;
+    let most = 0.1 * stroke;
+    if sigma > most {
+        let msg = format!(
+            "expected a number in [0, {most:e}] [m] (a tenth of the stroke \
+             mechanics.z_max − mechanics.z_min = {stroke:e} m), found {found}: a stop that \
+             uncertain is outside what a soft-landing reference can be designed for"
+        );
+        return Err(trajectory_sect.err(key, msg, "more than a tenth of the stroke"));
+    }
+    Ok(())
+}
+
 /// A controller tracks a `[trajectory]` sampled at least 10 times per
 /// motion, or (the model-based sliding mode) holds a constant `position`
 /// within the stroke.

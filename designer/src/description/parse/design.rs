@@ -36,12 +36,14 @@ pub(super) fn parse_trajectory(s: &Sect, supply: &Supply) -> Res<Trajectory> {
     let unit = input_unit(supply.drive);
     let u_bound = s.req_in("u_bound", unit)?;
     check_u_bound(s, u_bound, supply, unit)?;
+    let contact_uncertainty = s.or_default("contact_uncertainty")?;
     Ok(Trajectory {
         operations,
         takeoff,
         landing,
         shape,
         u_bound,
+        contact_uncertainty,
     })
 }
 

@@ -39,6 +39,7 @@
 
 pub(in crate::design) mod guess;
 pub(in crate::design) mod problem;
+pub(in crate::design) mod robust;
 pub(in crate::design) mod search;
 
 use crate::design::derive::linearization::Linearization;
@@ -107,6 +108,10 @@ pub struct OptimalTrajectory {
     pub duration_slope: f64,
     /// Set when the arc was solved on a C² twin of a C¹ tabulated gap: what was done.
     pub smoothed_gap: Option<String>,
+    /// With `contact_uncertainty` > 0: the probability-based design, its
+    /// cost and contact figures beside the deterministic reference's
+    /// (`optimal/robust.rs`).
+    pub contact: Option<robust::ContactDesign>,
     aux: Tape,
 }
 
@@ -162,6 +167,26 @@ impl OptimalTrajectory {
 
     /// A JSON summary (figures for reports and the oracle comparison).
     pub fn summary_json(&self) -> serde_json::Value {
+        let mut v = self.summary_json_without_contact();
+        if let (Some(c), Some(map)) = (&self.contact, v.as_object_mut()) {
+            map.insert(
+                "contact".into(),
+                serde_json::json!({
+                    "sigma": c.sigma,
+                    "weight": c.weight,
+                    "cost": c.cost,
+                    "deterministic_cost": c.deterministic_cost,
+                    "deterministic_energy": c.deterministic_energy,
+                    "robust": figures_json(&c.robust),
+                    "deterministic": figures_json(&c.deterministic),
+                    "steps": c.steps,
+                }),
+            );
+        }
+        v
+    }
+
+    fn summary_json_without_contact(&self) -> serde_json::Value {
         serde_json::json!({
             "cost": self.cost,
             "guess_cost": self.guess_cost,
@@ -210,6 +235,15 @@ impl Reference for OptimalTrajectory {
     fn motion(&self) -> (f64, f64) {
         (self.spec.t0, self.spec.tf)
     }
+}
+
+fn figures_json(f: &robust::ContactFigures) -> serde_json::Value {
+    serde_json::json!({
+        "expected_speed": f.expected_speed,
+        "rms_speed": f.rms_speed,
+        "worst_speed": f.worst_speed,
+        "speed_at_sigma": f.speed_at,
+    })
 }
 
 /// 5-point Gauss–Legendre nodes and weights on [−1, 1].
@@ -407,11 +441,46 @@ fn solve(
         rate: c0.min(cf),
     };
     let plan = search.plan(rest, &precise)?;
+    let robust = if spec.contact_uncertainty > 0.0 {
+        Some(plan.arc.clone())
+    } else {
+        None
+    };
     let mut traj = trajectory(&sys, spec, plan, [x0, xf], rest_inputs);
     traj.guess_cost = guess.cost;
     traj.guess_max_abs_input = guess.max_abs_u;
     locate_switches(&mut traj);
     integrate_cost(&mut traj, &tapes);
+    let Some(det_arc) = robust else {
+        return Ok(traj);
+    };
+    // the probability-based design, by continuation from this one
+    let det = traj;
+    let target = robust::contact_cost(spec, det.cost, det_arc.b - det_arc.a);
+    let (arc, rsys, steps) = robust::continuation(model, lin, &precise, &det_arc, target)?;
+    let slope = ArcSolver::slope(&arc, rest);
+    let mut traj = trajectory(&rsys, spec, Plan { arc, slope }, [x0, xf], rest_inputs);
+    traj.guess_cost = guess.cost;
+    traj.guess_max_abs_input = guess.max_abs_u;
+    locate_switches(&mut traj);
+    integrate_cost(&mut traj, &tapes);
+    let sigma = spec.contact_uncertainty;
+    let (fr, _) = robust::contact_figures(&traj, spec.z0, spec.zf, sigma);
+    let (fd, _) = robust::contact_figures(&det, spec.z0, spec.zf, sigma);
+    let (er, ed) = (
+        contact_integral(&traj, sigma),
+        contact_integral(&det, sigma),
+    );
+    traj.contact = Some(robust::ContactDesign {
+        sigma,
+        weight: target.weight,
+        cost: traj.cost + target.weight * er,
+        deterministic_cost: det.cost + target.weight * ed,
+        deterministic_energy: det.cost,
+        robust: fr,
+        deterministic: fd,
+        steps,
+    });
     Ok(traj)
 }
 
@@ -478,6 +547,7 @@ fn trajectory(
         rest_cost: 0.0,
         duration_slope: plan.slope,
         smoothed_gap: None,
+        contact: None,
         aux: sys.aux.clone(),
     }
 }
@@ -522,6 +592,23 @@ fn locate_switches(traj: &mut OptimalTrajectory) {
     }
     switches.sort_by(|a, b| a.t.total_cmp(&b.t));
     traj.switches = switches;
+}
+
+/// E[v_c²] = ∫ρ(d(z))·|v|³ dt on the arc's interpolant (Gauss–Legendre per
+/// mesh interval; the rests have v = 0).
+fn contact_integral(traj: &OptimalTrajectory, sigma: f64) -> f64 {
+    let (z0, zf) = (traj.spec.z0, traj.spec.zf);
+    let inward = (z0 - zf).signum();
+    let mut e = 0.0;
+    for w in traj.t.windows(2) {
+        e += gauss5(w[0], w[1], &mut |tt| {
+            let y = traj.solution.eval(tt);
+            let d = (y[0] - zf) * inward;
+            // the Gaussian continued where a Newton dip leaves the stroke
+            robust::density(d, sigma) * y[1].abs().powi(3)
+        });
+    }
+    e
 }
 
 /// J = ∫u*² dt and max|u*| on the interpolant (Gauss–Legendre per interval,

@@ -43,6 +43,10 @@ pub struct OptimalSpec {
     /// The largest u_max worth trying when the problem has no solution (the
     /// supply): the needed bound is searched up to it. Default: ∞.
     pub u_max_limit: f64,
+    /// σ [m] of the arrival stop's position into the stroke (half-normal from
+    /// z_f); > 0 adds the expected squared contact speed to the cost
+    /// (`optimal/robust.rs`). Default: 0, the deterministic problem.
+    pub contact_uncertainty: f64,
 }
 
 impl OptimalSpec {
@@ -60,6 +64,7 @@ impl OptimalSpec {
             max_nodes: 20000,
             costate_guess: CostateGuess::Chain,
             u_max_limit: f64::INFINITY,
+            contact_uncertainty: 0.0,
         }
     }
 }
@@ -102,6 +107,13 @@ pub enum OptimalError {
         given: f64,
         u_min: f64,
         u_max: f64,
+        #[source]
+        source: Box<OptimalError>,
+    },
+    #[error("the probability-based reference for a stop spread σ = {sigma:e} m did not converge: the continuation from the deterministic optimum reached {:.3}·W of the contact weight W ({source}); a smaller trajectory.contact_uncertainty, a longer motion or a larger trajectory.u_bound leaves it more room", reached)]
+    Contact {
+        reached: f64,
+        sigma: f64,
         #[source]
         source: Box<OptimalError>,
     },
@@ -165,6 +177,33 @@ fn stroke_extension(g: &mut crate::sym::Graph, z: Id, z_min: f64) -> Id {
     g.piecewise(z, &[z_b], &[below, z])
 }
 
+/// The running cost of the contact (`optimal/robust.rs`):
+/// L_c = W·ρ(z)·|v|³, ρ the half-normal density of scale σ of the stop's
+/// position into the stroke from `z_stop` (its Gaussian continued outside,
+/// where the arc does not go), so that ∫L_c dt = W·E[v_c²] over the stops.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactCost {
+    pub weight: f64,
+    pub sigma: f64,
+    pub z_stop: f64,
+}
+
+impl ContactCost {
+    fn build(&self, g: &mut crate::sym::Graph, z: Id, v: Id) -> Id {
+        let zs = g.constant(self.z_stop);
+        let d = g.sub(z, zs);
+        let d2 = g.powi(d, 2);
+        let e = g.scale(-0.5 / (self.sigma * self.sigma), d2);
+        let rho = g.exp(e);
+        let peak = 2.0 / (self.sigma * (2.0 * std::f64::consts::PI).sqrt());
+        let av = g.abs(v);
+        let v2 = g.powi(v, 2);
+        let v3 = g.mul(v2, av);
+        let l = g.mul(rho, v3);
+        g.scale(self.weight * peak, l)
+    }
+}
+
 /// Indices of [`HamiltonianSystem::aux`] outputs.
 pub(in crate::design) const AUX_U: usize = 0;
 pub(in crate::design) const AUX_RAW: usize = 1;
@@ -179,6 +218,19 @@ impl HamiltonianSystem {
         lin: &Linearization,
         u_min: f64,
         u_max: f64,
+    ) -> Result<HamiltonianSystem, OptimalError> {
+        Self::derive_with(model, lin, u_min, u_max, None)
+    }
+
+    /// The system of the cost ∫(u² + L_c(x)) dt, with L_c the contact term
+    /// of `contact` (`optimal/robust.rs`): u* is unchanged (L_c does not
+    /// depend on u), ṗ gains −∂L_c/∂x and H gains L_c.
+    pub fn derive_with(
+        model: &mut Model,
+        lin: &Linearization,
+        u_min: f64,
+        u_max: f64,
+        contact: Option<&ContactCost>,
     ) -> Result<HamiltonianSystem, OptimalError> {
         if model.dim() != 3 || lin.system.input_field.len() != 3 {
             return Err(OptimalError::NotAffine(model.dim()));
@@ -222,19 +274,28 @@ impl HamiltonianSystem {
         let to_ustar: HashMap<Id, Id> = std::iter::once((u, ustar)).collect();
         // ẋ = f(x, u*)
         let mut rhs: Vec<Id> = f.iter().map(|&fi| g.substitute(fi, &to_ustar)).collect();
-        // ṗ = −(∂f/∂x)ᵀp at u*
+        // ṗ = −(∂f/∂x)ᵀp at u* (− ∂L_c/∂x with the contact term)
+        let lc = contact.map(|c| c.build(g, x[0], x[1]));
+        let dlc = lc.map(|l| g.jacobian(&[l], &x).remove(0));
         let a = g.jacobian(&f, &x);
         for k in 0..3 {
-            let terms: Vec<Id> = (0..3).map(|i| g.mul(a[i][k], p[i])).collect();
+            let mut terms: Vec<Id> = (0..3).map(|i| g.mul(a[i][k], p[i])).collect();
+            if let Some(d) = &dlc {
+                terms.push(d[k]);
+            }
             let s = g.sum(&terms);
             let s = g.substitute(s, &to_ustar);
             rhs.push(g.neg(s));
         }
-        // H = u² + pᵀf
+        // H = u² + pᵀf (+ L_c)
         let pf_terms: Vec<Id> = (0..3).map(|i| g.mul(p[i], rhs[i])).collect();
         let pf = g.sum(&pf_terms);
         let u2 = g.powi(ustar, 2);
         let h = g.add(u2, pf);
+        let h = match lc {
+            Some(l) => g.add(h, l),
+            None => h,
+        };
         let ju = g.mul(lin.lglf2h, ustar);
         let jerk = g.add(lin.lf3h, ju);
         let accel = lin.transform[2];

@@ -243,7 +243,7 @@ impl ArcSolver<'_> {
         }
     }
 
-    fn slope(arc: &Arc, rest: Rest) -> f64 {
+    pub(crate) fn slope(arc: &Arc, rest: Rest) -> f64 {
         let h = if rest.at_end {
             arc.hamiltonian[1]
         } else {
