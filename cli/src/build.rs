@@ -86,7 +86,8 @@ pub fn run(args: &Args) -> Result<(), Report> {
 fn calibration_report(design: &designer::design::Design, sample_period: f64) -> String {
     use std::fmt::Write as _;
     let mut s = String::from("self-calibration (controller.self_calibration):\n");
-    match designer::calibrate::choose(design, sample_period) {
+    let chosen = designer::calibrate::choose(design, sample_period);
+    match &chosen {
         Ok(c) => {
             let _ = writeln!(
                 s,
@@ -130,7 +131,7 @@ fn calibration_report(design: &designer::design::Design, sample_period: f64) -> 
         }
     }
     let emitted = matches!(
-        designer::calibrate::choose(design, sample_period),
+        &chosen,
         Ok(c) if c.method == designer::calibrate::Method::Innovations
     );
     s.push_str(if emitted {

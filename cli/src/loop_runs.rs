@@ -78,9 +78,9 @@ pub fn run(args: &Args) -> Result<(), Report> {
         files.push((path.as_path(), svg.as_bytes()));
     }
     crate::atomic::write_all(&files).map_err(fail)?;
-    // the runtime pushes an armature not at its stop by t_f + (t_f − t₀)
-    let late_after = (description.trajectory.as_ref())
-        .map_or(f64::INFINITY, |t| t.landing + (t.landing - t.takeoff));
+    // the runtime pushes an armature not at its stop by t_f + the design's margin
+    let late_after =
+        (design.controller.as_ref()).map_or(f64::INFINITY, |c| c.landing + c.arrival_margin);
     if args.json {
         println!(
             "{}",

@@ -12,8 +12,8 @@ use designer::calibrate::CalibrationDesign;
 use designer::model::Params;
 use designer::sym::Id;
 
+use crate::emit::macro_literal;
 use crate::error::EmitError;
-use crate::float::Float;
 use crate::names::const_name;
 
 /// (local name, symbol) of each adapted parameter in θ's order: the
@@ -38,17 +38,6 @@ pub(crate) fn theta_symbols(theta: &[(String, Id)]) -> Vec<Id> {
     theta.iter().map(|t| t.1).collect()
 }
 
-/// f64 text of `value` for the macro (rounded to f32 where `$f` is f32).
-fn text(name: &str, value: f64) -> Result<String, EmitError> {
-    Float::F64
-        .literal_text(value)
-        .ok_or_else(|| EmitError::NonFinite {
-            name: name.to_owned(),
-            value: format!("{value:?}"),
-            float: "f64",
-        })
-}
-
 /// `macro_rules! calibration`: θ's keys, θ_d, the domain, the record's
 /// capacity and the runtime's settings, written once for every float module
 /// that invokes it (after `params!`).
@@ -57,18 +46,20 @@ pub fn calibration_macro(name: &str, c: &CalibrationDesign) -> Result<String, Em
     let mut list = String::new();
     let (mut keys, mut nominal, mut lower, mut upper) = (vec![], vec![], vec![], vec![]);
     for a in &c.parameters {
+        let (lo, hi) = (
+            macro_literal(a.key, a.lower)?,
+            macro_literal(a.key, a.upper)?,
+        );
         list.push_str(&format!(
-            "        /// - `{}` (`{}`): {} within [{}, {}]\n",
+            "        /// - `{}` (`{}`): {} within [{lo}, {hi}]\n",
             a.key,
             a.symbol,
-            text(a.key, a.nominal)?,
-            text(a.key, a.lower)?,
-            text(a.key, a.upper)?
+            macro_literal(a.key, a.nominal)?,
         ));
         keys.push(format!("\"{}\"", a.key));
         nominal.push(const_name(a.symbol)?);
-        lower.push(text(a.key, a.lower)?);
-        upper.push(text(a.key, a.upper)?);
+        lower.push(lo);
+        upper.push(hi);
     }
     let array = |items: &[String]| -> String {
         let mut s = String::from("[\n");
@@ -97,15 +88,15 @@ pub fn calibration_macro(name: &str, c: &CalibrationDesign) -> Result<String, Em
          \x20               motion_evidence: {motion_evidence},\n\
          \x20               difference_step: {difference_step},\n\
          \x20           }};\n",
-        max_step = text("max_step", c.max_step)?,
-        ts = text("sample_period", c.sample_period)?,
+        max_step = macro_literal("max_step", c.max_step)?,
+        ts = macro_literal("sample_period", c.sample_period)?,
         iterations = c.iterations,
         min_samples = c.min_samples,
-        current_limit = text("current_limit", c.current_limit)?,
-        dip_tolerance = text("dip_tolerance", c.dip_tolerance)?,
-        dip_share = text("dip_share", c.dip_share)?,
-        motion_evidence = text("motion_evidence", c.motion_evidence)?,
-        difference_step = text("difference_step", c.difference_step)?,
+        current_limit = macro_literal("current_limit", c.current_limit)?,
+        dip_tolerance = macro_literal("dip_tolerance", c.dip_tolerance)?,
+        dip_share = macro_literal("dip_share", c.dip_share)?,
+        motion_evidence = macro_literal("motion_evidence", c.motion_evidence)?,
+        difference_step = macro_literal("difference_step", c.difference_step)?,
     );
     let body = format!(
         "        /// The parameters θ the self-calibration adapts, in θ's order (their\n\

@@ -91,14 +91,7 @@ pub fn params_macro(model: &Model) -> Result<String, EmitError> {
     let mut lines: Vec<(&str, String, Option<&str>)> = Vec::new();
     let given = model.params.iter().map(|(name, _, value)| (name, value));
     for (name, value) in given.chain([("z_min", m.z_min), ("z_max", m.z_max)]) {
-        let text = Float::F64
-            .literal_text(value)
-            .ok_or_else(|| EmitError::NonFinite {
-                name: name.to_owned(),
-                value: format!("{value:?}"),
-                float: "f64",
-            })?;
-        lines.push((name, text, None));
+        lines.push((name, macro_literal(name, value)?, None));
     }
     for c in physical::of_model(model) {
         lines.push((c.symbol, c.definition.to_owned(), Some(c.doc)));
@@ -124,6 +117,19 @@ pub fn params_macro(model: &Model) -> Result<String, EmitError> {
          macro_rules! params {{\n    ($f:ident) => {{\n{body}    }};\n}}\n",
         d.name
     ))
+}
+
+/// The f64 text of `value` (named `name` in the error) for a macro over
+/// `$f`, which an f32 module reads rounded to the nearest f32: the
+/// `params!` and `calibration!` macros' literals.
+pub(crate) fn macro_literal(name: &str, value: f64) -> Result<String, EmitError> {
+    Float::F64
+        .literal_text(value)
+        .ok_or_else(|| EmitError::NonFinite {
+            name: name.to_owned(),
+            value: format!("{value:?}"),
+            float: "f64",
+        })
 }
 
 /// The doc of a parameter const from the description schema: its TOML

@@ -784,40 +784,44 @@ fn destination(operation: Operation) -> Limit {
     }
 }
 
-/// The first impact's velocity at `operation`'s end stop in (from, to], and
-/// the number of bouncing impacts there.
-/// The time of the first impact or stick at `operation`'s end stop within
-/// (from, to].
-fn first_arrival(tr: &Trajectory, operation: Operation, from: f64, to: f64) -> Option<f64> {
+/// The impacts and sticks at `operation`'s end stop in (from, to], in time
+/// order.
+fn arrivals(
+    tr: &Trajectory,
+    operation: Operation,
+    from: f64,
+    to: f64,
+) -> impl Iterator<Item = &crate::sim::Event> {
     let destination = destination(operation);
-    tr.events
-        .iter()
-        .filter(|e| e.t > from && e.t <= to)
-        .find(|e| {
-            matches!(e.kind, EventKind::Impact { limit, .. } | EventKind::Stick { limit }
+    tr.events.iter().filter(move |e| {
+        e.t > from
+            && e.t <= to
+            && matches!(e.kind, EventKind::Impact { limit, .. } | EventKind::Stick { limit }
                 if limit == destination)
-        })
-        .map(|e| e.t)
+    })
 }
 
+/// The time of the first impact or stick at `operation`'s end stop in
+/// (from, to].
+fn first_arrival(tr: &Trajectory, operation: Operation, from: f64, to: f64) -> Option<f64> {
+    arrivals(tr, operation, from, to).next().map(|e| e.t)
+}
+
+/// The first impact's velocity at `operation`'s end stop in (from, to], and
+/// the number of bouncing impacts there.
 fn impacts(tr: &Trajectory, operation: Operation, from: f64, to: f64) -> (Option<f64>, usize) {
-    let destination = destination(operation);
     let mut first = None;
     let mut bounces = 0;
-    for e in tr.events.iter().filter(|e| e.t > from && e.t <= to) {
+    for e in arrivals(tr, operation, from, to) {
         match e.kind {
             EventKind::Impact {
-                limit,
-                v_before,
-                v_after,
-                ..
-            } if limit == destination => {
+                v_before, v_after, ..
+            } => {
                 first = first.or(Some(v_before));
                 bounces += usize::from(v_after != 0.0);
             }
             // arriving at rest: the softest landing there is
-            EventKind::Stick { limit } if limit == destination => first = first.or(Some(0.0)),
-            _ => {}
+            _ => first = first.or(Some(0.0)),
         }
     }
     (first, bounces)

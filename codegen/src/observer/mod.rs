@@ -189,7 +189,11 @@ fn model_macro(
         .filter(|p| !adapted.contains(&p.1))
         .map(Param::from)
         .collect();
-    let (mut graph, follows) = phi_lim_follows(dm, &adapted);
+    // the flux domain follows an adapted φ_sat, as the designer's tapes'
+    let mut graph = dm.graph.clone();
+    let follows: HashMap<_, _> = (dm.flux_limit_following(&mut graph, &adapted))
+        .into_iter()
+        .collect();
     let mut items = TokenStream::new();
     for f in functions(layout) {
         let f = f.substituted(&mut graph, &follows);
@@ -206,29 +210,6 @@ fn model_macro(
         input.name
     );
     Ok(macro_rules("model", &doc, &text))
-}
-
-/// The model's graph with φ_lim = (1 − margin)·φ_sat where φ_sat is adapted
-/// (the filter's flux domain follows θ, as the designer's adaptive tapes'),
-/// and the substitution to apply to the functions' outputs.
-fn phi_lim_follows(
-    dm: &DiscreteModel,
-    adapted: &[designer::sym::Id],
-) -> (
-    designer::sym::Graph,
-    HashMap<designer::sym::Id, designer::sym::Id>,
-) {
-    let mut graph = dm.graph.clone();
-    let mut map = HashMap::new();
-    let lim = dm.params.symbol(designer::observe::discrete::PHI_LIM);
-    if let (Some(lim), Some(sat)) = (lim, dm.params.symbol("phi_sat")) {
-        if adapted.contains(&sat) {
-            let margin = graph.constant(1.0 - designer::observe::discrete::FLUX_DOMAIN_MARGIN);
-            let follows = graph.mul(margin, sat);
-            map.insert(lim, follows);
-        }
-    }
-    (graph, map)
 }
 
 /// One `pub mod f64 { … }` / `pub mod f32 { … }`, formatted.

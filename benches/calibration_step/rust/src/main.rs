@@ -158,37 +158,8 @@ fn sizes() {
     println!("run_samples={}", RECORD.len());
 }
 
-/// f32: the fixed and the adaptive file's estimates and inputs over the record.
-fn compare() {
-    let rec32: Vec<[f32; 3]> = RECORD.iter().map(|s| s.map(|x| x as f32)).collect();
-    let (mut of, mut oa) = (
-        fixed::ukf::f32::Filter::new(),
-        adaptive::ukf::f32::Filter::new(),
-    );
-    let mut cf = fixed::f32::Controller::new(fixed::f32::Operation::Closing);
-    let mut ca = adaptive::f32::Controller::new(adaptive::f32::Operation::Closing);
-    cf.start(0.0);
-    ca.start(0.0);
-    for (k, [_, u, i]) in rec32.iter().enumerate().take(500) {
-        let (ef, ea) = (of.step(*u, *i), oa.step(*u, *i));
-        let t = k as f32 * 5e-5;
-        let (uf, ua) = (
-            cf.step(t, ef.z, ef.v, ef.phi),
-            ca.step(t, ea.z, ea.v, ea.phi),
-        );
-        println!(
-            "{k} z {:e} {:e} phi {:e} {:e} u {uf} {ua}",
-            ef.z, ea.z, ef.phi, ea.phi
-        );
-    }
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() == 2 && args[1] == "compare" {
-        compare();
-        return;
-    }
     if args.len() == 2 && args[1] == "sizes" {
         sizes();
         return;

@@ -416,19 +416,22 @@ impl DiscreteModel {
         for id in free {
             assert!(map.remove(id).is_some(), "θ holds a parameter");
         }
-        if let (Some(lim), Some(sat)) = (self.params.symbol(PHI_LIM), self.params.symbol("phi_sat"))
-        {
-            if free.contains(&sat) {
-                let margin = g.constant(1.0 - FLUX_DOMAIN_MARGIN);
-                let follows = g.mul(margin, sat);
-                map.insert(lim, follows);
-            }
-        }
+        map.extend(self.flux_limit_following(&mut g, free));
         let bound = g.substitute_all(exprs, &map);
         let mut inputs = self.tape_inputs();
         inputs.extend_from_slice(free);
         Tape::compile(&g, &inputs, &bound)
             .expect("the discretised model only uses x, u, t and parameters")
+    }
+
+    /// φ_lim → (1 − margin)·φ_sat in `g` where φ_sat is among the adapted
+    /// parameters `free`: the filter's flux domain follows θ (the designer's
+    /// adaptive tapes and the emitted adaptive model alike); `None` otherwise.
+    pub fn flux_limit_following(&self, g: &mut Graph, free: &[Id]) -> Option<(Id, Id)> {
+        let lim = self.params.symbol(PHI_LIM)?;
+        let sat = self.params.symbol("phi_sat").filter(|s| free.contains(s))?;
+        let margin = g.constant(1.0 - FLUX_DOMAIN_MARGIN);
+        Some((lim, g.mul(margin, sat)))
     }
 
     /// The symbol of each named parameter (`None` for a name that is not one,
