@@ -130,3 +130,25 @@ fn emitted_module_compiles_passes_clippy_and_is_total() {
     assert_eq!(filters, 2 * thetas * 5);
     assert_eq!(updates, 2 * 4);
 }
+
+#[test]
+fn a_self_calibration_without_the_ukf_is_refused_naming_the_key() {
+    let text = example_text()
+        .replace("estimator = \"ukf\"", "estimator = \"ekf\"")
+        .replace("estimators = [\"ukf\"]", "estimators = [\"ekf\"]");
+    let d =
+        designer::description::parse_str(&text, "ekf-valve.toml").unwrap_or_else(|e| panic!("{e}"));
+    let design = designer::design::Design::new(&d).unwrap_or_else(|e| panic!("{e}"));
+    let message = match reldesign_build::emit(&design) {
+        Ok(_) => panic!("a self-calibrating design without a UKF was emitted"),
+        Err(e) => e.to_string(),
+    };
+    for part in [
+        "ekf-valve.toml",
+        "self_calibration",
+        "[observer] estimators",
+        "ukf",
+    ] {
+        assert!(message.contains(part), "`{part}` not in: {message}");
+    }
+}
