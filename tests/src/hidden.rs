@@ -783,8 +783,8 @@ pub fn hidden_case_of(
 }
 
 /// The case with the extensions `causes` drawn one on top of the other (the
-/// first is the case's `cause`).
-fn case_of(
+/// first is the case's `cause`), on the description `text` named `file_name`.
+pub fn case_of(
     text: &str,
     file_name: &str,
     causes: &[Cause],

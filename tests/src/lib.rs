@@ -1,6 +1,7 @@
 //! Shared helpers of the end-to-end tests: locating the bundled examples,
 //! loading models, deterministic pseudo-random states.
 
+pub mod blind;
 pub mod devices;
 pub mod friction;
 pub mod hidden;

@@ -1,6 +1,8 @@
 //! What a record shows of a cause: whether it contains what the effect
 //! needs to show (a λ–i loop, motion, an impact), and whether the fitted
-//! effect parameter stands clear of its null value. A cause is named only
+//! effect parameter stands clear of its null value, or, for a cause whose
+//! null is another model (a Jiles–Atherton core, fringing), whether its
+//! effect stands clear of zero on the held-out end. A cause is named only
 //! where both hold; the report says, per named cause, why it is identified.
 
 use super::{impacts, peak_abs, Cause, Diagnosis, FittedParameter};
@@ -140,6 +142,57 @@ pub(super) fn unidentified(cause: Cause, fit: &FitReport) -> Option<String> {
         "{key} = {value:.4e} ± {:.2e}: its {IDENTIFIED_Z}-standard-error interval holds {null}",
         value.abs() * rel
     ))
+}
+
+/// Whether `cause`'s "no such effect" on `baseline` is another model rather
+/// than a value of its parameters. Fringing has no parameter whose value
+/// removes it. A Jiles–Atherton core with κ → 0 is a single-valued
+/// (anhysteretic) core: the null of a description whose core is linear,
+/// where a saturating core fits as well (κ's distance from 0 then tells a
+/// loop from a saturation); but κ → 0 does not turn it into a description's
+/// saturating core. Such a cause is identified by its effect on data its fit
+/// did not see ([`held_out_effect`]), not by a parameter's distance from a
+/// null.
+pub fn null_is_another_model(cause: Cause, baseline: &Description) -> bool {
+    match cause {
+        Cause::Fringing => true,
+        Cause::Hysteresis => !matches!(baseline.core, Core::Linear { .. }),
+        _ => false,
+    }
+}
+
+/// By how much the extended model beats the baseline on the held-out
+/// samples, in BIC units: n·ln(e_b²/e_x²) − p·ln n with e the |φ̇|-weighted
+/// errors there, p the extension's `parameters` and n the held-out
+/// samples' effective count over the integrated autocorrelation time of the
+/// extended model's residual (a correlated residual counts as fewer
+/// independent samples). The likelihood ratio of the ranking, on data no fit
+/// saw: positive where the extension is worth its parameters there.
+pub fn held_out_effect(
+    baseline: &[f64],
+    extended: &[f64],
+    measured: &[f64],
+    weights: &[f64],
+    parameters: usize,
+) -> f64 {
+    let error = |model: &[f64]| crate::wnrmse(model, measured, weights);
+    let residual: Vec<f64> = (extended.iter().zip(measured).zip(weights))
+        .map(|((x, m), w)| w.sqrt() * (x - m))
+        .collect();
+    let tau = super::integrated_autocorrelation(&residual).max(1.0);
+    let n = super::rank::effective_samples(weights) / tau;
+    super::rank::bic(error(baseline), 0, n) - super::rank::bic(error(extended), parameters, n)
+}
+
+/// Why the held-out end does not identify `cause`, if it does not: its
+/// model is not worth its parameters there ([`held_out_effect`]).
+pub(super) fn effect_unseen(cause: Cause, evidence: f64) -> Option<String> {
+    (!(evidence > 0.0)).then(|| {
+        format!(
+            "on the held-out end the {cause} model is not worth its parameters ({evidence:.1} \
+             BIC units; the residual's correlation counted)"
+        )
+    })
 }
 
 /// Why the record identifies the cause `step` named: what the record shows

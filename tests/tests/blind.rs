@@ -1,0 +1,117 @@
+//! The classes of blind records the diagnosis got wrong (issue 36 §1,
+//! `reldesign_tests::blind`): each class drawn on unseen generated devices,
+//! the answer counted per class on the tuning seeds and on the held-out ones.
+
+use std::time::Instant;
+
+use designer::description::parse_str;
+use designer::record::Record;
+use reldesign_identify::diagnose::{diagnose_causes, Cause, Causes, Options};
+use reldesign_identify::Measured;
+use reldesign_tests::blind::{stroke_covered, Blind, HELD_OUT, TUNING};
+use reldesign_tests::hidden::{visibility, HiddenCase};
+
+/// The answer to a case (as the CLI reads the two files) and its wall time.
+fn answer(case: &HiddenCase) -> (Causes, f64) {
+    let model = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
+    let record = Record::parse(&case.data_csv, "data.csv").unwrap_or_else(|e| panic!("{e}"));
+    let data = Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
+    let start = Instant::now();
+    let causes =
+        diagnose_causes(&model, &data, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
+    (causes, start.elapsed().as_secs_f64())
+}
+
+/// One line per record: the answer, its gain, what is left, the partial
+/// causes, the ranking.
+fn line(class: Blind, seed: u64, causes: &Causes, seconds: f64, rows: usize) -> String {
+    let names: Vec<_> = causes.names().iter().map(|c| c.name()).collect();
+    let first = causes.first();
+    format!(
+        "{class:?} seed {seed} ({rows} rows, {seconds:.1} s): {} (gain {:.1} %, left {:.2}× the floor; partial {:?}; not identifiable {:?}; rejected {:?}; ranking {})",
+        names.join(" + "),
+        100.0 * causes.gain(),
+        causes.residual.over_floor,
+        causes.partial(),
+        first.not_identifiable.iter().map(|(c, why)| format!("{c}: {why}")).collect::<Vec<_>>(),
+        first.rejected.iter().map(|r| format!("{}: {}", r.cause, r.reason())).collect::<Vec<_>>(),
+        reldesign_tests::hidden::ranking_summary(first),
+    )
+}
+
+/// Right answers of `class` over `seeds`, each record's line printed.
+fn score(class: Blind, seeds: impl Iterator<Item = u64>) -> (usize, usize, Vec<String>) {
+    let (mut right, mut total, mut wrong) = (0, 0, Vec::new());
+    for seed in seeds {
+        let case = class.case(seed);
+        let rows = case.data_csv.lines().count() - 2;
+        let (causes, seconds) = answer(&case);
+        let line = line(class, seed, &causes, seconds, rows);
+        eprintln!("{line}");
+        total += 1;
+        if class.right(&causes.names()) {
+            right += 1;
+        } else {
+            wrong.push(line);
+        }
+    }
+    (right, total, wrong)
+}
+
+/// Every class on its tuning and its held-out seeds; `BLIND_CLASS=<name>`
+/// and `BLIND_SEEDS=tuning|held-out` narrow it.
+/// `cargo test --release -p reldesign-tests --test blind -- --ignored --nocapture`
+#[test]
+#[ignore = "slow: 80 records, every candidate"]
+fn classes_on_unseen_devices() {
+    let only = std::env::var("BLIND_CLASS").ok();
+    let pick: Option<Vec<u64>> = std::env::var("BLIND_PICK")
+        .ok()
+        .map(|s| s.split(",").map(|x| x.parse().unwrap()).collect());
+    let sets = std::env::var("BLIND_SEEDS").ok();
+    let mut summary = Vec::new();
+    let mut wrong = Vec::new();
+    for class in Blind::ALL {
+        if only.as_deref().is_some_and(|o| o != format!("{class:?}")) {
+            continue;
+        }
+        for (set, seeds) in [("tuning", TUNING), ("held-out", HELD_OUT)] {
+            if sets.as_deref().is_some_and(|s| s != set) {
+                continue;
+            }
+            let (right, total, w) = score(
+                class,
+                seeds.filter(|s| pick.as_ref().is_none_or(|p| p.contains(s))),
+            );
+            summary.push(format!("{class:?} {set}: {right} of {total} right"));
+            wrong.extend(w);
+        }
+    }
+    eprintln!("{}", summary.join("\n"));
+    assert!(wrong.is_empty(), "wrong answers:\n{}", wrong.join("\n"));
+}
+
+/// The generator draws what each class says: the hysteretic record has no
+/// motion and its effect shows; the others move and show theirs.
+#[test]
+fn each_class_shows_its_effect() {
+    for class in Blind::ALL {
+        let case = class.case(TUNING.start);
+        let still = stroke_covered(&case.truth, &case.excitation);
+        if class == Blind::HysteresisBelowPullIn {
+            assert!(still <= 0.01, "{class:?}: the armature moves ({still})");
+        } else {
+            assert!(
+                still > 0.5,
+                "{class:?}: the armature does not switch ({still})"
+            );
+        }
+        let seen = visibility(&case).ratio();
+        assert!(
+            seen > 3.0,
+            "{class:?}: the effect hides in the noise ({seen:.2}×)"
+        );
+        let expected: Vec<Cause> = class.expected().to_vec();
+        assert_eq!(case.cause, expected[0], "{class:?}");
+    }
+}
