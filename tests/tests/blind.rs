@@ -6,20 +6,20 @@ use std::time::Instant;
 
 use designer::description::parse_str;
 use designer::record::Record;
-use reldesign_identify::diagnose::{diagnose_causes, Cause, Causes, Options};
+use reldesign_identify::diagnose::{diagnose_causes, Cause, Causes, DiagnoseError, Options};
 use reldesign_identify::Measured;
 use reldesign_tests::blind::{stroke_covered, Blind, HELD_OUT, TUNING};
 use reldesign_tests::hidden::{visibility, HiddenCase};
 
-/// The answer to a case (as the CLI reads the two files) and its wall time.
-fn answer(case: &HiddenCase) -> (Causes, f64) {
+/// The answer to a case (as the CLI reads the two files) and its wall time,
+/// or why the diagnosis failed.
+fn answer(case: &HiddenCase) -> Result<(Causes, f64), DiagnoseError> {
     let model = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
     let record = Record::parse(&case.data_csv, "data.csv").unwrap_or_else(|e| panic!("{e}"));
     let data = Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
     let start = Instant::now();
-    let causes =
-        diagnose_causes(&model, &data, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
-    (causes, start.elapsed().as_secs_f64())
+    let causes = diagnose_causes(&model, &data, &Options::default())?;
+    Ok((causes, start.elapsed().as_secs_f64()))
 }
 
 /// One line per record: the answer, its gain, what is left, the partial
@@ -45,10 +45,18 @@ fn score(class: Blind, seeds: impl Iterator<Item = u64>) -> (usize, usize, Vec<S
     for seed in seeds {
         let case = class.case(seed);
         let rows = case.data_csv.lines().count() - 2;
-        let (causes, seconds) = answer(&case);
+        total += 1;
+        let (causes, seconds) = match answer(&case) {
+            Ok(answer) => answer,
+            Err(e) => {
+                let line = format!("{class:?} seed {seed} ({rows} rows): {e}");
+                eprintln!("{line}");
+                wrong.push(line);
+                continue;
+            }
+        };
         let line = line(class, seed, &causes, seconds, rows);
         eprintln!("{line}");
-        total += 1;
         if class.right(&causes.names()) {
             right += 1;
         } else {
@@ -114,4 +122,20 @@ fn each_class_shows_its_effect() {
         let expected: Vec<Cause> = class.expected().to_vec();
         assert_eq!(case.cause, expected[0], "{class:?}");
     }
+}
+
+/// Fringing with eddy currents on a generated valve (tuning seed 8), where
+/// a Jiles–Atherton core wins the first ranking by mimicking part of both
+/// and leaves 24× the floor whatever is added to it (2026-12-02): the
+/// selection without it names both true causes, to the noise.
+#[test]
+fn a_cause_that_mimics_two_is_set_aside() {
+    let class = Blind::FringingWithEddy;
+    let (causes, _) = answer(&class.case(8)).unwrap_or_else(|e| panic!("{e}"));
+    let line = line(class, 8, &causes, 0.0, 0);
+    assert!(class.right(&causes.names()), "{line}");
+    assert!(causes.residual.over_floor < 1.5, "{line}");
+    // (the answer comes from the selection without the core)
+    let ranked = causes.first().ranking.iter().map(|s| s.cause);
+    assert!(!ranked.clone().any(|c| c == Cause::Hysteresis), "{line}");
 }

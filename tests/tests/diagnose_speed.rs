@@ -50,7 +50,7 @@ fn record(seed: u64, k: u64) -> (String, HiddenCase) {
             };
             let drive = at_least(drive, samples);
             if kind == 9 {
-                let effect = OUTSIDE[(draw % OUTSIDE.len() as u64) as usize];
+                let effect = OUTSIDE[((draw / 10) % OUTSIDE.len() as u64) as usize];
                 let case = outside_case_of(&d.toml, &file, effect, &drive, false, draw);
                 (format!("outside {effect:?}"), case)
             } else {
