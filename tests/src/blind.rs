@@ -9,15 +9,14 @@ use std::ops::Range;
 
 use designer::description::{Core, Description};
 use designer::model::MU0;
-use designer::record::Record;
 use reldesign_identify::diagnose::Cause;
 use reldesign_identify::edit::write_physics;
-use reldesign_identify::{fit, FitOptions, FitParam, Measured};
+use reldesign_identify::{fit, FitOptions, FitParam};
 
 use crate::devices::{device, Device};
 use crate::hidden::{
-    baseline_of, case_of, experiment, simulate, with_effect_for, Excitation, HiddenCase, Noise,
-    Sampling, SAMPLE_PERIOD,
+    baseline_of, case_of, experiment, measured, noise_free, simulate, with_effect_for, Excitation,
+    HiddenCase, Noise, Sampling, SAMPLE_PERIOD,
 };
 use crate::Rng;
 
@@ -186,19 +185,7 @@ fn calibrated(
     truth: &Description,
     excitation: &Excitation,
 ) -> Description {
-    let csv = experiment(
-        truth,
-        excitation,
-        Sampling {
-            period: SAMPLE_PERIOD,
-            delay: 0.0,
-        },
-        Noise::NONE,
-        false,
-        &mut Rng::new(0),
-    );
-    let record = Record::parse(&csv, "calibration.csv").unwrap_or_else(|e| panic!("{e}"));
-    let data = Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
+    let data = measured(&noise_free(truth, excitation), "calibration.csv");
     let Core::Saturating { r0, phi_sat } = described.core else {
         unreachable!("a saturating core")
     };

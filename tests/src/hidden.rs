@@ -828,6 +828,38 @@ pub fn baseline_of(text: &str, file_name: &str) -> (Description, String) {
     (base, toml)
 }
 
+impl HiddenCase {
+    /// The description and the record as the CLI reads the two files.
+    pub fn inputs(&self) -> (Description, reldesign_identify::Measured) {
+        let model =
+            parse_str(&self.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
+        (model, measured(&self.data_csv, "data.csv"))
+    }
+}
+
+/// The record `csv` (named `file_name`) as the diagnosis reads it.
+pub fn measured(csv: &str, file_name: &str) -> reldesign_identify::Measured {
+    let record = designer::record::Record::parse(csv, file_name).unwrap_or_else(|e| panic!("{e}"));
+    reldesign_identify::Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// [`experiment`] without noise, every edge on a sample instant: the
+/// simulation of `truth` under `excitation`, digit for digit.
+pub fn noise_free(truth: &Description, excitation: &Excitation) -> String {
+    let sampling = Sampling {
+        period: SAMPLE_PERIOD,
+        delay: 0.0,
+    };
+    experiment(
+        truth,
+        excitation,
+        sampling,
+        Noise::NONE,
+        false,
+        &mut Rng::new(0),
+    )
+}
+
 /// [`hidden_case`] with two effects at once (issue 17 §1): `causes[0]`'s
 /// extension drawn on the baseline, then `causes[1]`'s on top of it; the
 /// case's `cause` is the first, `drawn` holds both draws.
@@ -884,10 +916,7 @@ impl Visibility {
 /// currents with the measured one by [JA 81], weighted by |φ̇| estimated from
 /// the data as (v − R·i)/N (the coil equation, baseline R and N).
 pub fn visibility(case: &HiddenCase) -> Visibility {
-    let record = designer::record::Record::parse(&case.data_csv, "data.csv")
-        .unwrap_or_else(|e| panic!("{e}"));
-    let data = reldesign_identify::Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
-    let base = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
+    let (base, data) = case.inputs();
     let data = reldesign_identify::Measured {
         edges: Some(located(&base, &data)),
         ..data

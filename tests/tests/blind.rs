@@ -4,19 +4,14 @@
 
 use std::time::Instant;
 
-use designer::description::parse_str;
-use designer::record::Record;
 use reldesign_identify::diagnose::{diagnose_causes, Cause, Causes, DiagnoseError, Options};
-use reldesign_identify::Measured;
 use reldesign_tests::blind::{stroke_covered, Blind, HELD_OUT, TUNING};
 use reldesign_tests::hidden::{visibility, HiddenCase};
 
 /// The answer to a case (as the CLI reads the two files) and its wall time,
 /// or why the diagnosis failed.
 fn answer(case: &HiddenCase) -> Result<(Causes, f64), DiagnoseError> {
-    let model = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
-    let record = Record::parse(&case.data_csv, "data.csv").unwrap_or_else(|e| panic!("{e}"));
-    let data = Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
+    let (model, data) = case.inputs();
     let start = Instant::now();
     let causes = diagnose_causes(&model, &data, &Options::default())?;
     Ok((causes, start.elapsed().as_secs_f64()))

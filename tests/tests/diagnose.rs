@@ -12,11 +12,9 @@
 //! runs every cause × actuator × excitation × column combination.
 
 use designer::description::parse_str;
-use designer::record::Record;
 use reldesign_identify::diagnose::{
     diagnose, diagnose_causes, Cause, Causes, Diagnosis, FittedParameter, Options,
 };
-use reldesign_identify::Measured;
 use reldesign_tests::hidden::{hidden_case, Excitation, HiddenCase};
 use reldesign_tests::outside::Outside;
 
@@ -118,9 +116,7 @@ fn excitation(example: &str, drive: Drive) -> Excitation {
 /// Diagnoses a case from its two texts only (as the CLI would read the
 /// files), with the named cause's fitted parameters.
 fn run(case: &HiddenCase) -> (Diagnosis, Vec<FittedParameter>) {
-    let model = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
-    let record = Record::parse(&case.data_csv, "data.csv").unwrap_or_else(|e| panic!("{e}"));
-    let data = Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
+    let (model, data) = case.inputs();
     let d = diagnose(&model, &data, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
     let parameters = d.parameters(&model, &data);
     (d, parameters)
@@ -460,9 +456,7 @@ fn confusion(cases: &[Case<u64>]) -> Confusion {
 /// The CLI's answer for a case (forward selection, joint fit, `unexplained`)
 /// with the first cause's fitted parameters.
 fn run_causes(case: &HiddenCase) -> (Causes, Vec<FittedParameter>) {
-    let model = parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
-    let record = Record::parse(&case.data_csv, "data.csv").unwrap_or_else(|e| panic!("{e}"));
-    let data = Measured::from_record(&record).unwrap_or_else(|e| panic!("{e}"));
+    let (model, data) = case.inputs();
     let answer =
         diagnose_causes(&model, &data, &Options::default()).unwrap_or_else(|e| panic!("{e}"));
     let parameters = answer.first().parameters(&model, &data);

@@ -9,10 +9,7 @@
 
 use std::time::Instant;
 
-use designer::description::parse_str;
-use designer::record::Record;
 use reldesign_identify::diagnose::{diagnose_causes, Cause, Options};
-use reldesign_identify::Measured;
 use reldesign_tests::blind::{at_least, Blind, FAMILY};
 use reldesign_tests::devices::device;
 use reldesign_tests::hidden::{baseline, hidden_case_of, Excitation, HiddenCase};
@@ -84,10 +81,7 @@ fn diagnosis_time_on_fresh_records() {
     let (mut per_record, mut per_10k) = (Vec::new(), Vec::new());
     for k in 0..n {
         let (label, case) = record(seed, k);
-        let model =
-            parse_str(&case.baseline_toml, "baseline.toml").unwrap_or_else(|e| panic!("{e}"));
-        let rec = Record::parse(&case.data_csv, "data.csv").unwrap_or_else(|e| panic!("{e}"));
-        let data = Measured::from_record(&rec).unwrap_or_else(|e| panic!("{e}"));
+        let (model, data) = case.inputs();
         let rows = data.t.len();
         let start = Instant::now();
         let answer =

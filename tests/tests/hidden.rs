@@ -9,7 +9,7 @@ use designer::sim::Limit;
 use reldesign_identify::diagnose::Cause;
 use reldesign_tests::example;
 use reldesign_tests::hidden::{
-    baseline, experiment, experiment_through, hidden_case, visibility, write_case, Chain,
+    baseline, experiment_through, hidden_case, noise_free, visibility, write_case, Chain,
     Excitation, HiddenCase, Noise, Sampling, SAMPLE_PERIOD,
 };
 use reldesign_tests::Rng;
@@ -190,17 +190,7 @@ fn record_parses_with_the_right_columns() {
     let z_max = d.mechanics.z_max;
     assert!(z.iter().any(|&z| z < 0.01 * z_max) && z.iter().any(|&z| z > 0.99 * z_max));
     // Without noise the measured columns are the simulation, digit for digit.
-    let clean = experiment(
-        &c.truth,
-        &ex,
-        Sampling {
-            period: SAMPLE_PERIOD,
-            delay: 0.0,
-        },
-        Noise::NONE,
-        false,
-        &mut Rng::new(0),
-    );
+    let clean = noise_free(&c.truth, &ex);
     let r = Record::parse(&clean, "clean.csv").unwrap();
     assert_eq!(r.columns, ["t", "v", "i"]);
     let Excitation::Pulses { amplitude, .. } = ex else {

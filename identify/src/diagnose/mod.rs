@@ -301,10 +301,7 @@ fn diagnose_step(
     let fit_data = data.head(fitted_samples);
     let fit_weights = &weights[..fitted_samples];
     let n_eff = rank::effective_samples(fit_weights);
-    let scales = Scales {
-        peak_flux: peak_abs(&baseline_replay.phi),
-        duration: data.t[n - 1] - data.t[0],
-    };
+    let scales = scales_of(&baseline_replay, data);
     let (mut candidates, not_applicable) = candidates(baseline, &options.causes, scales);
     for c in &mut candidates {
         let own: Vec<String> = c.params.iter().map(|p| p.path.clone()).collect();
@@ -377,11 +374,12 @@ fn diagnose_step(
             continue;
         };
         let lacking = evidence::record_lacks(scored.cause, &baseline_replay, data, baseline);
-        // (a cause whose null is another model: tested on its effect below)
-        let null_is_a_model =
-            evidence::null_is_another_model(scored.cause, baseline) && held_out_visible;
-        let by_effect = (null_is_a_model || options.held_out_evidence) && held_out_visible;
-        let unidentified = || (!null_is_a_model).then(|| evidence::unidentified(scored.cause, fit));
+        // (a cause whose null is another model is tested on its effect
+        // below instead of its parameter, where the held-out end shows it)
+        let null_is_a_model = evidence::null_is_another_model(scored.cause, baseline);
+        let by_effect = held_out_visible && (options.held_out_evidence || null_is_a_model);
+        let effect_instead = held_out_visible && null_is_a_model;
+        let unidentified = || (!effect_instead).then(|| evidence::unidentified(scored.cause, fit));
         if let Some(reason) = lacking.or_else(|| unidentified().flatten()) {
             not_identifiable.push((scored.cause, reason));
             continue;
@@ -417,15 +415,11 @@ fn diagnose_step(
             }
         }
         match held_out_gain(&extended_replay) {
-            Some(h)
-                if !(h.gain > 0.0) && h.baseline_wnrmse > options.floor_factor * noise_floor =>
-            {
-                rejected.push(Rejected {
-                    cause: scored.cause,
-                    whole: whole_gain(&extended_replay),
-                    held_out: Some(h),
-                })
-            }
+            Some(h) if !(h.gain > 0.0) && held_out_visible => rejected.push(Rejected {
+                cause: scored.cause,
+                whole: whole_gain(&extended_replay),
+                held_out: Some(h),
+            }),
             _ => {
                 // The named extension is fitted again, the edges' instants
                 // with its values (eddy currents change the current's jump
@@ -707,7 +701,7 @@ fn next_step(
     }
     let next_options = Options {
         causes: remaining,
-        refitted: earlier_parameters(baseline, &named, steps[0].scales(data)),
+        refitted: earlier_parameters(baseline, &named, scales_of(&steps[0].baseline_replay, data)),
         held_out_evidence: true,
         ..options.clone()
     };
@@ -803,6 +797,15 @@ fn same_part(a: Cause, b: Cause) -> bool {
 /// named.
 fn unreplayable(e: &DiagnoseError) -> String {
     format!("its fitted model does not replay the whole record ({e})")
+}
+
+/// The scales of the experiment `data` as `replay` (a baseline's) runs it.
+fn scales_of(replay: &SimOutputs, data: &Measured) -> Scales {
+    let t = &data.t;
+    Scales {
+        peak_flux: peak_abs(&replay.phi),
+        duration: t.last().copied().unwrap_or(0.0) - t.first().copied().unwrap_or(0.0),
+    }
 }
 
 /// Samples used by the fits: all but the held-out fraction at the end.
@@ -934,15 +937,6 @@ impl Diagnosis {
 }
 
 impl Diagnosis {
-    /// The scales of the experiment as this step's baseline replays it.
-    fn scales(&self, data: &Measured) -> Scales {
-        let t = &data.t;
-        Scales {
-            peak_flux: peak_abs(&self.baseline_replay.phi),
-            duration: t.last().copied().unwrap_or(0.0) - t.first().copied().unwrap_or(0.0),
-        }
-    }
-
     /// The standard error of the `j`-th named value whose residual-scale
     /// standard error is `white`: the larger of it and the current's noise
     /// where the fit weighs it (both hold that noise), and the drawn part in
