@@ -139,9 +139,7 @@ fn emitted_module_compiles_passes_clippy_and_is_total() {
     }
     main.push_str("}\n");
     krate.write("src/main.rs", &main);
-    krate.clippy_panic_free();
-    let out = krate.cargo(&["run", "--offline", "--quiet"]);
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = krate.run_panic_free(&[]);
     let (mut n, mut waiting) = (0, 0);
     for line in text.lines() {
         let f: Vec<&str> = line.split(' ').collect();

@@ -260,9 +260,7 @@ fn emitted_code_compiles_passes_clippy_and_matches_the_tape() {
     let mut cases = [synthetic(), valve_law()];
     let krate = ScratchCrate::new("codegen-check");
     write_crate(&krate, &cases);
-    krate.clippy_panic_free();
-    let out = krate.cargo(&["run", "--offline", "--quiet"]);
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = krate.run_panic_free(&[]);
     let mut lines = text.lines();
     for (float, tol) in [("f64", 1e-12), ("f32", 1e-5)] {
         for case in &mut cases {

@@ -376,9 +376,7 @@ fn emitted_controller_compiles_passes_clippy_and_matches_the_tape() {
     main.push_str("}\n");
     krate.write("src/main.rs", &main);
 
-    krate.clippy_panic_free();
-    let out = krate.cargo(&["run", "--offline", "--quiet"]);
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = krate.run_panic_free(&[]);
     let mut lines = text.lines();
 
     let k = gains(&Gains::SettlingTime(1e-3));

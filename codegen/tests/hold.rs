@@ -153,9 +153,7 @@ fn emitted_module_compiles_passes_clippy_and_is_total() {
     }
     main.push_str("}\n");
     krate.write("src/main.rs", &main);
-    krate.clippy_panic_free();
-    let out = krate.cargo(&["run", "--offline", "--quiet"]);
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = krate.run_panic_free(&[]);
     let d = design(&example_text());
     let h = d.hold.as_ref().unwrap();
     let (mut n, mut at_stops, mut guarded, mut law) = (0, 0, 0, 0);
@@ -233,12 +231,6 @@ fn the_tracking_law_on_the_hysteretic_core_takes_the_field() {
 }}\n"
     );
     krate.write("src/main.rs", &main);
-    krate.clippy_panic_free();
-    let out = krate.cargo(&["run", "--offline", "--quiet"]);
-    let n: usize = String::from_utf8(out.stdout)
-        .unwrap()
-        .trim()
-        .parse()
-        .unwrap();
+    let n: usize = krate.run_panic_free(&[]).trim().parse().unwrap();
     assert_eq!(n, (3 + 9) * (3 + 9) * (2 + 9) * (1 + 9));
 }

@@ -520,9 +520,7 @@ fn emitted_filters_compile_pass_clippy_and_match_the_designer() {
         records.push((d, resistance, rec, name));
     }
 
-    krate.clippy_panic_free();
-    let out = krate.cargo(&["run", "--offline", "--quiet", "--", data.to_str().unwrap()]);
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = krate.run_panic_free(&[data.to_str().unwrap()]);
     let mut lines = text.lines();
 
     println!("| record | filter | max rel. difference f64 (z, v, a, φ, H_c or R) | max rel. difference f32 | skipped | repairs f64/f32 |");

@@ -126,6 +126,20 @@ impl ScratchCrate {
         }
         self.cargo(&args);
     }
+
+    /// [`ScratchCrate::clippy_panic_free`], then `cargo run` with `args`
+    /// for the program: its standard output.
+    pub fn run_panic_free(&self, args: &[&str]) -> String {
+        self.clippy_panic_free();
+        let mut run = vec!["run", "--offline", "--quiet"];
+        if !args.is_empty() {
+            run.push("--");
+            run.extend(args);
+        }
+        let out = self.cargo(&run);
+        String::from_utf8(out.stdout)
+            .unwrap_or_else(|e| panic!("{}: stdout: {e}", self.dir.display()))
+    }
 }
 
 /// Values in every input's odd corners, written as Rust expressions of a

@@ -131,17 +131,10 @@ def guess(hs, z0, zf, m=151, t0=T0, tf=TF):
     return t, np.column_stack([X, P]).T, guess_cost, float(np.max(np.abs(uf)))
 
 
-def solve(desc, z0, zf, bound, tol, t0=T0, tf=TF, umin=None):
-    """The free arc on [t0, tf] with u in [umin (default −bound), bound]."""
-    p = load(desc)
-    hs = hamiltonian_system(p, -bound if umin is None else umin, bound)
-    x0 = inverse(hs, z0, 0.0, 0.0)
-    xf = inverse(hs, zf, 0.0, 0.0)
-    t, Y, gcost, gmax = guess(hs, z0, zf, t0=t0, tf=tf)
-    stroke = abs(zf - z0)
-    s = np.array([stroke, 2 * stroke / (tf - t0), np.max(np.abs(Y[2]))]
-                 + [np.max(np.abs(Y[3 + k])) for k in range(3)])
-    rhs, jac = hs["rhs"], hs["jac"]
+def scaled_bvp(sysd, t, Y, s, x0, xf, tol, max_nodes):
+    """scipy's solve_bvp on the Hamiltonian system `sysd` in the variables
+    y/s, from the guess (t, Y), z, v, φ fixed to x0 at t[0] and to xf at t[-1]."""
+    rhs, jac = sysd["rhs"], sysd["jac"]
 
     def f(tt, yh):
         y = yh * s[:, None]
@@ -165,12 +158,26 @@ def solve(desc, z0, zf, bound, tol, t0=T0, tf=TF, umin=None):
             jb[3 + k, k] = 1.0
         return ja, jb
 
-    start = time.perf_counter()
     sol = solve_bvp(f, bc, t, Y / s[:, None], fun_jac=fj, bc_jac=bcj, tol=tol,
-                    max_nodes=20000)
-    elapsed = time.perf_counter() - start
+                    max_nodes=max_nodes)
     if sol.status != 0:
         raise RuntimeError(f"scipy solve_bvp failed: {sol.message}")
+    return sol
+
+
+def solve(desc, z0, zf, bound, tol, t0=T0, tf=TF, umin=None):
+    """The free arc on [t0, tf] with u in [umin (default −bound), bound]."""
+    p = load(desc)
+    hs = hamiltonian_system(p, -bound if umin is None else umin, bound)
+    x0 = inverse(hs, z0, 0.0, 0.0)
+    xf = inverse(hs, zf, 0.0, 0.0)
+    t, Y, gcost, gmax = guess(hs, z0, zf, t0=t0, tf=tf)
+    stroke = abs(zf - z0)
+    s = np.array([stroke, 2 * stroke / (tf - t0), np.max(np.abs(Y[2]))]
+                 + [np.max(np.abs(Y[3 + k])) for k in range(3)])
+    start = time.perf_counter()
+    sol = scaled_bvp(hs, t, Y, s, x0, xf, tol, max_nodes=20000)
+    elapsed = time.perf_counter() - start
     aux = hs["aux"]
 
     def ax(tt):

@@ -38,7 +38,6 @@ import tomllib
 
 import casadi as ca
 import numpy as np
-from scipy.integrate import solve_bvp
 from scipy.optimize import brentq
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -72,35 +71,7 @@ def system(p, umin, umax, W, sigma, zs):
 
 
 def bvp(sysd, t, Y, s, x0, xf, tol):
-    rhs, jac = sysd["rhs"], sysd["jac"]
-
-    def f(tt, yh):
-        y = yh * s[:, None]
-        return np.column_stack([np.array(rhs(tt[i], y[:, i])).ravel() / s
-                                for i in range(tt.size)])
-
-    def fj(tt, yh):
-        y = yh * s[:, None]
-        out = np.empty((6, 6, tt.size))
-        for i in range(tt.size):
-            out[:, :, i] = np.array(jac(tt[i], y[:, i])) * s[None, :] / s[:, None]
-        return out
-
-    def bc(ya, yb):
-        return np.concatenate([(ya[:3] * s[:3] - x0) / s[:3], (yb[:3] * s[:3] - xf) / s[:3]])
-
-    def bcj(ya, yb):
-        ja, jb = np.zeros((6, 6)), np.zeros((6, 6))
-        for k in range(3):
-            ja[k, k] = 1.0
-            jb[3 + k, k] = 1.0
-        return ja, jb
-
-    sol = solve_bvp(f, bc, t, Y / s[:, None], fun_jac=fj, bc_jac=bcj, tol=tol,
-                    max_nodes=40000)
-    if sol.status != 0:
-        raise RuntimeError(f"scipy solve_bvp failed: {sol.message}")
-    return sol
+    return co.scaled_bvp(sysd, t, Y, s, x0, xf, tol, max_nodes=40000)
 
 
 def costs(sysd, sol, s, umin, umax):
