@@ -369,7 +369,12 @@ fn diagnose_step(
     let mut chosen = None;
     let mut refit = None;
     let mut not_identifiable = Vec::new();
-    for scored in eligible(&ranking, noise_floor, options.floor_factor) {
+    for scored in eligible(
+        &ranking,
+        noise_floor,
+        options.floor_factor,
+        held_out_visible,
+    ) {
         let Ok(fit) = scored.fit.as_ref() else {
             continue;
         };
@@ -862,12 +867,19 @@ fn score(c: &Candidate, report: Result<FitReport, FitError>, n_eff: f64) -> Scor
 }
 
 /// The extensions that beat the baseline's own best (`none`) by BIC, best
-/// first, when the baseline's error stands clear of the noise floor.
-fn eligible(ranking: &[Scored], noise_floor: f64, floor_factor: f64) -> Vec<&Scored> {
+/// first, when the baseline's error stands clear of the noise floor on the
+/// fitted part or on the held-out end (`held_out_visible`: a time-varying
+/// effect, a warming coil's drift, shows mostly at the record's end).
+fn eligible(
+    ranking: &[Scored],
+    noise_floor: f64,
+    floor_factor: f64,
+    held_out_visible: bool,
+) -> Vec<&Scored> {
     let Some(none) = ranking.iter().find(|s| s.cause == Cause::None) else {
         return Vec::new();
     };
-    if none.wnrmse_fit <= floor_factor * noise_floor {
+    if none.wnrmse_fit <= floor_factor * noise_floor && !held_out_visible {
         return Vec::new();
     }
     ranking
