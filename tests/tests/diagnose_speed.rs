@@ -5,7 +5,8 @@
 //! diagnosed as the CLI does (every candidate, forward selection, joint fit,
 //! `unexplained`), wall time per record and per 10 000 samples printed as a
 //! distribution. `benches/diagnose_fresh.sh` runs it; `SPEED_SEED` draws
-//! another set, `SPEED_RECORDS` sets its size (default 40).
+//! another set, `SPEED_RECORDS` sets its size (default 40), `SPEED_PICK=k`
+//! times record `k` alone (for a profile).
 
 use std::time::Instant;
 
@@ -78,8 +79,11 @@ fn diagnosis_time_on_fresh_records() {
     };
     let seed = env("SPEED_SEED", 1);
     let n = env("SPEED_RECORDS", 40);
+    let picked: Option<u64> = std::env::var("SPEED_PICK")
+        .ok()
+        .and_then(|s| s.parse().ok());
     let (mut per_record, mut per_10k) = (Vec::new(), Vec::new());
-    for k in 0..n {
+    for k in (0..n).filter(|k| picked.is_none_or(|p| p == *k)) {
         let (label, case) = record(seed, k);
         let (model, data) = case.inputs();
         let rows = data.t.len();
@@ -107,7 +111,7 @@ fn diagnosis_time_on_fresh_records() {
             x[x.len() - 1]
         )
     };
-    println!("{n} records of seed {seed}:");
+    println!("{} records of seed {seed}:", per_record.len());
     line("per record", &per_record);
     line("per 10 000 samples", &per_10k);
     let scaled: Vec<f64> = per_10k.iter().map(|x| 4.0 * x).collect();
