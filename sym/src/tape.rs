@@ -34,6 +34,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod compile;
+#[cfg(feature = "jit")]
+mod jit;
 mod layout;
 
 use std::ops::IndexMut;
@@ -109,11 +111,15 @@ pub struct Tape {
     n_slots: usize,
     n_inputs: usize,
     outputs: Vec<u32>,
+    /// The tape as machine code, compiled at its first evaluation (None:
+    /// the interpreter runs; feature `jit`, `tape/jit.rs`).
+    #[cfg(feature = "jit")]
+    compiled: std::sync::OnceLock<Option<std::sync::Arc<jit::Compiled>>>,
 }
 
 /// Instructions `start..end` of a tape, which depend on the inputs in `mask`
 /// (bit i: input i; all bits when the tape has more than 64 inputs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 struct Group {
     mask: u64,
     start: u32,
@@ -151,6 +157,8 @@ impl Tape {
             template,
             n_inputs: inputs.len(),
             outputs,
+            #[cfg(feature = "jit")]
+            compiled: std::sync::OnceLock::new(),
         })
     }
 
@@ -188,6 +196,24 @@ impl Tape {
     /// (bit for bit) as then are not run again (e.g. everything that depends
     /// on the position alone while the armature rests on a stop).
     pub fn eval(&self, inputs: &[f64], scratch: &mut [f64], outputs: &mut [f64]) {
+        #[cfg(feature = "jit")]
+        let compiled = (self.compiled)
+            .get_or_init(|| jit::compiled(&self.instrs, &self.groups, self.n_slots))
+            .as_ref()
+            .map(|c| &**c);
+        #[cfg(not(feature = "jit"))]
+        let compiled: Option<&Interpreted> = None;
+        self.eval_by(compiled, inputs, scratch, outputs)
+    }
+
+    /// [`Tape::eval`] by `compiled` code, or the interpreter where None.
+    fn eval_by<C: Compiled>(
+        &self,
+        compiled: Option<&C>,
+        inputs: &[f64],
+        scratch: &mut [f64],
+        outputs: &mut [f64],
+    ) {
         assert_eq!(inputs.len(), self.n_inputs, "tape: wrong number of inputs");
         assert_eq!(
             scratch.len(),
@@ -202,12 +228,13 @@ impl Tape {
                 *s = x;
             }
         }
-        match &self.narrow {
-            Some(code) => {
+        match (compiled, &self.narrow) {
+            (Some(code), _) => code.run(slots, changed),
+            (None, Some(code)) => {
                 let s: &mut [f64; NARROW] = slots.try_into().expect("narrow scratch size");
                 self.for_changed(changed, |r| run(&code[r], s));
             }
-            None => self.for_changed(changed, |r| run(&self.instrs[r], slots)),
+            (None, None) => self.for_changed(changed, |r| run(&self.instrs[r], slots)),
         }
         flag[0] = 1.0;
         for (o, &slot) in outputs.iter_mut().zip(&self.outputs) {
@@ -235,6 +262,22 @@ impl Tape {
         if let Some((start, end)) = pending {
             run(start as usize..end as usize);
         }
+    }
+}
+
+/// A tape's machine code: runs the groups whose inputs meet `changed`.
+trait Compiled {
+    fn run(&self, slots: &mut [f64], changed: u64);
+}
+
+/// No machine code: the interpreter runs (without the `jit` feature, and in
+/// the compiled code's tests).
+#[allow(dead_code)]
+enum Interpreted {}
+
+impl Compiled for Interpreted {
+    fn run(&self, _: &mut [f64], _: u64) {
+        match *self {}
     }
 }
 

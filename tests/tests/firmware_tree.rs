@@ -1,8 +1,10 @@
 //! A firmware build compiles only what designing and emitting need: the
 //! designer's analyses run on rayon's threads only with its `parallel`
-//! feature, which the CLI turns on and the build crate does not, so
-//! `cargo tree -p firmware-example -e normal,build` (the firmware's own
-//! resolution, as `cargo build -p firmware-example` sees it) has no rayon.
+//! feature, and its tapes are compiled to machine code only with its `jit`
+//! feature, which the CLI and the diagnosis turn on and the build crate does
+//! not, so `cargo tree -p firmware-example -e normal,build` (the firmware's
+//! own resolution, as `cargo build -p firmware-example` sees it) has neither
+//! rayon nor Cranelift.
 
 use std::path::Path;
 use std::process::Command;
@@ -43,4 +45,17 @@ fn a_firmware_build_compiles_no_thread_pool() {
         threads.is_empty(),
         "the firmware's build compiles {threads:?}"
     );
+}
+
+#[test]
+fn a_firmware_build_compiles_no_code_generator() {
+    let packages = firmware_packages();
+    assert!(
+        packages.iter().any(|p| p == "reldesign-sym"),
+        "the tree was not read: {packages:?}"
+    );
+    let jit: Vec<&String> = (packages.iter())
+        .filter(|p| p.starts_with("cranelift") || p.starts_with("regalloc"))
+        .collect();
+    assert!(jit.is_empty(), "the firmware's build compiles {jit:?}");
 }
