@@ -56,9 +56,13 @@ pub struct FitParam {
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitOptions {
-    /// Number of starts: the description's values, then `starts − 1` drawn
-    /// from the bounds.
+    /// Number of starts: the description's values, then those of
+    /// [`FitOptions::also_from`], then the rest drawn from the bounds.
     pub starts: usize,
+    /// Start points given (the fitted parameters' values, in order; clamped
+    /// into the bounds), tried after the description's values and before
+    /// the drawn ones, within `starts`.
+    pub also_from: Vec<Vec<f64>>,
     /// Levenberg–Marquardt iterations per start.
     pub max_iterations: usize,
     /// Include the flux term of [JA 80].
@@ -118,6 +122,7 @@ impl Default for FitOptions {
             stop: None,
             give_up: None,
             only_start: None,
+            also_from: Vec::new(),
         }
     }
 }
@@ -631,7 +636,7 @@ pub fn fit(
         };
         (result, kept.replays())
     };
-    let points = start_points(start0, params, starts, options.seed);
+    let points = start_points(start0, &options.also_from, params, starts, options.seed);
     let results: Vec<_> = (points.par_iter().enumerate())
         .filter(|(k, _)| options.only_start.is_none_or(|only| only == *k))
         .map(|(k, x0)| (k, solve((k, x0))))
@@ -874,11 +879,27 @@ fn check_params(d: &Description, params: &[FitParam]) -> Result<Vec<f64>, FitErr
     Ok(x0)
 }
 
-/// The start points: `x0`, then points drawn from the bounds.
-fn start_points(x0: &[f64], params: &[FitParam], starts: usize, seed: u64) -> Vec<Vec<f64>> {
+/// The start points: `x0`, those `given` (clamped into the bounds; only
+/// those of `params`' length), then points drawn from the bounds, `starts`
+/// in all. The drawn ones are the same whatever is given.
+fn start_points(
+    x0: &[f64],
+    given: &[Vec<f64>],
+    params: &[FitParam],
+    starts: usize,
+    seed: u64,
+) -> Vec<Vec<f64>> {
     let mut rng = SplitMix64(seed);
     let mut points = vec![x0.to_vec()];
-    for _ in 1..starts {
+    let clamped = |x: &Vec<f64>| {
+        (x.iter().zip(params))
+            .map(|(v, p)| v.clamp(p.lower, p.upper))
+            .collect::<Vec<f64>>()
+    };
+    let given =
+        (given.iter()).filter(|x| x.len() == params.len() && x.iter().all(|v| v.is_finite()));
+    points.extend(given.map(clamped).take(starts.saturating_sub(1)));
+    while points.len() < starts {
         points.push(
             params
                 .iter()
@@ -911,5 +932,34 @@ impl SplitMix64 {
     /// Uniform in (0, 1).
     fn uniform(&mut self) -> f64 {
         ((self.next() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{start_points, FitParam};
+
+    fn param(lower: f64, upper: f64) -> FitParam {
+        FitParam {
+            path: "p".into(),
+            lower,
+            upper,
+        }
+    }
+
+    #[test]
+    fn given_starts_come_before_the_drawn_ones_which_stay_the_same() {
+        let params = [param(1.0, 100.0), param(-1.0, 1.0)];
+        let x0 = [10.0, 0.0];
+        let drawn = start_points(&x0, &[], &params, 3, 7);
+        let given = vec![vec![500.0, 0.5], vec![f64::NAN, 0.0], vec![2.0]];
+        let with = start_points(&x0, &given, &params, 4, 7);
+        assert_eq!(with[0], x0);
+        // clamped into the bounds; a non-finite or short point is skipped
+        assert_eq!(with[1], vec![100.0, 0.5]);
+        assert_eq!(&with[2..], &drawn[1..]);
+        // `starts` counts the given points
+        assert_eq!(start_points(&x0, &given, &params, 2, 7).len(), 2);
+        assert_eq!(start_points(&x0, &given, &params, 1, 7), vec![x0.to_vec()]);
     }
 }

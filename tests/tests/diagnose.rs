@@ -410,7 +410,12 @@ impl Confusion {
 /// and what went wrong (a wrong cause, or a named cause without gain).
 fn confusion(cases: &[Case<u64>]) -> Confusion {
     let mut m = Confusion::new();
-    for c in cases {
+    // `DIAGNOSE_SEEDS=367,381` runs those records alone (to look at them)
+    let picked: Option<Vec<u64>> = std::env::var("DIAGNOSE_SEEDS")
+        .ok()
+        .map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect());
+    let picked = |c: &&Case<u64>| picked.as_ref().is_none_or(|p| p.contains(&c.seed));
+    for c in cases.iter().filter(picked) {
         let case = c.record();
         let (answer, parameters) = run_causes(&case);
         let d = answer.first();

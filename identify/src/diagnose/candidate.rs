@@ -31,6 +31,8 @@ pub struct Candidate {
     pub params: Vec<FitParam>,
     /// Starts of the multi-start fit (1 = the starting point only).
     pub starts: usize,
+    /// Other starting points among the `starts`, before the drawn ones.
+    pub also_from: Vec<Description>,
     /// Where a start is given up ([`GiveUp`]; the second hysteresis start).
     pub give_up: Option<GiveUp>,
 }
@@ -51,6 +53,7 @@ pub fn candidate(
     let mut start = baseline.clone();
     let mut params = vec![resistance(baseline)];
     let mut starts = 1;
+    let mut also_from = Vec::new();
     let not = |reason: &str| NotApplicable {
         cause,
         reason: reason.to_owned(),
@@ -107,6 +110,12 @@ pub fn candidate(
                 area,
                 winding_length,
             };
+            // (and the core as it was: where the linear gap was drawn
+            // through a fringing gap's curve, its offset is the line's, not
+            // a reluctance at z = 0, and the shifted core led the fit to the
+            // winding length's bound, 6.8× the floor left, on a generated
+            // relay of the blind class 4)
+            also_from.push(start.clone());
             shift_core_reluctance(&mut start, offset);
             params.push(param("gap.area", 0.05 * area, 20.0 * area));
             params.push(param(
@@ -115,7 +124,7 @@ pub fn candidate(
                 1.0,
             ));
             params.push(core_reluctance_param(&start));
-            starts = 3;
+            starts = 4;
         }
         Cause::ResistanceDrift => {
             if baseline.coil.resistance_drift != 0.0 {
@@ -140,6 +149,7 @@ pub fn candidate(
         start,
         params,
         starts,
+        also_from,
         give_up: None,
     })
 }
@@ -198,6 +208,7 @@ pub fn hysteresis_from_saturation(
         start,
         params,
         starts: 1,
+        also_from: Vec::new(),
         give_up: None,
     })
 }

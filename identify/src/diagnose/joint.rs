@@ -33,6 +33,7 @@ pub(super) fn refit(steps: &mut [Diagnosis], data: &Measured, options: &FitOptio
         start: last.extended.clone(),
         params,
         starts: 1,
+        also_from: Vec::new(),
         give_up: None,
     };
     let data = Measured {

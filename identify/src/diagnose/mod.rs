@@ -553,12 +553,18 @@ fn diagnose_step(
 /// (`causes_are_found_on_generated_devices`).
 const RANKING_FTOL_HYSTERESIS: f64 = 1e-3;
 
-/// The settings of `c`'s fit for the ranking: `base` with its starts, the
-/// run's `stop`, the candidate's give-up rule and, for the hysteresis
+/// The settings of `c`'s fit for the ranking: `base` with its starts (and
+/// the candidate's other starting points), the run's `stop`, the candidate's give-up rule and, for the hysteresis
 /// candidate, [`RANKING_FTOL_HYSTERESIS`].
 fn ranking_options(c: &Candidate, stop: Option<&Stop>, base: &FitOptions) -> FitOptions {
+    let values = |d: &Description| -> Option<Vec<f64>> {
+        (c.params.iter())
+            .map(|p| crate::params::get(d, &p.path).ok())
+            .collect()
+    };
     FitOptions {
         starts: c.starts,
+        also_from: c.also_from.iter().filter_map(values).collect(),
         stop: stop.cloned(),
         give_up: c.give_up,
         ftol: match c.cause {
@@ -1044,6 +1050,7 @@ mod tests {
             start: start.clone(),
             params: Vec::new(),
             starts: 1,
+            also_from: Vec::new(),
             give_up,
         };
         let base = fit_options(&Options::default());

@@ -308,6 +308,7 @@ mod tests {
             start: base.clone(),
             params: Vec::new(),
             starts,
+            also_from: Vec::new(),
             give_up: None,
         }
     }
