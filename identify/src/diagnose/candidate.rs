@@ -115,8 +115,11 @@ pub fn candidate(
             // a reluctance at z = 0, and the shifted core led the fit to the
             // winding length's bound, 6.8× the floor left, on a generated
             // relay of the blind class 4)
-            also_from.push(start.clone());
+            let unshifted = start.clone();
             shift_core_reluctance(&mut start, offset);
+            if start.core != unshifted.core {
+                also_from.push(unshifted);
+            }
             params.push(param("gap.area", 0.05 * area, 20.0 * area));
             params.push(param(
                 "gap.winding_length",
@@ -124,7 +127,7 @@ pub fn candidate(
                 1.0,
             ));
             params.push(core_reluctance_param(&start));
-            starts = 4;
+            starts = 3 + also_from.len();
         }
         Cause::ResistanceDrift => {
             if baseline.coil.resistance_drift != 0.0 {
