@@ -125,14 +125,20 @@ fn each_class_shows_its_effect() {
 /// selection without it names both true causes, to the noise.
 #[test]
 fn a_cause_that_mimics_two_is_set_aside() {
-    let class = Blind::FringingWithEddy;
-    let (causes, _) = answer(&class.case(8)).unwrap_or_else(|e| panic!("{e}"));
-    let line = line(class, 8, &causes, 0.0, 0);
-    assert!(class.right(&causes.names()), "{line}");
-    assert!(causes.residual.over_floor < 1.5, "{line}");
+    let (causes, line) = right_within(Blind::FringingWithEddy, 8, 1.5);
     // (the answer comes from the selection without the core)
     let ranked = causes.first().ranking.iter().map(|s| s.cause);
     assert!(!ranked.clone().any(|c| c == Cause::Hysteresis), "{line}");
+}
+
+/// The answer to `class`'s record of `seed`, which must be right and leave
+/// less than `over_floor` noise floors; with its line.
+fn right_within(class: Blind, seed: u64, over_floor: f64) -> (Causes, String) {
+    let (causes, _) = answer(&class.case(seed)).unwrap_or_else(|e| panic!("{e}"));
+    let line = line(class, seed, &causes, 0.0, 0);
+    assert!(class.right(&causes.names()), "{line}");
+    assert!(causes.residual.over_floor < over_floor, "{line}");
+    (causes, line)
 }
 
 /// Fringing alone on a generated relay (held-out seed 102), whose
@@ -143,11 +149,7 @@ fn a_cause_that_mimics_two_is_set_aside() {
 /// reaches the truth.
 #[test]
 fn fringing_is_fitted_from_the_core_as_it_was_too() {
-    let class = Blind::LoneFringing;
-    let (causes, _) = answer(&class.case(102)).unwrap_or_else(|e| panic!("{e}"));
-    let line = line(class, 102, &causes, 0.0, 0);
-    assert!(class.right(&causes.names()), "{line}");
-    assert!(causes.residual.over_floor < 1.25, "{line}");
+    right_within(Blind::LoneFringing, 102, 1.25);
 }
 
 /// A warming relay that bounces (held-out seed 100): after the bounce the
@@ -156,9 +158,5 @@ fn fringing_is_fitted_from_the_core_as_it_was_too() {
 /// it there (2026-12-02; before, `unexplained` with 6.1× left).
 #[test]
 fn a_drift_seen_on_the_held_out_end_is_named() {
-    let class = Blind::DriftWithBounce;
-    let (causes, _) = answer(&class.case(100)).unwrap_or_else(|e| panic!("{e}"));
-    let line = line(class, 100, &causes, 0.0, 0);
-    assert!(class.right(&causes.names()), "{line}");
-    assert!(causes.residual.over_floor < 1.25, "{line}");
+    right_within(Blind::DriftWithBounce, 100, 1.25);
 }

@@ -84,7 +84,7 @@ type Key = (Vec<Instr>, Vec<Group>, usize);
 
 /// Distinct tapes kept compiled; past it the cache starts again (a
 /// long-running process, e.g. the Python binding, sees many descriptions).
-const CACHE_ENTRIES: usize = 4096;
+const CACHE_ENTRIES: usize = 1024;
 
 /// The tape's compiled function, from the cache or compiled now (None:
 /// interpret).
