@@ -2,7 +2,10 @@
 //! interpreter's results bit for bit: the same IEEE operations in the same
 //! order (no fused multiply-add, no reassociation), and the library
 //! functions (`exp`, `ln`, `tanh`, `powi`, `powf`, `min`, `max`, `sign`)
-//! called through the same Rust functions the interpreter calls.
+//! called through the same Rust functions the interpreter calls. (A NaN is
+//! a NaN in both, but which operand's payload or sign it carries may
+//! differ where either compiler swaps a commutative operation's operands;
+//! Rust does not fix those bits either.)
 //!
 //! Why: the interpreter's cost is its dispatch, one indirect branch per
 //! instruction (issue 36 §2: 41–48 % of a diagnosis in `Tape::eval`).
@@ -99,20 +102,36 @@ pub(super) fn compiled(
     }
     static CACHE: OnceLock<Mutex<HashMap<Key, Option<Arc<Compiled>>>>> = OnceLock::new();
     let cache = CACHE.get_or_init(Default::default);
+    // (a lock poisoned by a panic elsewhere holds a valid map all the same)
+    let lock = || {
+        cache
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    };
     let key: Key = (instrs.to_vec(), groups.to_vec(), n_slots);
-    if let Some(hit) = cache.lock().ok()?.get(&key) {
+    if let Some(hit) = lock().get(&key) {
         return hit.clone();
     }
-    let made = compile(instrs, groups, n_slots).map(Arc::new);
-    let mut cache = cache.lock().ok()?;
+    // (a tape the code generator cannot take, or a panic inside it, leaves
+    // the tape to the interpreter)
+    let made = std::panic::catch_unwind(|| compile(instrs, groups, n_slots))
+        .ok()
+        .flatten()
+        .map(Arc::new);
+    let mut cache = lock();
     if cache.len() >= CACHE_ENTRIES {
         cache.clear();
     }
     cache.entry(key).or_insert(made).clone()
 }
 
-/// Compiles the tape, or None where this host has no backend.
+/// Compiles the tape, or None where this host has no backend or an operand
+/// lies outside the slots (the code's memory safety rests on that).
 fn compile(instrs: &[Instr], groups: &[Group], n_slots: usize) -> Option<Compiled> {
+    let inside = |s: u32| (s as usize) < n_slots && i32::try_from(8 * u64::from(s)).is_ok();
+    if !instrs.iter().all(|i| super::layout::slots(i).all(&inside)) {
+        return None;
+    }
     let mut flags = settings::builder();
     flags.set("opt_level", "speed").ok()?;
     let isa = cranelift_native::builder()
@@ -370,7 +389,13 @@ impl Emitter<'_> {
     fn call(&mut self, address: usize, params: &[types::Type], args: &[Value]) -> Value {
         let call_conv = self.b.func.signature.call_conv;
         let mut sig = Signature::new(call_conv);
-        sig.params.extend(params.iter().map(|t| AbiParam::new(*t)));
+        // (an i32 argument sign-extended, as the C ABIs of riscv64 and
+        // s390x expect of the caller)
+        let param = |t: &types::Type| match *t {
+            types::I32 => AbiParam::new(types::I32).sext(),
+            t => AbiParam::new(t),
+        };
+        sig.params.extend(params.iter().map(param));
         sig.returns.push(AbiParam::new(types::F64));
         let sig = self.b.import_signature(sig);
         let callee = self.b.ins().iconst(self.pointer, address as i64);

@@ -140,6 +140,13 @@ fn fuse(p: Instr, q: Instr, uses: &[u32]) -> Option<Instr> {
     })
 }
 
+/// Every slot an instruction writes or reads (the compiled code checks them).
+#[cfg_attr(not(feature = "jit"), allow(dead_code))]
+pub(super) fn slots(ins: &Instr) -> impl Iterator<Item = u32> {
+    let (d, read) = operands(ins);
+    d.into_iter().chain(read.into_iter().flatten())
+}
+
 /// The destination slot of an instruction and the slots it reads.
 fn operands(ins: &Instr) -> (Option<u32>, [Option<u32>; 3]) {
     match *ins {
