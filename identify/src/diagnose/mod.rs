@@ -343,51 +343,37 @@ fn diagnose_step(
     // named (it explains the fitted part only), unless the baseline is at the
     // noise floor there already (the held-out part then holds no evidence
     // either way: an effect such as a bounce can fall in the fitted part only).
-    let whole_gain = |r: &SimOutputs| {
-        Gain::new(
-            wnrmse(&baseline_replay.current, &data.i, &weights),
-            wnrmse(&r.current, &data.i, &weights),
-        )
-    };
+    // (the baseline's errors on the whole record and its held-out end,
+    // once for every candidate)
+    let k = fitted_samples;
+    let baseline_whole = wnrmse(&baseline_replay.current, &data.i, &weights);
+    let baseline_held_out =
+        (k < n).then(|| wnrmse(&baseline_replay.current[k..], &data.i[k..], &weights[k..]));
+    let whole_gain =
+        |r: &SimOutputs| Gain::new(baseline_whole, wnrmse(&r.current, &data.i, &weights));
     let held_out_gain = |r: &SimOutputs| {
-        (fitted_samples < n).then(|| {
-            let k = fitted_samples;
-            Gain::new(
-                wnrmse(&baseline_replay.current[k..], &data.i[k..], &weights[k..]),
-                wnrmse(&r.current[k..], &data.i[k..], &weights[k..]),
-            )
-        })
+        baseline_held_out
+            .map(|b| Gain::new(b, wnrmse(&r.current[k..], &data.i[k..], &weights[k..])))
     };
-    // The held-out end holds evidence where the baseline misses it beyond
-    // the noise.
-    let held_out_visible = fitted_samples < n && {
-        let k = fitted_samples;
-        let missed = wnrmse(&baseline_replay.current[k..], &data.i[k..], &weights[k..]);
-        missed > options.floor_factor * noise_floor
-    };
+    // Beyond the noise: the held-out end holds evidence where the baseline
+    // misses it so.
+    let beyond_noise = |e: f64| e > options.floor_factor * noise_floor;
+    let held_out_visible = baseline_held_out.is_some_and(beyond_noise);
     // Where only the held-out end shows a miss (the fitted part is within
     // the noise), a cause may be named where the whole record is beyond the
     // noise too, and only on its effect on the held-out end: on records of
     // the description itself a drift otherwise won by BIC (8 of 126 of the
     // self-consistency set, 2026-12-02), on integrated voltage noise or a
     // held-out end just above the floor.
-    let whole_visible =
-        wnrmse(&baseline_replay.current, &data.i, &weights) > options.floor_factor * noise_floor;
-    let seen_on_held_out_only = ranking
-        .iter()
+    let seen_on_held_out_only = (ranking.iter())
         .find(|s| s.cause == Cause::None)
         .is_some_and(|none| none.wnrmse_fit <= options.floor_factor * noise_floor);
+    let missed = !seen_on_held_out_only || (held_out_visible && beyond_noise(baseline_whole));
     let mut rejected = Vec::new();
     let mut chosen = None;
     let mut refit = None;
     let mut not_identifiable = Vec::new();
-    let beyond_the_fitted_part = held_out_visible && whole_visible;
-    for scored in eligible(
-        &ranking,
-        noise_floor,
-        options.floor_factor,
-        beyond_the_fitted_part,
-    ) {
+    for scored in eligible(&ranking, missed) {
         let Ok(fit) = scored.fit.as_ref() else {
             continue;
         };
@@ -420,7 +406,6 @@ fn diagnose_step(
             }
         };
         if by_effect {
-            let k = fitted_samples;
             let held_out = evidence::held_out_effect(
                 &baseline_replay.current[k..],
                 &extended_replay.current[k..],
@@ -568,8 +553,9 @@ fn diagnose_step(
 const RANKING_FTOL_HYSTERESIS: f64 = 1e-3;
 
 /// The settings of `c`'s fit for the ranking: `base` with its starts (and
-/// the candidate's other starting points), the run's `stop`, the candidate's give-up rule and, for the hysteresis
-/// candidate, [`RANKING_FTOL_HYSTERESIS`].
+/// the candidate's other starting points), the run's `stop`, the
+/// candidate's give-up rule and, for the hysteresis candidate,
+/// [`RANKING_FTOL_HYSTERESIS`].
 fn ranking_options(c: &Candidate, stop: Option<&Stop>, base: &FitOptions) -> FitOptions {
     let values = |d: &Description| -> Option<Vec<f64>> {
         (c.params.iter())
@@ -887,15 +873,15 @@ fn score(c: &Candidate, report: Result<FitReport, FitError>, n_eff: f64) -> Scor
 }
 
 /// The extensions that beat the baseline's own best (`none`) by BIC, best
-/// first, when the baseline's error stands clear of the noise floor on the
-/// fitted part, or beyond it (`beyond`: on the held-out end and the whole
-/// record; a time-varying effect, a warming coil's drift, shows mostly at
-/// the record's end).
-fn eligible(ranking: &[Scored], noise_floor: f64, floor_factor: f64, beyond: bool) -> Vec<&Scored> {
+/// first, where the baseline `missed` the record beyond the noise floor (on
+/// the fitted part, or on the held-out end and the whole record: a
+/// time-varying effect, a warming coil's drift, shows mostly at the
+/// record's end).
+fn eligible(ranking: &[Scored], missed: bool) -> Vec<&Scored> {
     let Some(none) = ranking.iter().find(|s| s.cause == Cause::None) else {
         return Vec::new();
     };
-    if none.wnrmse_fit <= floor_factor * noise_floor && !beyond {
+    if !missed {
         return Vec::new();
     }
     ranking

@@ -32,6 +32,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use cranelift_codegen::ir::condcodes::FloatCC;
 use cranelift_codegen::ir::{types, AbiParam, InstBuilder, MemFlags, Signature, Value};
+use cranelift_codegen::isa::OwnedTargetIsa;
 use cranelift_codegen::settings::{self, Configurable};
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::{JITBuilder, JITModule};
@@ -128,18 +129,12 @@ pub(super) fn compiled(
 /// Compiles the tape, or None where this host has no backend or an operand
 /// lies outside the slots (the code's memory safety rests on that).
 fn compile(instrs: &[Instr], groups: &[Group], n_slots: usize) -> Option<Compiled> {
-    let inside = |s: u32| (s as usize) < n_slots && i32::try_from(8 * u64::from(s)).is_ok();
+    let inside = |s: u32| (s as usize) < n_slots && byte_offset(s).is_some();
     if !instrs.iter().all(|i| super::layout::slots(i).all(&inside)) {
         return None;
     }
-    let mut flags = settings::builder();
-    flags.set("opt_level", "speed").ok()?;
-    let isa = cranelift_native::builder()
-        .ok()?
-        .finish(settings::Flags::new(flags))
-        .ok()?;
     let mut module = JITModule::new(JITBuilder::with_isa(
-        isa,
+        host()?,
         cranelift_module::default_libcall_names(),
     ));
     let mut ctx = module.make_context();
@@ -418,9 +413,26 @@ enum Fused {
     SubDiv,
 }
 
-/// The byte offset of slot `s`.
+/// The code generator for this host, made once (None: no backend here).
+fn host() -> Option<OwnedTargetIsa> {
+    static HOST: OnceLock<Option<OwnedTargetIsa>> = OnceLock::new();
+    let made = || {
+        let mut flags = settings::builder();
+        flags.set("opt_level", "speed").ok()?;
+        let builder = cranelift_native::builder().ok()?;
+        builder.finish(settings::Flags::new(flags)).ok()
+    };
+    HOST.get_or_init(made).clone()
+}
+
+/// The byte offset of slot `s`, where it fits the loads' and stores' i32.
+fn byte_offset(s: u32) -> Option<i32> {
+    i32::try_from(8 * u64::from(s)).ok()
+}
+
+/// The byte offset of slot `s` ([`compile`] checked that it fits).
 fn slot_offset(s: u32) -> i32 {
-    i32::try_from(8 * u64::from(s)).expect("tape slots fit an i32 offset")
+    byte_offset(s).expect("checked by `compile`")
 }
 
 extern "C" fn powi(x: f64, n: i32) -> f64 {
