@@ -442,6 +442,8 @@ fn both_sections_parse_into_the_expected_values() {
             shape: Shape::EnergyOptimal,
             u_bound: 20.0,
             contact_uncertainty: 0.0,
+            standoff: 0.0,
+            approach_speed: None,
         })
     );
     assert_eq!(

@@ -23,8 +23,12 @@ use reldesign_tests::variants::{physics_of, variant, Variant};
 const EXAMPLE: &str = "self-calibrating-valve.toml";
 const STROKE: f64 = 1e-3;
 
+/// The example, or the description `SELF_CALIBRATION_DESCRIPTION` names (a
+/// variant of its design to compare in the studies).
 fn example() -> (String, Description, Design) {
-    let text = std::fs::read_to_string(example_path(EXAMPLE)).expect("the example");
+    let path = std::env::var_os("SELF_CALIBRATION_DESCRIPTION")
+        .map_or_else(|| example_path(EXAMPLE), std::path::PathBuf::from);
+    let text = std::fs::read_to_string(path).expect("the example");
     let d = parse_str(&text, EXAMPLE).unwrap_or_else(|e| panic!("{e}"));
     let design = Design::new(&d).unwrap_or_else(|e| panic!("{e}"));
     (text, d, design)

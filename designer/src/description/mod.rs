@@ -201,6 +201,45 @@ pub struct Trajectory {
     /// σ [m]: the spread of each designed stop's position into the stroke
     /// (half-normal of scale σ); 0: the stops are where the mechanics says.
     pub contact_uncertainty: f64,
+    /// δ [m]: the move ends this far short of each stop, at rest, and the
+    /// reference approaches the stop at `approach_speed` (`trajectory/approach.rs`);
+    /// 0: it lands at rest on the stop.
+    pub standoff: f64,
+    /// v_c [m/s] of the approach (given exactly where `standoff` > 0).
+    pub approach_speed: Option<f64>,
+}
+
+/// The approach's part of the motion: its ramp time over δ/v_c.
+const RAMP_PER_STANDOFF_TIME: f64 = 0.5;
+
+/// δ and v_c of `[trajectory]` (`standoff`, `approach_speed`): the move ends
+/// at rest δ short of each stop and the reference approaches it at v_c
+/// (`design/trajectory/approach.rs`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Approach {
+    /// δ [m] (> 0): how far short of the stop the move ends.
+    pub standoff: f64,
+    /// v_c [m/s] (> 0): the speed at which the stop is approached.
+    pub speed: f64,
+}
+
+impl Approach {
+    /// The ramp's duration τ_r [s].
+    pub fn ramp(&self) -> f64 {
+        RAMP_PER_STANDOFF_TIME * self.standoff / self.speed
+    }
+
+    /// t_f − t_s [s]: the ramp and the constant-speed run, 5·δ/(4·v_c).
+    pub fn duration(&self) -> f64 {
+        self.standoff / self.speed + 0.5 * self.ramp()
+    }
+
+    /// The move's end z_s and time t_s for an operation from `z0` to the stop
+    /// `zf` landing at `tf`.
+    pub fn move_end(&self, z0: f64, zf: f64, tf: f64) -> (f64, f64) {
+        let direction = (zf - z0).signum();
+        (zf - direction * self.standoff, tf - self.duration())
+    }
 }
 
 impl Trajectory {
@@ -212,6 +251,14 @@ impl Trajectory {
     /// (t_f − t₀)/[`Trajectory::MIN_SAMPLES_PER_MOTION`].
     pub fn longest_sample_period(&self) -> f64 {
         (self.landing - self.takeoff) / Self::MIN_SAMPLES_PER_MOTION
+    }
+
+    /// The approach, where the reference stops short of the stops.
+    pub fn approach(&self) -> Option<Approach> {
+        match (self.standoff, self.approach_speed) {
+            (standoff, Some(speed)) if standoff > 0.0 => Some(Approach { standoff, speed }),
+            _ => None,
+        }
     }
 }
 

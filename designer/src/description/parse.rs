@@ -62,6 +62,7 @@ pub fn parse_str(text: &str, file_name: &str) -> Result<Description, Description
     if let (Some(s), Some(t)) = (&trajectory_sect, &trajectory) {
         checks::check_trajectory_core(s, t, &core)?;
         checks::check_contact_uncertainty(s, t, &mechanics)?;
+        checks::check_approach(s, t, &mechanics)?;
     }
     let controller_sect = root.opt_section("controller")?;
     let controller = controller_sect

@@ -23,6 +23,7 @@ use super::law::decisions::{
     gains, ControllerDesign, ControllerSpec, DesignedOperation, LawDesign,
 };
 use super::law::hold::{design_hold, HoldDesign};
+use super::trajectory::approach::Approached;
 use super::trajectory::feasibility::check as check_feasibility;
 use super::trajectory::fit_segments::{fit_segments, SegmentTolerance};
 use super::trajectory::optimal::problem::{OptimalError, OptimalSpec};
@@ -129,7 +130,8 @@ pub fn design_controller(
         u_max: description.supply.u_max,
         takeoff: trajectory.takeoff,
         landing: trajectory.landing,
-        creep_speed: controller.creep_speed,
+        // after t_f the creep goes on at the approach's speed, unless set
+        creep_speed: (controller.creep_speed).or(trajectory.approach().map(|a| a.speed)),
         landed_band: controller.landed_band,
     };
     ControllerDesign::decide(model, linearization, &spec, operations)
@@ -160,6 +162,51 @@ pub fn design_reference(
         return Err(PlanError::NothingToBuild);
     };
     let (bounds, polynomial) = design_bounds(description, trajectory, operation);
+    let Some(approach) = trajectory.approach() else {
+        return design_move(
+            description,
+            model,
+            linearization,
+            operation,
+            bounds,
+            polynomial,
+        );
+    };
+    let (zs, ts) = approach.move_end(polynomial.z0, polynomial.zf, polynomial.tf);
+    let to_standoff = Polynomial {
+        zf: zs,
+        tf: ts,
+        ..polynomial
+    };
+    let (moving, optimal) = design_move(
+        description,
+        model,
+        linearization,
+        operation,
+        bounds,
+        to_standoff,
+    )?;
+    let approached = Approached {
+        moving,
+        approach,
+        stop: polynomial.zf,
+        landing: polynomial.tf,
+    };
+    Ok((Box::new(approached), optimal))
+}
+
+/// The move of `polynomial`'s ends and times in `[trajectory]`'s shape.
+fn design_move(
+    description: &Description,
+    model: &mut Model,
+    linearization: &Linearization,
+    operation: Operation,
+    bounds: (f64, f64),
+    polynomial: Polynomial,
+) -> Result<(SharedReference, Option<OptimalTrajectory>), PlanError> {
+    let Some(trajectory) = &description.trajectory else {
+        return Err(PlanError::NothingToBuild);
+    };
     match trajectory.shape {
         Shape::Polynomial => Ok((Box::new(polynomial), None)),
         Shape::EnergyOptimal => {
@@ -169,8 +216,8 @@ pub fn design_reference(
                 ..OptimalSpec::new(
                     polynomial.z0,
                     polynomial.zf,
-                    trajectory.takeoff,
-                    trajectory.landing,
+                    polynomial.t0,
+                    polynomial.tf,
                     bounds.0,
                     bounds.1,
                 )
@@ -246,7 +293,11 @@ fn design_operation(
         .as_ref()
         .map_or(trajectory.takeoff, |o| o.arc.0.max(trajectory.takeoff));
     let takeoff = check_takeoff(operation, supply, reference.as_ref(), planned)?;
-    let breaks: Vec<f64> = optimal.iter().flat_map(|o| o.breaks()).collect();
+    let mut breaks: Vec<f64> = optimal.iter().flat_map(|o| o.breaks()).collect();
+    if let Some(approach) = trajectory.approach() {
+        let start = trajectory.landing - approach.duration();
+        breaks.extend([start, start + approach.ramp()]);
+    }
     let fit =
         fit_segments(reference.as_ref(), &breaks, &SegmentTolerance::default()).map_err(|e| {
             PlanError::Table {
@@ -388,6 +439,18 @@ fn optimal_message(e: &OptimalError, description: &Description) -> String {
         Drive::Current => "A",
     };
     let supply = description.supply.u_max;
+    // the move is the motion less the approach of `standoff`
+    let approach = (description.trajectory.as_ref())
+        .and_then(Trajectory::approach)
+        .map_or(0.0, |a| a.duration());
+    let move_note = if approach > 0.0 {
+        format!(
+            " (the move is the motion less the approach to the stop, 5·standoff/(4·approach_speed) = {:.4} ms)",
+            approach * 1e3
+        )
+    } else {
+        String::new()
+    };
     match e {
         OptimalError::BoundTooLow {
             needed,
@@ -397,7 +460,7 @@ fn optimal_message(e: &OptimalError, description: &Description) -> String {
         } => format!(
             "no motion of {:.4} ms keeps the input within trajectory.u_bound = {given:.4} {unit}: \
              it needs trajectory.u_bound ≥ {:.4} {unit} (the supply allows {supply:.4} {unit}), \
-             or a longer motion (trajectory.landing − trajectory.takeoff)",
+             or a longer motion (trajectory.landing − trajectory.takeoff){move_note}",
             duration * 1e3,
             needed * (1.0 + 1e-3),
         ),
@@ -409,14 +472,14 @@ fn optimal_message(e: &OptimalError, description: &Description) -> String {
             ..
         } => format!(
             "no motion of {:.4} ms exists with the input in [{u_min:.4}, {u_max:.4}] {unit}{}: \
-             it needs trajectory.landing − trajectory.takeoff ≥ {:.4} ms",
+             it needs trajectory.landing − trajectory.takeoff ≥ {:.4} ms{move_note}",
             given * 1e3,
             if *u_max < supply {
                 " (a larger trajectory.u_bound, up to the supply, does not help)"
             } else {
                 ""
             },
-            needed * (1.0 + 1e-3) * 1e3,
+            (needed * (1.0 + 1e-3) + approach) * 1e3,
         ),
         other => other.to_string(),
     }

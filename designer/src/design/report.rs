@@ -57,6 +57,14 @@ impl Design {
                         let _ = write!(s, "{}", contact_text(c));
                     }
                 }
+                if let Some(a) = self
+                    .description
+                    .trajectory
+                    .as_ref()
+                    .and_then(|t| t.approach())
+                {
+                    let _ = writeln!(s, "  {}", approach_text(&a, o.zf - o.z0));
+                }
                 let _ = write!(s, "{}", o.feasibility.report());
                 if let Some(takeoff) = &o.takeoff {
                     let _ = writeln!(s, "  {}", takeoff.report_line());
@@ -224,4 +232,17 @@ fn contact_text(c: &crate::design::trajectory::optimal::robust::ContactDesign) -
         c.deterministic_energy
     );
     s
+}
+
+/// The approach of `[trajectory] standoff` in one line.
+fn approach_text(a: &crate::description::Approach, stroke: f64) -> String {
+    format!(
+        "approach: the move ends at rest {:e} m short of the stop ({:.1} % of the stroke), \
+         then {:e} m/s into it over the last {:.4} ms: any stop or lead within the standoff \
+         is met at no more than that speed",
+        a.standoff,
+        100.0 * a.standoff / stroke.abs(),
+        a.speed,
+        1e3 * a.duration()
+    )
 }

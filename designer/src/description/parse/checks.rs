@@ -181,6 +181,71 @@ pub(super) fn check_contact_uncertainty(
     Ok(())
 }
 
+/// `standoff` and `approach_speed` come together; δ is at most a tenth of the
+/// stroke, and the approach (5·δ/(4·v_c)) leaves at least half of the motion
+/// t_f − t₀ to the move.
+pub(super) fn check_approach(
+    trajectory_sect: &Sect,
+    trajectory: &Trajectory,
+    mechanics: &Mechanics,
+) -> Res<()> {
+    let found = |key: &str, value: f64| {
+        trajectory_sect
+            .entry(key)
+            .map_or_else(|| value.to_string(), |(_, v)| trajectory_sect.ctx.found(v))
+    };
+    let standoff = trajectory.standoff;
+    let Some(speed) = trajectory.approach_speed else {
+        if standoff > 0.0 {
+            let msg = format!(
+                "standoff = {} [m] needs the speed of the approach to the stop: add \
+                 approach_speed [m/s] (e.g. 5e-3)",
+                found("standoff", standoff)
+            );
+            return Err(trajectory_sect.err("standoff", msg, "without approach_speed"));
+        }
+        return Ok(());
+    };
+    if standoff <= 0.0 {
+        let msg = format!(
+            "found approach_speed = {} [m/s] without a standoff > 0: the reference lands at \
+             rest on the stop; set standoff [m] too, or remove approach_speed",
+            found("approach_speed", speed)
+        );
+        return Err(trajectory_sect.err("approach_speed", msg, "without standoff"));
+    }
+    if trajectory.contact_uncertainty > 0.0 {
+        let msg = format!(
+            "found standoff = {} [m] with contact_uncertainty > 0: the two are different answers \
+             to an uncertain stop (a bounded approach speed within δ, or the expected contact \
+             speed over a distribution); set one of them",
+            found("standoff", standoff)
+        );
+        return Err(trajectory_sect.err("standoff", msg, "with contact_uncertainty"));
+    }
+    let stroke = mechanics.z_max - mechanics.z_min;
+    if standoff > 0.1 * stroke {
+        let msg = format!(
+            "expected a number in [0, {:e}] [m] (a tenth of the stroke {stroke:e} m), found {}",
+            0.1 * stroke,
+            found("standoff", standoff)
+        );
+        return Err(trajectory_sect.err("standoff", msg, "more than a tenth of the stroke"));
+    }
+    let approach = crate::description::Approach { standoff, speed };
+    let motion = trajectory.landing - trajectory.takeoff;
+    if approach.duration() > 0.5 * motion {
+        let msg = format!(
+            "the approach takes 5·standoff/(4·approach_speed) = {:e} s, more than half of the \
+             motion trajectory.landing − trajectory.takeoff = {motion:e} s: a faster approach, \
+             a smaller standoff or a later landing leaves the move its time",
+            approach.duration()
+        );
+        return Err(trajectory_sect.err("approach_speed", msg, "the approach is too long"));
+    }
+    Ok(())
+}
+
 /// A controller tracks a `[trajectory]` sampled at least 10 times per
 /// motion, or (the model-based sliding mode) holds a constant `position`
 /// within the stroke.

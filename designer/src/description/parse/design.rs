@@ -37,6 +37,8 @@ pub(super) fn parse_trajectory(s: &Sect, supply: &Supply) -> Res<Trajectory> {
     let u_bound = s.req_in("u_bound", unit)?;
     check_u_bound(s, u_bound, supply, unit)?;
     let contact_uncertainty = s.or_default("contact_uncertainty")?;
+    let standoff = s.or_default("standoff")?;
+    let approach_speed = s.opt("approach_speed")?;
     Ok(Trajectory {
         operations,
         takeoff,
@@ -44,6 +46,8 @@ pub(super) fn parse_trajectory(s: &Sect, supply: &Supply) -> Res<Trajectory> {
         shape,
         u_bound,
         contact_uncertainty,
+        standoff,
+        approach_speed,
     })
 }
 

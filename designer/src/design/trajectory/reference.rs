@@ -21,6 +21,16 @@ pub trait Reference {
     fn motion(&self) -> (f64, f64);
 }
 
+impl<R: Reference + ?Sized> Reference for Box<R> {
+    fn at(&self, t: f64) -> Flat {
+        (**self).at(t)
+    }
+
+    fn motion(&self) -> (f64, f64) {
+        (**self).motion()
+    }
+}
+
 /// [PT 51–53] with the 5th-degree polynomial motion.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Polynomial {
