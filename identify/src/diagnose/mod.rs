@@ -405,6 +405,10 @@ fn diagnose_step(
                 continue;
             }
         };
+        // (a fit that gains on the held-out end but is not worth its
+        // parameters there may stop short of the record: it is tested again
+        // on the model the polish names, which places its own edges)
+        let mut confirm_effect = false;
         if by_effect {
             let held_out = evidence::held_out_effect(
                 &baseline_replay.current[k..],
@@ -412,10 +416,15 @@ fn diagnose_step(
                 &data.i[k..],
                 &weights[k..],
                 scored.parameters,
+                noise_floor,
             );
-            if let Some(reason) = evidence::effect_unseen(scored.cause, held_out) {
-                not_identifiable.push((scored.cause, reason));
-                continue;
+            if let Some(reason) = held_out.and_then(|e| evidence::effect_unseen(scored.cause, e)) {
+                if held_out_gain(&extended_replay).is_some_and(|h| h.gain > 0.0) {
+                    confirm_effect = true;
+                } else {
+                    not_identifiable.push((scored.cause, reason));
+                    continue;
+                }
             }
         }
         match held_out_gain(&extended_replay) {
@@ -487,6 +496,21 @@ fn diagnose_step(
                         held_out: held_out_gain(&extended_replay),
                     });
                     continue;
+                }
+                if confirm_effect {
+                    let again = evidence::held_out_effect(
+                        &baseline_replay.current[k..],
+                        &extended_replay.current[k..],
+                        &data.i[k..],
+                        &weights[k..],
+                        scored.parameters,
+                        noise_floor,
+                    );
+                    let unseen = again.and_then(|e| evidence::effect_unseen(scored.cause, e));
+                    if let Some(reason) = unseen {
+                        not_identifiable.push((scored.cause, reason));
+                        continue;
+                    }
                 }
                 chosen = Some((
                     scored.cause,
