@@ -91,18 +91,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
             args.initial_field
         )));
     }
-    let noise = Noise {
-        seed: args.seed,
-        sigma: match args.noise.as_deref() {
-            None => None,
-            Some(&[v, i]) if v >= 0.0 && i >= 0.0 && v.is_finite() && i.is_finite() => Some([v, i]),
-            Some(other) => {
-                return Err(fail(format!(
-                    "--noise: expected two numbers σ_v,σ_i ≥ 0 [V,A], found {other:?}"
-                )))
-            }
-        },
-    };
+    let noise = noise_of(args)?;
     let holds = matches!(
         controller.law,
         Law::ModelSlidingMode(ModelSurface {
@@ -373,4 +362,21 @@ pub(crate) fn design_at(
         resample_observer(o, ts);
     }
     Design::new(&designed).map_err(|e| fail(format!("{file}: {e}")))
+}
+
+/// `--seed` and `--noise` as the loop's measurement noise.
+pub(crate) fn noise_of(args: &Args) -> Result<Noise, Report> {
+    let sigma = match args.noise.as_deref() {
+        None => None,
+        Some(&[v, i]) if v >= 0.0 && i >= 0.0 && v.is_finite() && i.is_finite() => Some([v, i]),
+        Some(other) => {
+            return Err(fail(format!(
+                "--noise: expected two numbers σ_v,σ_i ≥ 0 [V,A], found {other:?}"
+            )))
+        }
+    };
+    Ok(Noise {
+        seed: args.seed,
+        sigma,
+    })
 }

@@ -50,7 +50,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
         plant.as_ref(),
         runs,
         ts,
-        args.seed,
+        crate::closed_loop::noise_of(args)?,
         &options,
     )
     .map_err(|e| fail(format!("{file}: {e}")))?;

@@ -244,4 +244,25 @@ fn loop_runs_prints_the_contracts_json() {
     rd!("loop", model, "--json").rejected(&["--json", "--runs"]);
     rd!("loop", model).rejected(&["--out"]);
     rd!("loop", model, "--runs", "0", "--json").rejected(&["--runs"]);
+    rd!("loop", model, "--runs", "1", "--json", "--noise", "-1,0").rejected(&["--noise"]);
+}
+
+/// `loop --runs` reads the measurement noise of `--noise` as `loop` does:
+/// without noise the seed changes nothing, with it the seed changes the run.
+#[test]
+fn loop_runs_honours_the_noise() {
+    let model = example_path("self-calibrating-valve.toml");
+    let model = model.to_str().unwrap();
+    let first = |seed: &str, noise: &[&str]| {
+        let mut args = vec!["loop", model, "--runs", "1", "--json", "--seed", seed];
+        args.extend_from_slice(noise);
+        let text = support::Cli::new(env!("CARGO_BIN_EXE_reldesign"))
+            .run(&args)
+            .ok();
+        let json: Value = serde_json::from_str(&text).unwrap();
+        json["runs"][0]["operations"][1]["impact_velocity"].clone()
+    };
+    let silent = ["--noise", "0,0"];
+    assert_eq!(first("1", &silent), first("2", &silent));
+    assert_ne!(first("1", &[]), first("2", &[]));
 }

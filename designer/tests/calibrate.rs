@@ -307,8 +307,16 @@ fn every_operation_reaches_its_stop_on_a_plant_the_design_cannot_follow() {
     let design = design();
     // a spring preloaded 60 % harder: the law's takeoff balances the wrong force
     let plant = plant(&[("preload = -0.75", "preload = -1.2")]);
-    let runs = run_runs(&design, None, Some(&plant), 1, 5e-5, 7, &Default::default())
-        .unwrap_or_else(|e| panic!("{e}"));
+    let runs = run_runs(
+        &design,
+        None,
+        Some(&plant),
+        1,
+        5e-5,
+        Noise::seeded(7),
+        &Default::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     for o in &runs[0].operations {
         assert!(
             o.outcome.impact_velocity.is_some(),

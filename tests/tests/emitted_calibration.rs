@@ -8,7 +8,7 @@
 //! again on the adapted description.
 
 use designer::calibrate::{adapted_design, choose, innovations, run_runs, Outcome};
-use designer::closed_loop::Measured;
+use designer::closed_loop::{Measured, Noise};
 use designer::description::parse_str;
 use designer::design::{Design, RuntimePlan};
 use reldesign_generated::self_calibrating_valve as sc;
@@ -42,7 +42,7 @@ fn measured_run(text: &str, design: &Design, seed: u64) -> Vec<Measured> {
         Some(&plant.description),
         1,
         ts,
-        seed,
+        Noise::seeded(seed),
         &Default::default(),
     )
     .unwrap_or_else(|e| panic!("{e}"));

@@ -13,7 +13,7 @@
 
 use designer::calibrate::{choose, run_runs, run_runs_updated_by, Outcome, Run};
 use designer::closed_loop::switching_baseline;
-use designer::closed_loop::Measured;
+use designer::closed_loop::{Measured, Noise};
 use designer::description::{parse_str, Description, Operation};
 use designer::design::Design;
 use reldesign_generated::self_calibrating_valve::ukf::f32 as emitted;
@@ -82,7 +82,7 @@ fn runs_by(design: &Design, plant: &Variant, n: usize, updater: Updater) -> Vec<
             Some(&plant.description),
             n,
             ts,
-            plant.seed,
+            Noise::seeded(plant.seed),
             &Default::default(),
         ),
         Updater::EmittedF32 => run_runs_updated_by(
@@ -91,7 +91,7 @@ fn runs_by(design: &Design, plant: &Variant, n: usize, updater: Updater) -> Vec<
             Some(&plant.description),
             n,
             ts,
-            plant.seed,
+            Noise::seeded(plant.seed),
             &Default::default(),
             &mut emitted_f32,
         ),

@@ -10,6 +10,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use designer::calibrate::run_runs;
+use designer::closed_loop::Noise;
 use designer::description::parse_str;
 use designer::design::Design;
 
@@ -43,7 +44,7 @@ fn main() {
         .as_ref()
         .expect("controller")
         .sample_period;
-    let runs = run_runs(&adaptive, None, Some(&plant), 1, ts, 7, &Default::default())
+    let runs = run_runs(&adaptive, None, Some(&plant), 1, ts, Noise::seeded(7), &Default::default())
         .unwrap_or_else(|e| panic!("{e}"));
     let measured = &runs[0].run_loop.measured;
     let mut rec = format!(

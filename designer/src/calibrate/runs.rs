@@ -55,7 +55,7 @@ pub struct Run {
 }
 
 /// `runs` runs of `design` on `plant` (default: its own model) at
-/// `sample_period`, the noise of run k seeded by `seed + k`, with the
+/// `sample_period`, the measurement noise of run k `noise` seeded by `noise.seed + k`, with the
 /// calibration (where given) updated after every operation's run.
 pub fn run_runs(
     design: &Design,
@@ -63,14 +63,14 @@ pub fn run_runs(
     plant: Option<&Description>,
     runs: usize,
     sample_period: f64,
-    seed: u64,
+    noise: Noise,
     options: &Options,
 ) -> Result<Vec<Run>, RunsError> {
     let study = Study {
         design,
         plant,
         sample_period,
-        seed,
+        noise,
         options,
     };
     let p = calibration.map_or(0, |c| c.parameters.len());
@@ -102,7 +102,7 @@ pub fn run_runs_updated_by(
     plant: Option<&Description>,
     runs: usize,
     sample_period: f64,
-    seed: u64,
+    noise: Noise,
     options: &Options,
     update: &mut RunUpdate,
 ) -> Result<Vec<Run>, RunsError> {
@@ -110,7 +110,7 @@ pub fn run_runs_updated_by(
         design,
         plant,
         sample_period,
-        seed,
+        noise,
         options,
     };
     study.updated_by(c, runs, update)
@@ -121,7 +121,7 @@ struct Study<'a> {
     design: &'a Design,
     plant: Option<&'a Description>,
     sample_period: f64,
-    seed: u64,
+    noise: Noise,
     options: &'a Options,
 }
 
@@ -142,7 +142,10 @@ impl Study<'_> {
             )
         };
         let d = adapted.as_ref().unwrap_or(self.design);
-        let noise = Noise::seeded(self.seed.wrapping_add(run as u64));
+        let noise = Noise {
+            seed: self.noise.seed.wrapping_add(run as u64),
+            ..self.noise
+        };
         let trajectory = self.design.description.trajectory.as_ref();
         let window = trajectory.map(super::operation_window);
         let looped = run_spaced_loop(
