@@ -408,17 +408,20 @@ fn diagnose_step(
         // (a fit that gains on the held-out end but is not worth its
         // parameters there may stop short of the record: it is tested again
         // on the model the polish names, which places its own edges)
-        let mut confirm_effect = false;
-        if by_effect {
+        let effect_unseen = |extended: &SimOutputs| {
             let held_out = evidence::held_out_effect(
                 &baseline_replay.current[k..],
-                &extended_replay.current[k..],
+                &extended.current[k..],
                 &data.i[k..],
                 &weights[k..],
                 scored.parameters,
                 noise_floor,
             );
-            if let Some(reason) = held_out.and_then(|e| evidence::effect_unseen(scored.cause, e)) {
+            held_out.and_then(|e| evidence::effect_unseen(scored.cause, e))
+        };
+        let mut confirm_effect = false;
+        if by_effect {
+            if let Some(reason) = effect_unseen(&extended_replay) {
                 if held_out_gain(&extended_replay).is_some_and(|h| h.gain > 0.0) {
                     confirm_effect = true;
                 } else {
@@ -497,20 +500,12 @@ fn diagnose_step(
                     });
                     continue;
                 }
-                if confirm_effect {
-                    let again = evidence::held_out_effect(
-                        &baseline_replay.current[k..],
-                        &extended_replay.current[k..],
-                        &data.i[k..],
-                        &weights[k..],
-                        scored.parameters,
-                        noise_floor,
-                    );
-                    let unseen = again.and_then(|e| evidence::effect_unseen(scored.cause, e));
-                    if let Some(reason) = unseen {
-                        not_identifiable.push((scored.cause, reason));
-                        continue;
-                    }
+                if let Some(reason) = confirm_effect
+                    .then(|| effect_unseen(&extended_replay))
+                    .flatten()
+                {
+                    not_identifiable.push((scored.cause, reason));
+                    continue;
                 }
                 chosen = Some((
                     scored.cause,
