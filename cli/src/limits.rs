@@ -165,6 +165,13 @@ fn text(model: &mut Model, ops: &[Operation], file: &str) -> String {
             }
         }
     }
+    if let Some(a) = d.trajectory.as_ref().and_then(|t| t.approach()) {
+        let _ = writeln!(
+            s,
+            "\nwith [trajectory] standoff: t_f − t₀ holds the approach too, 5·standoff/(4·approach_speed) = {:.4} ms beyond the move (the motions above cross the whole stroke)",
+            a.duration() * 1e3
+        );
+    }
     let _ = write!(s, "\n{}", crate::check::statics_text(model));
     s
 }
@@ -185,8 +192,10 @@ fn limits_json(l: &MotionLimits) -> serde_json::Value {
 }
 
 fn json(ops: &[Operation], d: &Description) -> serde_json::Value {
+    let approach = d.trajectory.as_ref().and_then(|t| t.approach());
     serde_json::json!({
         "name": d.name,
+        "approach_time": approach.map(|a| a.duration()),
         "operations": ops.iter().map(|op| serde_json::json!({
             "operation": op.name,
             "supply": limits_json(&op.supply),

@@ -225,3 +225,23 @@ fn an_infeasible_polynomial_says_which_time_it_needs_and_that_time_works() {
         relay_with("poly-too-short", &[poly[0], ("landing = 11e-3", &landing)]);
     assert!(!build(&too_short).0);
 }
+
+/// With `[trajectory] standoff`, `limits` says how much of t_f − t₀ the
+/// approach holds (5·δ/(4·v_c)), in its text and its JSON; without, null.
+#[test]
+fn limits_names_the_approachs_share_of_the_motion() {
+    let (_dir, model) = relay_with(
+        "standoff",
+        &[(
+            "u_bound = 10.0",
+            "u_bound = 10.0\nstandoff = 20e-6\napproach_speed = 10e-3",
+        )],
+    );
+    let v: Value = serde_json::from_str(&rd!("limits", model, "--json").ok()).unwrap();
+    let approach = v["approach_time"].as_f64().unwrap();
+    assert!((approach - 2.5e-3).abs() < 1e-15, "{approach}");
+    assert!(rd!("limits", model).ok().contains("holds the approach too"));
+    let plain = root().join("tests/data/relay-12v.toml");
+    let v: Value = serde_json::from_str(&rd!("limits", plain, "--json").ok()).unwrap();
+    assert!(v["approach_time"].is_null());
+}
