@@ -89,6 +89,15 @@ pub fn report_json(design: &Design) -> String {
             if let (Some(opt), Some(map)) = (&o.optimal, entry.as_object_mut()) {
                 map.insert("optimal".into(), opt.summary_json());
             }
+            let approach = (design.description.trajectory.as_ref()).and_then(|t| t.approach());
+            if let (Some(a), Some(map)) = (approach, entry.as_object_mut()) {
+                let approach = serde_json::json!({
+                    "standoff": a.standoff,
+                    "speed": a.speed,
+                    "duration": a.duration(),
+                });
+                map.insert("approach".into(), approach);
+            }
             (o.operation.name().to_string(), entry)
         })
         .collect();

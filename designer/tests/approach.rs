@@ -95,6 +95,14 @@ fn the_table_rests_short_of_the_stop_then_reaches_it_at_the_approach_speed() {
     }
     // after t_f the runtime's creep goes on at v_c (a fraction of the stroke per second)
     assert!((c.creep * STROKE - SPEED).abs() < 1e-12, "{}", c.creep);
+    // the report's JSON names it per operation
+    let json: serde_json::Value =
+        serde_json::from_str(&designer::design_json::report_json(&design)).unwrap();
+    for op in ["closing", "opening"] {
+        let a = &json["operations"][op]["approach"];
+        assert_eq!(a["standoff"], STANDOFF);
+        assert!((a["duration"].as_f64().unwrap() - approach_time).abs() < 1e-15);
+    }
 }
 
 #[test]
