@@ -133,6 +133,9 @@ struct Study {
     last: [f64; 2],
     worst_late: [f64; 2],
     bounce_late: [f64; 2],
+    /// The first run from which every later run lands ≥ 20× softer than
+    /// switching (`None`: the last run does not).
+    settled: [Option<usize>; 2],
     hovered: bool,
     /// The uncontrolled switching reaches both stops (a valve that works).
     switches: bool,
@@ -160,6 +163,7 @@ fn study(design: &Design, d: &Description, plant: &Variant, n: usize, updater: U
         last: [0.0; 2],
         worst_late: [f64::INFINITY; 2],
         bounce_late: [0.0; 2],
+        settled: [None; 2],
         hovered: false,
         switches: baseline.iter().all(|(_, v)| v.is_some()),
     };
@@ -170,6 +174,12 @@ fn study(design: &Design, d: &Description, plant: &Variant, n: usize, updater: U
             s.worst_late[k] = s.worst_late[k].min(softness(run, k));
             s.bounce_late[k] = s.bounce_late[k].max(run.operations[k].outcome.highest_bounce);
         }
+        let unsettled = done.iter().rposition(|run| softness(run, k) < 20.0);
+        s.settled[k] = match unsettled {
+            None => Some(1),
+            Some(last) if last + 1 < n => Some(last + 2),
+            Some(_) => None,
+        };
     }
     s.hovered = done
         .iter()
@@ -234,6 +244,19 @@ fn forty_plants(updater: Updater) {
                 "  {op}: worst of runs {}–{n}          {}",
                 n - 4,
                 quantiles(part.iter().map(|s| s.worst_late[k]).collect())
+            );
+            let settled: Vec<f64> = (part.iter())
+                .filter_map(|s| s.settled[k].map(|r| r as f64))
+                .collect();
+            println!(
+                "  {op}: ≥ 20× from run r on, for good: {} of {} plants, r {}",
+                settled.len(),
+                part.len(),
+                if settled.is_empty() {
+                    "—".to_string()
+                } else {
+                    quantiles(settled)
+                }
             );
             println!(
                 "  {op}: highest bounce of runs {}–{n} [% stroke] {}",
