@@ -106,3 +106,21 @@ pub fn impacts(
         _ => None,
     })
 }
+
+/// "min … median … max" of the finite values of `x` (a study's distribution
+/// over plants; a plant that gives no value, e.g. a valve whose switching
+/// misses a stop, is left out).
+pub fn quantiles(mut x: Vec<f64>) -> String {
+    x.retain(|v| v.is_finite());
+    x.sort_by(f64::total_cmp);
+    if x.is_empty() {
+        return "—".to_string();
+    }
+    let q = |p: f64| x[((x.len() - 1) as f64 * p).round() as usize];
+    format!(
+        "min {:6.1}  median {:6.1}  max {:6.1}",
+        q(0.0),
+        q(0.5),
+        q(1.0)
+    )
+}

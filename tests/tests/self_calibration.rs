@@ -17,8 +17,8 @@ use designer::closed_loop::{Measured, Noise};
 use designer::description::{parse_str, Description, Operation};
 use designer::design::Design;
 use reldesign_generated::self_calibrating_valve::ukf::f32 as emitted;
-use reldesign_tests::example_path;
 use reldesign_tests::variants::{physics_of, variant, Variant};
+use reldesign_tests::{example_path, quantiles};
 
 const EXAMPLE: &str = "self-calibrating-valve.toml";
 const STROKE: f64 = 1e-3;
@@ -186,19 +186,6 @@ fn study(design: &Design, d: &Description, plant: &Variant, n: usize, updater: U
         .flat_map(|r| &r.operations)
         .any(|o| o.outcome.impact_velocity.is_none());
     s
-}
-
-fn quantiles(mut x: Vec<f64>) -> String {
-    // a plant whose switching never reached the stop has no softness
-    x.retain(|v| v.is_finite());
-    x.sort_by(f64::total_cmp);
-    let q = |p: f64| x[((x.len() - 1) as f64 * p).round() as usize];
-    format!(
-        "min {:6.1}  median {:6.1}  max {:6.1}",
-        q(0.0),
-        q(0.5),
-        q(1.0)
-    )
 }
 
 #[test]

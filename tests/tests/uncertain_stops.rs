@@ -13,13 +13,13 @@
 //! standoff lands at least 3× softer, and the distribution over 40 plants,
 //! printed by `cargo test --release -p reldesign-tests --test uncertain_stops -- --nocapture`.
 
-use designer::closed_loop::{run_loop, switching_baseline, Noise, OperationOutcome};
+use designer::closed_loop::{sweep, switching_baseline, OperationOutcome};
 use designer::description::{parse_str, Description, Operation};
 use designer::design::Design;
 use designer::random::SplitMix64;
 use designer::sim::Options;
-use reldesign_tests::example_path;
 use reldesign_tests::variants::{physics_of, variant};
+use reldesign_tests::{example_path, quantiles};
 
 const STROKE: f64 = 1e-3;
 const MOST_DISPLACED: f64 = 20e-6;
@@ -75,17 +75,15 @@ fn landings(design: &Design, plant: &Description) -> Option<[(f64, f64); 2]> {
         switching(Operation::Closing)?,
         switching(Operation::Opening)?,
     ];
-    let t = design.description.trajectory.as_ref().expect("trajectory");
-    let run = run_loop(
-        design,
+    // the description's own design at its own period, as `reldesign sweep` runs it
+    let rows = sweep(
+        &design.description,
         Some(plant),
-        1e-5,
-        None,
-        Noise::seeded(0),
+        &[1e-5],
         &Options::default(),
     )
     .unwrap_or_else(|e| panic!("{e}"));
-    let outcomes = run.outcomes(t.takeoff, t.landing);
+    let outcomes = &rows.first().expect("one period").outcomes;
     let of = |k: usize, op: Operation| {
         let o: &OperationOutcome = outcomes.iter().find(|o| o.operation == op).expect("op");
         let softness = o
@@ -115,18 +113,6 @@ fn the_standoff_lands_softer_on_displaced_stops_of_varied_plants() {
             );
         }
     }
-}
-
-fn quantiles(mut x: Vec<f64>) -> String {
-    x.retain(|v| v.is_finite());
-    x.sort_by(f64::total_cmp);
-    let q = |p: f64| x[((x.len() - 1) as f64 * p).round() as usize];
-    format!(
-        "min {:6.1}  median {:6.1}  max {:6.1}",
-        q(0.0),
-        q(0.5),
-        q(1.0)
-    )
 }
 
 /// The distribution over 40 plants (`--nocapture` prints it): the standoff
@@ -166,5 +152,25 @@ fn the_standoff_over_forty_plants() {
             .filter(|l| l.iter().any(|&(s, _)| s == 0.0))
             .count();
         println!("  plants with an operation that never landed: {missed}");
+        medians.push([0, 1].map(|k| median(all.iter().map(|l| l[k].0).collect())));
+        if *name == "standoff" {
+            assert_eq!(
+                missed, 0,
+                "the standoff left an operation short of its stop"
+            );
+        }
     }
+    for k in 0..2 {
+        assert!(
+            medians[1][k] >= 4.0 * medians[0][k],
+            "operation {k}: the standoff's median {}× against {}×",
+            medians[1][k],
+            medians[0][k]
+        );
+    }
+}
+
+fn median(mut x: Vec<f64>) -> f64 {
+    x.sort_by(f64::total_cmp);
+    x[x.len() / 2]
 }
