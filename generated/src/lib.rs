@@ -35,9 +35,9 @@ pub mod jiles_atherton_valve;
 pub mod backstepping_valve;
 
 /// `examples/self-calibrating-valve.toml`: the perfect-tracking valve,
-/// sensorless at 50 µs (the UKF from the coil voltage and current). Its
-/// run-to-run self-calibration runs in `reldesign loop --runs`; the emitted
-/// update is not in this file yet (`docs/guide/self-calibration.md`).
+/// sensorless at 50 µs (the UKF from the coil voltage and current), with its
+/// run-to-run self-calibration: θ read at run time by the law and the filter,
+/// and the update between runs (`docs/guide/self-calibration.md`).
 #[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
 pub mod self_calibrating_valve;
 
