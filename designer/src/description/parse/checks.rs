@@ -98,9 +98,7 @@ pub(super) fn check_u_bound(s: &Sect, u_bound: f64, supply: &Supply, unit: &str)
     if u_bound > lower && u_bound <= u_max {
         return Ok(());
     }
-    let found = s
-        .entry("u_bound")
-        .map_or_else(|| u_bound.to_string(), |(_, v)| s.ctx.found(v));
+    let found = s.found("u_bound", u_bound);
     let design = "the trajectory is designed with inputs in [max(u_min, -u_bound), u_bound], \
                   which must lie within the supply and include positive inputs (closing needs \
                   them)";
@@ -157,9 +155,7 @@ pub(super) fn check_contact_uncertainty(
         return Ok(());
     }
     let key = "contact_uncertainty";
-    let found = trajectory_sect
-        .entry(key)
-        .map_or_else(|| sigma.to_string(), |(_, v)| trajectory_sect.ctx.found(v));
+    let found = trajectory_sect.found(key, sigma);
     if trajectory.shape != Shape::EnergyOptimal {
         let msg = format!(
             "found {found} [m] with shape = \"polynomial\": the probability-based reference \
@@ -189,11 +185,7 @@ pub(super) fn check_approach(
     trajectory: &Trajectory,
     mechanics: &Mechanics,
 ) -> Res<()> {
-    let found = |key: &str, value: f64| {
-        trajectory_sect
-            .entry(key)
-            .map_or_else(|| value.to_string(), |(_, v)| trajectory_sect.ctx.found(v))
-    };
+    let found = |key: &str, value: f64| trajectory_sect.found(key, value);
     let standoff = trajectory.standoff;
     let Some(speed) = trajectory.approach_speed else {
         if standoff > 0.0 {
@@ -281,9 +273,7 @@ pub(super) fn check_controller(
     };
     let limit = t.longest_sample_period();
     if c.sample_period > limit {
-        let found = s
-            .entry("sample_period")
-            .map_or_else(|| c.sample_period.to_string(), |(_, v)| s.ctx.found(v));
+        let found = s.found("sample_period", c.sample_period);
         let msg = format!(
             "expected a number <= (trajectory.landing - trajectory.takeoff)/10 = {limit:e} [s], \
              found {found}: the motion must span at least 10 sample periods for the sampled \
@@ -308,9 +298,7 @@ fn check_position(
         return Err(root.err("trajectory", msg, "conflicts with controller.position"));
     }
     if !(m.z_min..=m.z_max).contains(&z_ref) {
-        let found = s
-            .entry("position")
-            .map_or_else(|| z_ref.to_string(), |(_, v)| s.ctx.found(v));
+        let found = s.found("position", z_ref);
         let msg = format!(
             "expected a number in [mechanics.z_min, mechanics.z_max] = [{}, {}] [m], found \
              {found}: the armature can only be held within its stroke",

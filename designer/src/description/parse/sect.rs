@@ -102,6 +102,13 @@ impl<'a> Sect<'a> {
         }
     }
 
+    /// `key`'s value as the file writes it (for "found …" in a message), or
+    /// `value` where the key is absent (a default).
+    pub(super) fn found(&self, key: &str, value: f64) -> String {
+        self.entry(key)
+            .map_or_else(|| value.to_string(), |(_, v)| self.ctx.found(v))
+    }
+
     pub(super) fn err(&self, key: &str, msg: impl Into<String>, label: &str) -> DescriptionError {
         self.ctx
             .err(self.full_key(key), self.key_span(key), msg, label)
