@@ -234,11 +234,19 @@ impl Approach {
         self.standoff / self.speed + 0.5 * self.ramp()
     }
 
+    /// The approach's knots for a landing at `tf`: t_s, where the move ends
+    /// and the ramp starts, and the ramp's end.
+    pub fn knots(&self, tf: f64) -> [f64; 2] {
+        let start = tf - self.duration();
+        [start, start + self.ramp()]
+    }
+
     /// The move's end z_s and time t_s for an operation from `z0` to the stop
     /// `zf` landing at `tf`.
     pub fn move_end(&self, z0: f64, zf: f64, tf: f64) -> (f64, f64) {
         let direction = (zf - z0).signum();
-        (zf - direction * self.standoff, tf - self.duration())
+        let [start, _] = self.knots(tf);
+        (zf - direction * self.standoff, start)
     }
 }
 

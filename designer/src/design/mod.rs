@@ -54,7 +54,7 @@ pub use plan::{design_controller, design_kalman, design_reference, Design, Share
 pub use runtime::{
     runtime_switching, RuntimeBackstepping, RuntimeController, RuntimeHold, RuntimePlan,
 };
-pub use trajectory::approach::{Approach, Approached};
+pub use trajectory::approach::Approached;
 pub use trajectory::bvp::{
     jacobian_discrepancy, solve_bvp, solve_collocation, BvpError, BvpOptions, BvpProblem,
     BvpSolution,

@@ -165,6 +165,7 @@ pub fn design_reference(
     let Some(approach) = trajectory.approach() else {
         return design_move(
             description,
+            trajectory,
             model,
             linearization,
             operation,
@@ -180,6 +181,7 @@ pub fn design_reference(
     };
     let (moving, optimal) = design_move(
         description,
+        trajectory,
         model,
         linearization,
         operation,
@@ -198,15 +200,13 @@ pub fn design_reference(
 /// The move of `polynomial`'s ends and times in `[trajectory]`'s shape.
 fn design_move(
     description: &Description,
+    trajectory: &Trajectory,
     model: &mut Model,
     linearization: &Linearization,
     operation: Operation,
     bounds: (f64, f64),
     polynomial: Polynomial,
 ) -> Result<(SharedReference, Option<OptimalTrajectory>), PlanError> {
-    let Some(trajectory) = &description.trajectory else {
-        return Err(PlanError::NothingToBuild);
-    };
     match trajectory.shape {
         Shape::Polynomial => Ok((Box::new(polynomial), None)),
         Shape::EnergyOptimal => {
@@ -295,8 +295,7 @@ fn design_operation(
     let takeoff = check_takeoff(operation, supply, reference.as_ref(), planned)?;
     let mut breaks: Vec<f64> = optimal.iter().flat_map(|o| o.breaks()).collect();
     if let Some(approach) = trajectory.approach() {
-        let start = trajectory.landing - approach.duration();
-        breaks.extend([start, start + approach.ramp()]);
+        breaks.extend(approach.knots(trajectory.landing));
     }
     let fit =
         fit_segments(reference.as_ref(), &breaks, &SegmentTolerance::default()).map_err(|e| {

@@ -15,7 +15,7 @@
 //! (`optimal/robust.rs`): the speed at every stop within δ is bounded, not
 //! only its expectation weighed.
 
-pub use crate::description::Approach;
+use crate::description::Approach;
 use crate::design::trajectory::reference::{Flat, Reference};
 
 /// The move (a reference ending at rest at z_s at t_s), then the approach.
@@ -31,8 +31,7 @@ pub struct Approached<R> {
 impl<R: Reference> Approached<R> {
     /// The move's end time t_s and the ramp's end, for the table's knots.
     pub fn breaks(&self) -> [f64; 2] {
-        let start = self.landing - self.approach.duration();
-        [start, start + self.approach.ramp()]
+        self.approach.knots(self.landing)
     }
 
     fn direction(&self) -> f64 {
