@@ -419,10 +419,11 @@ fn diagnose_step(
             );
             held_out.and_then(|e| evidence::effect_unseen(scored.cause, e))
         };
+        let held_out = held_out_gain(&extended_replay);
         let mut confirm_effect = false;
         if by_effect {
             if let Some(reason) = effect_unseen(&extended_replay) {
-                if held_out_gain(&extended_replay).is_some_and(|h| h.gain > 0.0) {
+                if held_out.is_some_and(|h| h.gain > 0.0) {
                     confirm_effect = true;
                 } else {
                     not_identifiable.push((scored.cause, reason));
@@ -430,7 +431,7 @@ fn diagnose_step(
                 }
             }
         }
-        match held_out_gain(&extended_replay) {
+        match held_out {
             Some(h) if !(h.gain > 0.0) && held_out_visible => rejected.push(Rejected {
                 cause: scored.cause,
                 whole: whole_gain(&extended_replay),
