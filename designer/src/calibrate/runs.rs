@@ -55,7 +55,7 @@ pub struct Run {
 }
 
 /// `runs` runs of `design` on `plant` (default: its own model) at
-/// `sample_period`, the measurement noise of run k `noise` seeded by `noise.seed + k`, with the
+/// `sample_period`, the measurement noise `noise` with run k seeded by `noise.seed + k`, with the
 /// calibration (where given) updated after every operation's run.
 pub fn run_runs(
     design: &Design,
