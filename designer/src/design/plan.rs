@@ -162,23 +162,16 @@ pub fn design_reference(
         return Err(PlanError::NothingToBuild);
     };
     let (bounds, polynomial) = design_bounds(description, trajectory, operation);
-    let Some(approach) = trajectory.approach() else {
-        return design_move(
-            description,
-            trajectory,
-            model,
-            linearization,
-            operation,
-            bounds,
-            polynomial,
-        );
-    };
-    let (zs, ts) = approach.move_end(polynomial.z0, polynomial.zf, polynomial.tf);
-    let to_standoff = Polynomial {
-        zf: zs,
-        tf: ts,
-        ..polynomial
-    };
+    // with a standoff, the move ends short of the stop, and the approach follows
+    let approach = trajectory.approach();
+    let move_to = approach.map_or(polynomial, |a| {
+        let (zf, tf) = a.move_end(polynomial.z0, polynomial.zf, polynomial.tf);
+        Polynomial {
+            zf,
+            tf,
+            ..polynomial
+        }
+    });
     let (moving, optimal) = design_move(
         description,
         trajectory,
@@ -186,8 +179,11 @@ pub fn design_reference(
         linearization,
         operation,
         bounds,
-        to_standoff,
+        move_to,
     )?;
+    let Some(approach) = approach else {
+        return Ok((moving, optimal));
+    };
     let approached = Approached {
         moving,
         approach,
