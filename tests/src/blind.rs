@@ -15,8 +15,8 @@ use reldesign_identify::{fit, FitOptions, FitParam};
 
 use crate::devices::{device, Device};
 use crate::hidden::{
-    baseline_of, case_of, experiment, measured, noise_free, simulate, with_effect_for, Excitation,
-    HiddenCase, Noise, Sampling, SAMPLE_PERIOD,
+    baseline_of, case_of, errors_on, experiment, measured, noise_free, simulate, with_effect_for,
+    Excitation, HiddenCase, Noise, Sampling, SAMPLE_PERIOD,
 };
 use crate::Rng;
 
@@ -91,34 +91,71 @@ impl Blind {
         let (base, _) = baseline_of(&device.toml, &file);
         let square = at_least(Excitation::square_wave(&base), samples);
         let seed = seed ^ 0x36_0000;
+        let draw = |causes: &[Cause], excitation: &Excitation| {
+            // a draw that leaves a cause without evidence is drawn again
+            (0..MOST_DRAWS)
+                .map(|attempt| {
+                    let seed = seed ^ (attempt << 32);
+                    case_of(&device.toml, &file, causes, excitation, false, seed)
+                })
+                .find(|case| evidence(self, case).iter().all(|&b| b > 0.0))
+                .unwrap_or_else(|| panic!("{file}: no draw of {causes:?} shows every cause"))
+        };
         match self {
             Blind::HysteresisBelowPullIn => hysteresis_below_pull_in(&device, &file, seed, samples),
-            Blind::FringingWithEddy => case_of(
-                &device.toml,
-                &file,
-                &[Cause::Fringing, Cause::EddyCurrents],
-                &square,
-                false,
-                seed,
-            ),
-            Blind::DriftWithBounce => case_of(
-                &device.toml,
-                &file,
+            Blind::FringingWithEddy => draw(&[Cause::Fringing, Cause::EddyCurrents], &square),
+            Blind::DriftWithBounce => draw(
                 &[Cause::ResistanceDrift, Cause::Bouncing],
                 &at_least(Excitation::square_wave(&base).repeated(4), samples),
-                false,
-                seed,
             ),
-            Blind::LoneFringing => case_of(
-                &device.toml,
-                &file,
-                &[Cause::Fringing],
-                &square,
-                false,
-                seed,
-            ),
+            Blind::LoneFringing => draw(&[Cause::Fringing], &square),
         }
     }
+}
+
+/// Draws of a record before its class is given up: one is enough unless a
+/// cause leaves no evidence (see [`evidence`]).
+const MOST_DRAWS: u64 = 8;
+
+/// `truth` without `cause`: the fields its draw sets back to `base`'s.
+pub fn without(truth: &Description, base: &Description, cause: Cause) -> Description {
+    let mut d = truth.clone();
+    match cause {
+        Cause::Fringing => d.gap = base.gap.clone(),
+        Cause::EddyCurrents => d.coil.eddy = base.coil.eddy,
+        Cause::ResistanceDrift => d.coil.resistance_drift = base.coil.resistance_drift,
+        Cause::Bouncing => d.mechanics.restitution = base.mechanics.restitution,
+        Cause::Hysteresis | Cause::Saturation => d.core = base.core.clone(),
+        Cause::None | Cause::Unexplained => {}
+    }
+    d
+}
+
+/// The evidence each of the class's causes leaves in `case`: the truth
+/// without that cause against the truth itself (whose error is the floor),
+/// n·ln(e_without²/e_truth²) − ln n, the BIC by which the record prefers
+/// the cause at the price of one parameter (the diagnosis's criterion,
+/// `rank::bic`; n the independent samples, the weights' effective count
+/// over the truth's residual's autocorrelation time, as its held-out test
+/// counts them, [`errors_on`]). Where it is ≤ 0 the record carries no
+/// evidence of the cause and is not a record of the class: it is drawn
+/// again. Held-out seed 105 of the warming relay drew a
+/// first impact of 0.09 m/s at γ = 0.45, bounces of a few µm: the truth
+/// without them replayed the record 0.003 % *better* than the truth itself.
+/// Its redraw has +15.5 (the bounce lowers the error by 0.025 %); every
+/// other record of seeds 0–9 and 100–109 keeps its first draw, the least
+/// evidence among them 155.
+pub fn evidence(class: Blind, case: &HiddenCase) -> Vec<f64> {
+    let (base, _) = case.inputs();
+    class
+        .expected()
+        .iter()
+        .map(|&c| {
+            let less = without(&case.truth, &base, c);
+            let ([e, floor], n) = errors_on(case, [&less, &case.truth]);
+            n * (e * e / (floor * floor)).ln() - n.ln()
+        })
+        .collect()
 }
 
 /// Pulses at most this fraction of the stroke of motion count as "no motion".

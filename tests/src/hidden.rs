@@ -22,7 +22,7 @@ use designer::description::{parse_str, Core, Description, Gap, JilesAtherton, Re
 use designer::model::{Model, Statics, MU0};
 use designer::replay::{replay, Replay};
 use designer::sim::{EventKind, Limit, Options, PiecewiseLinear};
-use reldesign_identify::diagnose::Cause;
+use reldesign_identify::diagnose::{integrated_autocorrelation, Cause};
 use reldesign_identify::edges::{located, replay_input};
 use reldesign_identify::edit::write_physics;
 use reldesign_identify::wnrmse;
@@ -916,6 +916,20 @@ impl Visibility {
 /// currents with the measured one by [JA 81], weighted by |φ̇| estimated from
 /// the data as (v − R·i)/N (the coil equation, baseline R and N).
 pub fn visibility(case: &HiddenCase) -> Visibility {
+    let (base, _) = case.inputs();
+    let ([baseline_wnrmse, noise_wnrmse], _) = errors_on(case, [&base, &case.truth]);
+    Visibility {
+        baseline_wnrmse,
+        noise_wnrmse,
+    }
+}
+
+/// The wNRMSE of each of `models`' currents replayed on `case`'s measured
+/// voltage, as [`visibility`] weighs them, and the independent samples
+/// behind them: the weights' effective count (Kish, (Σw)²/Σw², as the
+/// diagnosis's BIC counts them) over the integrated autocorrelation time of
+/// the last model's weighted residual (as its held-out test counts them).
+pub fn errors_on<const K: usize>(case: &HiddenCase, models: [&Description; K]) -> ([f64; K], f64) {
     let (base, data) = case.inputs();
     let data = reldesign_identify::Measured {
         edges: Some(located(&base, &data)),
@@ -929,14 +943,18 @@ pub fn visibility(case: &HiddenCase) -> Visibility {
         .zip(&data.i)
         .map(|(v, i)| ((v - r * i) / n).abs())
         .collect();
-    let error = |d: &Description| {
+    let mut residual = Vec::new();
+    let mut error = |d: &Description| {
         let mut model = Model::build(d);
         let run = replay(&mut model, &input, &data.t, &Options::default())
             .unwrap_or_else(|e| panic!("{}: simulation failed: {e}", d.name));
+        residual = (run.current.iter().zip(&data.i).zip(&w))
+            .map(|((c, i), w)| w.sqrt() * (c - i))
+            .collect();
         wnrmse(&run.current, &data.i, &w)
     };
-    Visibility {
-        baseline_wnrmse: error(&base),
-        noise_wnrmse: error(&case.truth),
-    }
+    let errors = models.map(&mut error);
+    let (sum, squares) = w.iter().fold((0.0, 0.0), |(s, q), x| (s + x, q + x * x));
+    let tau = integrated_autocorrelation(&residual);
+    (errors, sum * sum / squares / tau)
 }

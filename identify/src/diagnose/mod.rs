@@ -1005,7 +1005,7 @@ impl Diagnosis {
 /// summed up to Sokal's automatic window (the first lag K ≥ 5·τ_int(K);
 /// at most a quarter of the samples): a sum over all lags is dominated by
 /// the noise of the far lags' estimates.
-pub(crate) fn integrated_autocorrelation(r: &[f64]) -> f64 {
+pub fn integrated_autocorrelation(r: &[f64]) -> f64 {
     let n = r.len();
     let mean = r.iter().sum::<f64>() / n.max(1) as f64;
     let c: Vec<f64> = r.iter().map(|x| x - mean).collect();
