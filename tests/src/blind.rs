@@ -3,7 +3,8 @@
 //! family [`FAMILY`] (never used to tune anything before), an effect or a
 //! pair of effects drawn as [`crate::hidden`] draws them, a noisy record.
 //! A seed gives one record; [`TUNING`] seeds were looked at while the
-//! diagnosis was changed, [`HELD_OUT`] seeds only to measure it.
+//! diagnosis was changed, [`HELD_OUT`] seeds only to measure it, [`FRESH`]
+//! seeds first after the last change.
 
 use std::ops::Range;
 
@@ -24,8 +25,12 @@ use crate::Rng;
 pub const FAMILY: u64 = 36;
 /// Seeds looked at while the diagnosis was changed.
 pub const TUNING: Range<u64> = 0..10;
-/// Seeds kept out of every change: they measure it.
+/// Seeds kept out of every change: they measure it. (The misses of the
+/// first two rounds were looked at to make the next change.)
 pub const HELD_OUT: Range<u64> = 100..110;
+/// Seeds first drawn after the third round (2026-12-02), to measure it on
+/// records nobody had looked at.
+pub const FRESH: Range<u64> = 200..210;
 
 /// A class of records and the answer it must get.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

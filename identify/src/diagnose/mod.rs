@@ -15,6 +15,7 @@
 //!
 //! Only the two inputs are read: the description and the recording.
 
+mod bounce_threshold;
 pub mod candidate;
 pub mod cause;
 pub mod evidence;
@@ -323,6 +324,10 @@ fn diagnose_step(
     let fit = |c: &Candidate, race: Race, stop: Option<&Stop>| {
         let options = ranking_options(c, stop, &fit_options);
         let report = crate::staged_fit::after_race(&c.start, &fit_data, &c.params, &options, race);
+        let report = match bounce_threshold::fits_restitution(&c.params) {
+            true => report.map(|r| bounce_threshold::scanned(r, &fit_data, &c.params, &options)),
+            false => report,
+        };
         score(c, report, n_eff)
     };
     let fits = waves::Fits {
