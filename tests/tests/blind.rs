@@ -184,3 +184,12 @@ fn a_drift_seen_on_the_held_out_end_is_named() {
 fn the_bounce_threshold_is_scanned() {
     right_within(Blind::DriftWithBounce, 4, 1.25);
 }
+
+/// A warming relay that bounces (fresh seed 209): the drift fitted jointly
+/// on the record's first 12 000 of 60 001 samples stopped 4 % short of the
+/// truth and left 2.03× the floor (`unexplained`, above the pair's 2×);
+/// fitted together on all but the held-out end, 1.08× (2026-12-02).
+#[test]
+fn a_drift_is_fitted_together_on_the_whole_fitted_part() {
+    right_within(Blind::DriftWithBounce, 209, 1.25);
+}

@@ -699,8 +699,9 @@ impl Path {
         while let Some(next) = next_step(baseline, &steps, data, options) {
             steps.push(next);
         }
-        let fitted_together =
-            steps.len() > 1 && joint::refit(&mut steps, data, &fit_options(options));
+        let whole_fitted_part = fitted_samples(data.t.len(), options.holdout);
+        let fitted_together = steps.len() > 1
+            && joint::refit(&mut steps, data, &fit_options(options), whole_fitted_part);
         let residual = Residual::of(&steps, data);
         Path {
             steps,
