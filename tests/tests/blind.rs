@@ -65,7 +65,7 @@ fn score(class: Blind, seeds: impl Iterator<Item = u64>) -> (usize, usize, Vec<S
 /// and `BLIND_SEEDS=tuning|held-out|fresh` narrow it.
 /// `cargo test --release -p reldesign-tests --test blind -- --ignored --nocapture`
 #[test]
-#[ignore = "slow: 120 records, every candidate"]
+#[ignore = "slow: 160 records, every candidate"]
 fn classes_on_unseen_devices() {
     let only = std::env::var("BLIND_CLASS").ok();
     let pick: Option<Vec<u64>> = std::env::var("BLIND_PICK")
