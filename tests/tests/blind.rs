@@ -61,7 +61,7 @@ fn score(class: Blind, seeds: impl Iterator<Item = u64>) -> (usize, usize, Vec<S
     (right, total, wrong)
 }
 
-/// Every class on its tuning and its held-out seeds; `BLIND_CLASS=<name>`
+/// Every class on its tuning, held-out and fresh seeds; `BLIND_CLASS=<name>`
 /// and `BLIND_SEEDS=tuning|held-out|fresh` narrow it.
 /// `cargo test --release -p reldesign-tests --test blind -- --ignored --nocapture`
 #[test]

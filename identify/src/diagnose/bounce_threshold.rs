@@ -12,9 +12,11 @@
 //! with v_ε anywhere between its last two bounce speeds, 39 and 63 mm/s,
 //! leave 1.00×; 0–10 mm/s, 2.5×; 70 mm/s, 3.8×).
 //!
-//! So v_ε is tried at the geometric mean of each two neighbouring levels of
-//! the fitted model's impact speeds (one replay each); the best is kept
-//! where it lowers the current's error, and the fit runs again from there.
+//! So after every ranking fit that fits γ, v_ε is tried at 0 and between each
+//! two neighbouring levels of the fitted model's impact speeds (one replay
+//! each); the best is kept where it lowers the current's error [JA 81], the
+//! fit runs again from there, and the candidate counts v_ε as one more
+//! parameter in its BIC.
 //! Scanned, that relay is named `bouncing + resistance-drift` at 1.16× the
 //! floor.
 
@@ -40,101 +42,102 @@ pub(super) fn fits_restitution(params: &[FitParam]) -> bool {
 
 const RESTITUTION: &str = "mechanics.restitution";
 
-/// `report` (a fit that fits the restitution of `params` on `data`), or its
-/// fit again from the best bounce threshold where that is better.
+/// `report` (a ranking fit of `params` on `data` from `start`, that fits
+/// the restitution), or its fit again from the best bounce threshold where
+/// that is better; whether v_ε moved (it is then one more parameter).
+///
+/// Every error here is measured as the ranking measures `report`'s: [JA 81]
+/// with the |φ̇| weights of `start`'s resistance, so that the refit's error
+/// stands beside the other candidates'.
 pub(super) fn scanned(
     report: FitReport,
+    start: &Description,
     data: &Measured,
     params: &[FitParam],
     options: &FitOptions,
-) -> FitReport {
-    better_threshold(&report, data, params, options)
-        .and_then(|start| {
-            let once = FitOptions {
-                starts: 1,
-                also_from: Vec::new(),
-                ..options.clone()
-            };
-            fit(&start, data, params, &once, &|_| {}).ok()
-        })
-        .filter(|refit| refit.wnrmse_current < report.wnrmse_current)
-        .unwrap_or(report)
+) -> (FitReport, bool) {
+    let Ok(setup) = Setup::new(start, data, params, options) else {
+        return (report, false);
+    };
+    let refit = better_threshold(&report.description, &setup, data).and_then(|from| {
+        let once = FitOptions {
+            starts: 1,
+            also_from: Vec::new(),
+            ..options.clone()
+        };
+        let mut refit = fit(&from, data, params, &once, &|_| {}).ok()?;
+        let errors = setup.objective.errors(&refit.description, data).ok()?;
+        refit.wnrmse_current = errors.current;
+        refit.wnrmse_flux = errors.flux;
+        refit.nrmse_position = errors.position;
+        refit.iterations += report.iterations;
+        refit.simulations += report.simulations;
+        Some(refit)
+    });
+    match refit {
+        Some(refit) if refit.wnrmse_current < report.wnrmse_current => (refit, true),
+        _ => (report, false),
+    }
 }
 
-/// The fitted model with the threshold that lowers its current's error
-/// most, if one does.
-fn better_threshold(
-    report: &FitReport,
-    data: &Measured,
-    params: &[FitParam],
-    options: &FitOptions,
-) -> Option<Description> {
-    let fitted = &report.description;
-    let setup = Setup::new(fitted, data, params, options).ok()?;
+/// `fitted` with the threshold that lowers its current's error most, if
+/// one does.
+fn better_threshold(fitted: &Description, setup: &Setup, data: &Measured) -> Option<Description> {
     let run = replay(fitted, data, &setup.objective.budget).ok()?;
-    let thresholds = between_levels(impact_speeds(&run.trajectory.events)?);
-    let error = |d: &Description| {
-        setup
-            .objective
-            .errors(d, data)
-            .map_or(f64::INFINITY, |e| e.current)
-    };
+    let own = setup.objective.errors(fitted, data).ok()?.current;
+    let thresholds = candidates(impact_speeds(&run.trajectory.events)?);
     let with_threshold = |v_eps: f64| {
         let mut d = fitted.clone();
         d.mechanics.bounce_threshold = v_eps;
         d
     };
-    // in parallel, reduced in order: the same choice on any number of threads
-    let tried: Vec<(f64, Description)> = (thresholds.par_iter())
+    // in parallel, collected in order: the same choice on any number of threads
+    let tried: Vec<(f64, f64)> = (thresholds.par_iter())
         .map(|&v| {
-            let d = with_threshold(v);
-            (error(&d), d)
+            let e = setup.objective.errors(&with_threshold(v), data);
+            (e.map_or(f64::INFINITY, |e| e.current), v)
         })
         .collect();
-    let own = error(fitted);
-    let (best, d) =
-        tried.into_iter().fold(
-            None,
-            |best: Option<(f64, Description)>, (e, d)| match best {
-                Some((b, _)) if b <= e => best,
-                _ => Some((e, d)),
-            },
-        )?;
-    (best < own).then_some(d)
+    let (best, v) = tried.into_iter().filter(|(e, _)| e.is_finite()).fold(
+        None,
+        |best: Option<(f64, f64)>, (e, v)| match best {
+            Some((b, _)) if b <= e => best,
+            _ => Some((e, v)),
+        },
+    )?;
+    (best < own).then(|| with_threshold(v))
 }
 
-/// |v| before each impact where the model bounces at least once, sorted;
-/// `None` where no impact bounces (nothing for the threshold to decide).
+/// |v| before each impact of the replay, sorted (`None` without impacts).
 fn impact_speeds(events: &[crate::sim::Event]) -> Option<Vec<f64>> {
-    let mut bounced = false;
     let mut speeds: Vec<f64> = events
         .iter()
         .filter_map(|e| match e.kind {
-            EventKind::Impact {
-                v_before, v_after, ..
-            } => {
-                bounced |= v_after != 0.0;
-                Some(v_before.abs())
-            }
+            EventKind::Impact { v_before, .. } => Some(v_before.abs()),
             _ => None,
         })
         .filter(|v| v.is_finite() && *v > 0.0)
         .collect();
     speeds.sort_by(f64::total_cmp);
-    bounced.then_some(speeds)
+    (!speeds.is_empty()).then_some(speeds)
 }
 
-/// The geometric mean of each two neighbouring levels of `speeds` (sorted),
-/// levels being runs of speeds within [`SAME_LEVEL`] of each other.
-fn between_levels(speeds: Vec<f64>) -> Vec<f64> {
-    let mut levels: Vec<f64> = Vec::new();
+/// The thresholds to try for impacts at `speeds` (sorted): 0 (every impact
+/// bounces: where the model's v_ε is above all of them, γ has no effect),
+/// and between each two neighbouring levels, √(fastest of the slower
+/// level · slowest of the faster), levels being runs of speeds within
+/// [`SAME_LEVEL`] of their neighbour.
+fn candidates(speeds: Vec<f64>) -> Vec<f64> {
+    // (slowest, fastest) of each level
+    let mut levels: Vec<(f64, f64)> = Vec::new();
     for v in speeds {
-        match levels.last() {
-            Some(&last) if v <= SAME_LEVEL * last => {}
-            _ => levels.push(v),
+        match levels.last_mut() {
+            Some((_, fastest)) if v <= SAME_LEVEL * *fastest => *fastest = v,
+            _ => levels.push((v, v)),
         }
     }
-    levels.windows(2).map(|w| (w[0] * w[1]).sqrt()).collect()
+    let between = levels.windows(2).map(|w| (w[0].1 * w[1].0).sqrt());
+    std::iter::once(0.0).chain(between).collect()
 }
 
 #[cfg(test)]
@@ -145,21 +148,32 @@ mod tests {
     fn thresholds_fall_between_the_levels_of_the_impact_speeds() {
         // two cycles of a bounce sequence at γ = 0.6, the second 2 % slower
         let cycle = [0.5, 0.3, 0.18, 0.108];
-        let speeds: Vec<f64> = (cycle.iter().chain(cycle.iter()))
+        let mut speeds: Vec<f64> = (cycle.iter().chain(cycle.iter()))
             .enumerate()
             .map(|(k, v)| if k < 4 { *v } else { 0.98 * v })
             .collect();
-        let mut sorted = speeds.clone();
-        sorted.sort_by(f64::total_cmp);
-        let between = between_levels(sorted);
-        assert_eq!(between.len(), 3, "{between:?}");
-        for (t, w) in between.iter().zip([[0.108, 0.18], [0.18, 0.3], [0.3, 0.5]]) {
+        speeds.sort_by(f64::total_cmp);
+        let tried = candidates(speeds);
+        assert_eq!(tried.len(), 4, "{tried:?}");
+        assert_eq!(tried[0], 0.0);
+        for (t, w) in tried[1..]
+            .iter()
+            .zip([[0.108, 0.18], [0.18, 0.3], [0.3, 0.5]])
+        {
             assert!(*t > w[0] && *t < 0.98 * w[1], "{t} between {w:?}");
         }
     }
 
     #[test]
-    fn no_bounce_nothing_to_scan() {
+    fn a_level_stands_for_all_its_speeds() {
+        // a level spread over 5–10 % (a warming coil's cycles): the point
+        // tried lies above its fastest speed, not inside it
+        let tried = candidates(vec![0.100, 0.104, 0.108, 0.2]);
+        assert!(tried[1] > 0.108 && tried[1] < 0.2, "{tried:?}");
+    }
+
+    #[test]
+    fn no_impact_nothing_to_scan() {
         use crate::sim::{Event, Limit, Mode};
         let impact = |v_after| Event {
             t: 0.0,
@@ -171,7 +185,8 @@ mod tests {
             },
             mode_after: Mode::Free,
         };
-        assert_eq!(impact_speeds(&[impact(0.0)]), None);
+        assert_eq!(impact_speeds(&[]), None);
+        assert_eq!(impact_speeds(&[impact(0.0)]), Some(vec![0.4]));
         assert_eq!(
             impact_speeds(&[impact(0.2), impact(0.0)]),
             Some(vec![0.4, 0.4])

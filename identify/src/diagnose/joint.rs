@@ -93,6 +93,8 @@ pub(super) fn refit(
             crate::wnrmse(&replay.current[k..], &data.i[k..], &last.weights[k..]),
         )
     });
+    // what the last model was fitted on: its held-out end is the rest
+    last.fitted_samples = k;
     last.extended = fit.description.clone();
     last.extended_replay = replay;
     last.named_fit = Some(fit);

@@ -324,11 +324,16 @@ fn diagnose_step(
     let fit = |c: &Candidate, race: Race, stop: Option<&Stop>| {
         let options = ranking_options(c, stop, &fit_options);
         let report = crate::staged_fit::after_race(&c.start, &fit_data, &c.params, &options, race);
-        let report = match bounce_threshold::fits_restitution(&c.params) {
-            true => report.map(|r| bounce_threshold::scanned(r, &fit_data, &c.params, &options)),
-            false => report,
+        // v_ε moved by the scan is one more parameter
+        let (report, scanned) = match (report, bounce_threshold::fits_restitution(&c.params)) {
+            (Ok(r), true) => {
+                let (r, moved) =
+                    bounce_threshold::scanned(r, &c.start, &fit_data, &c.params, &options);
+                (Ok(r), usize::from(moved))
+            }
+            (report, _) => (report, 0),
         };
-        score(c, report, n_eff)
+        score(c, report, c.params.len() + scanned, n_eff)
     };
     let fits = waves::Fits {
         race: &race,
@@ -874,9 +879,13 @@ fn candidates(
     (ok, not)
 }
 
-/// `c` scored by its fit's `report`.
-fn score(c: &Candidate, report: Result<FitReport, FitError>, n_eff: f64) -> Scored {
-    let parameters = c.params.len();
+/// `c` scored by its fit's `report` with `parameters` free parameters.
+fn score(
+    c: &Candidate,
+    report: Result<FitReport, FitError>,
+    parameters: usize,
+    n_eff: f64,
+) -> Scored {
     match report {
         Ok(report) => {
             let e = report.wnrmse_current;
