@@ -541,8 +541,12 @@ impl<'a> Objective<'a> {
     /// The errors of `d` replayed on `driven` (the record, its edges
     /// perhaps moved).
     pub(crate) fn errors(&self, d: &Description, driven: &Measured) -> Result<Errors, FitError> {
-        let out = simulate_with(d, driven, &self.budget)?;
-        Ok(Errors {
+        Ok(self.errors_of(d, &simulate_with(d, driven, &self.budget)?))
+    }
+
+    /// The errors of `out`, a replay of `d` already made.
+    pub(crate) fn errors_of(&self, d: &Description, out: &SimOutputs) -> Errors {
+        Errors {
             current: wnrmse(&out.current, &self.data.i, &self.weights),
             flux: self
                 .flux_reference(d)
@@ -558,7 +562,7 @@ impl<'a> Objective<'a> {
                 ),
                 _ => None,
             },
-        })
+        }
     }
 }
 

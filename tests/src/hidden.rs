@@ -943,18 +943,21 @@ pub fn errors_on<const K: usize>(case: &HiddenCase, models: [&Description; K]) -
         .zip(&data.i)
         .map(|(v, i)| ((v - r * i) / n).abs())
         .collect();
-    let mut residual = Vec::new();
-    let mut error = |d: &Description| {
+    let currents = models.map(|d| {
         let mut model = Model::build(d);
-        let run = replay(&mut model, &input, &data.t, &Options::default())
-            .unwrap_or_else(|e| panic!("{}: simulation failed: {e}", d.name));
-        residual = (run.current.iter().zip(&data.i).zip(&w))
-            .map(|((c, i), w)| w.sqrt() * (c - i))
-            .collect();
-        wnrmse(&run.current, &data.i, &w)
-    };
-    let errors = models.map(&mut error);
+        replay(&mut model, &input, &data.t, &Options::default())
+            .unwrap_or_else(|e| panic!("{}: simulation failed: {e}", d.name))
+            .current
+    });
+    let errors = currents.each_ref().map(|c| wnrmse(c, &data.i, &w));
+    let residual: Vec<f64> = (currents.last().into_iter().flatten())
+        .zip(&data.i)
+        .zip(&w)
+        .map(|((c, i), w)| w.sqrt() * (c - i))
+        .collect();
     let (sum, squares) = w.iter().fold((0.0, 0.0), |(s, q), x| (s + x, q + x * x));
-    let tau = integrated_autocorrelation(&residual);
-    (errors, sum * sum / squares / tau)
+    (
+        errors,
+        sum * sum / squares / integrated_autocorrelation(&residual),
+    )
 }

@@ -23,7 +23,7 @@
 use rayon::prelude::*;
 
 use crate::description::Description;
-use crate::em_fit::{replay, Setup};
+use crate::em_fit::{outputs, replay, Setup};
 use crate::sim::EventKind;
 use crate::{fit, FitOptions, FitParam, FitReport, Measured};
 
@@ -84,7 +84,10 @@ pub(super) fn scanned(
 /// one does.
 fn better_threshold(fitted: &Description, setup: &Setup, data: &Measured) -> Option<Description> {
     let run = replay(fitted, data, &setup.objective.budget).ok()?;
-    let own = setup.objective.errors(fitted, data).ok()?.current;
+    let own = setup
+        .objective
+        .errors_of(fitted, &outputs(fitted, &run))
+        .current;
     let thresholds = candidates(impact_speeds(&run.trajectory.events)?);
     let with_threshold = |v_eps: f64| {
         let mut d = fitted.clone();
@@ -98,13 +101,10 @@ fn better_threshold(fitted: &Description, setup: &Setup, data: &Measured) -> Opt
             (e.map_or(f64::INFINITY, |e| e.current), v)
         })
         .collect();
-    let (best, v) = tried.into_iter().filter(|(e, _)| e.is_finite()).fold(
-        None,
-        |best: Option<(f64, f64)>, (e, v)| match best {
-            Some((b, _)) if b <= e => best,
-            _ => Some((e, v)),
-        },
-    )?;
+    // the first of equal errors
+    let (best, v) = (tried.into_iter())
+        .filter(|(e, _)| e.is_finite())
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
     (best < own).then(|| with_threshold(v))
 }
 
