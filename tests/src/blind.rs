@@ -32,6 +32,10 @@ pub const HELD_OUT: Range<u64> = 100..110;
 /// records nobody had looked at: 200–209 after the bounce threshold's scan
 /// (seed 209's miss then led to the joint drift fit), 210–219 after that.
 pub const FRESH: Range<u64> = 200..220;
+/// Seeds first drawn after the fourth round (2026-12-02, the impact
+/// windows and the drift fitted on the whole fitted part after its own
+/// step), which fresh seeds 213 and 217 led to.
+pub const UNSEEN: Range<u64> = 220..240;
 
 /// A class of records and the answer it must get.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
