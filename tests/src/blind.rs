@@ -3,8 +3,9 @@
 //! family [`FAMILY`] (never used to tune anything before), an effect or a
 //! pair of effects drawn as [`crate::hidden`] draws them, a noisy record.
 //! A seed gives one record; [`TUNING`] seeds were looked at while the
-//! diagnosis was changed, [`HELD_OUT`] seeds only to measure it, [`FRESH`]
-//! seeds first after the last change.
+//! diagnosis was changed, [`HELD_OUT`] seeds only to measure it, [`FRESH`],
+//! [`ROUND_4`] and [`ROUND_5`] seeds each drawn first after a round of
+//! changes (some of their misses then led to the next round).
 
 use std::ops::Range;
 
@@ -32,10 +33,14 @@ pub const HELD_OUT: Range<u64> = 100..110;
 /// records nobody had looked at: 200–209 after the bounce threshold's scan
 /// (seed 209's miss then led to the joint drift fit), 210–219 after that.
 pub const FRESH: Range<u64> = 200..220;
-/// Seeds first drawn after the fourth round (2026-12-02, the impact
+/// Seeds first drawn after the fourth round (2026-12-02: the impact
 /// windows and the drift fitted on the whole fitted part after its own
-/// step), which fresh seeds 213 and 217 led to.
-pub const UNSEEN: Range<u64> = 220..240;
+/// step, which fresh seeds 213 and 217 led to). Seeds 226 and 239 then led
+/// to the fifth round.
+pub const ROUND_4: Range<u64> = 220..240;
+/// Seeds first drawn after the fifth round (2026-12-02: the earlier causes'
+/// own starting points as further starts of a later step).
+pub const ROUND_5: Range<u64> = 240..260;
 
 /// A class of records and the answer it must get.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -65,13 +65,7 @@ pub(super) fn scanned(
             also_from: Vec::new(),
             ..options.clone()
         };
-        // (a refit that fails leaves the scanned threshold on the fit)
-        let mut refit = fit(&from, data, params, &once, &|_| {}).unwrap_or_else(|_| FitReport {
-            description: from,
-            iterations: 0,
-            simulations: 0,
-            ..report.clone()
-        });
+        let mut refit = fit(&from, data, params, &once, &|_| {}).ok()?;
         let errors = setup.objective.errors(&refit.description, data).ok()?;
         refit.wnrmse_current = errors.current;
         refit.wnrmse_flux = errors.flux;

@@ -48,58 +48,62 @@ fn covered(windows: &[Range<usize>], from: usize, n: usize) -> Vec<usize> {
     (0..n).filter(|k| inside[*k]).collect()
 }
 
-/// The |φ̇|-weighted RMS of `model − measured` over `samples` [A].
-fn weighted_rms(model: &[f64], measured: &[f64], weights: &[f64], samples: &[usize]) -> f64 {
+/// The |φ̇|-weighted RMS of `model − measured` over `samples` [A] (None:
+/// no weight there).
+fn weighted_rms(
+    model: &[f64],
+    measured: &[f64],
+    weights: &[f64],
+    samples: &[usize],
+) -> Option<f64> {
     let (mut num, mut den) = (0.0, 0.0);
     for &k in samples {
         num += weights[k] * (model[k] - measured[k]).powi(2);
         den += weights[k];
     }
-    if den > 0.0 {
-        (num / den).sqrt()
-    } else {
-        0.0
-    }
+    (den > 0.0).then(|| (num / den).sqrt())
 }
 
 /// The noise floor of `step` in amperes: the wNRMSE floor times the
 /// weighted RMS of the measured current it is relative to.
-fn floor_amperes(step: &Diagnosis, data: &Measured) -> f64 {
+fn floor_amperes(step: &Diagnosis, data: &Measured) -> Option<f64> {
     let all: Vec<usize> = (0..data.i.len()).collect();
     let zeros = vec![0.0; data.i.len()];
-    step.noise_floor * weighted_rms(&data.i, &zeros, &step.weights, &all)
+    let rms = weighted_rms(&data.i, &zeros, &step.weights, &all)?;
+    Some(step.noise_floor * rms).filter(|f| *f > 0.0)
 }
 
 /// How many noise floors `step`'s model leaves in the windows after its
-/// impacts (0 where it has none).
+/// impacts (0 where it has none, or they hold no weight).
 pub(super) fn excess(step: &Diagnosis, data: &Measured) -> f64 {
-    let n = data.i.len();
-    let samples = covered(&windows(&step.extended_replay), 0, n);
-    let floor = floor_amperes(step, data);
-    if samples.is_empty() || !(floor > 0.0) {
-        return 0.0;
+    let samples = covered(&windows(&step.extended_replay), 0, data.i.len());
+    let replay = &step.extended_replay;
+    let error = weighted_rms(&replay.current, &data.i, &step.weights, &samples);
+    match (error, floor_amperes(step, data)) {
+        (Some(e), Some(floor)) => e / floor,
+        _ => 0.0,
     }
-    weighted_rms(
-        &step.extended_replay.current,
-        &data.i,
-        &step.weights,
-        &samples,
-    ) / floor
 }
 
 /// The gain of `next` over `last` in the windows after `last`'s impacts:
-/// over the whole record, and over those on the part `next`'s fits did not
-/// see (None: no window there).
-pub(super) fn gains(last: &Diagnosis, next: &Diagnosis, data: &Measured) -> (Gain, Option<Gain>) {
+/// over the whole record (None: no weight in them), and over those on the
+/// part `next`'s fits did not see (None: no window, or no weight, there).
+pub(super) fn gains(
+    last: &Diagnosis,
+    next: &Diagnosis,
+    data: &Measured,
+) -> (Option<Gain>, Option<Gain>) {
     let n = data.i.len();
     let windows = windows(&last.extended_replay);
     let gain = |samples: &[usize]| {
         let error = |r: &SimOutputs| weighted_rms(&r.current, &data.i, &last.weights, samples);
-        Gain::new(error(&last.extended_replay), error(&next.extended_replay))
+        Some(Gain::new(
+            error(&last.extended_replay)?,
+            error(&next.extended_replay)?,
+        ))
     };
     let unseen = covered(&windows, next.fitted_samples, n);
-    let held_out = (!unseen.is_empty()).then(|| gain(&unseen));
-    (gain(&covered(&windows, 0, n)), held_out)
+    (gain(&covered(&windows, 0, n)), gain(&unseen))
 }
 
 #[cfg(test)]
@@ -120,11 +124,12 @@ mod tests {
 
     #[test]
     fn a_window_follows_each_impact_for_as_long_as_its_transit() {
-        // stuck, a transit of 3 samples, stuck, a transit of 2 (cut short
-        // by the record's end), stuck
+        // stuck, a transit of 3 samples, stuck, a transit of 2, stuck
         let r = replay(&[1, 1, 2, 2, 2, 3, 3, 3, 3, 3, 2, 2, 1, 1]);
         assert_eq!(windows(&r), vec![5..8, 12..14]);
         assert_eq!(covered(&windows(&r), 6, 14), vec![6, 7, 12, 13]);
+        // a window cut short by the record's end
+        assert_eq!(windows(&replay(&[2, 2, 2, 1])), vec![3..4]);
     }
 
     #[test]

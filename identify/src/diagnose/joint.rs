@@ -5,6 +5,9 @@
 //! pair leaves up to 49× the noise floor). Every named cause's parameters are
 //! therefore fitted once more, all at once, from the selection's values, on
 //! the record's edges as the whole model places them ([`super::polish`]).
+//! A resistance drift named first is fitted again the same way, alone, before
+//! the next step (`Path::from`): on the whole fitted part, where a drift
+//! shows.
 
 use super::candidate::Candidate;
 use super::{polish, Cause, Diagnosis, Gain};

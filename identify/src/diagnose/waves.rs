@@ -3,7 +3,9 @@
 //! 1. The first wave fits every candidate that is fitted in one stage (the
 //!    hysteresis candidate's own start, `none`, eddy currents, a drifting
 //!    resistance) and the saturating core, and races the other candidates'
-//!    starts on the record's first pulses ([`crate::staged_fit::race`]).
+//!    starts on the record's first pulses ([`crate::staged_fit::race`]). In
+//!    a later step every candidate but the hysteresis one also starts from
+//!    the earlier causes' own starting points, and is raced too.
 //! 2. Once every fit of the first wave has ended, the second fits each
 //!    race's winner on the whole record, given up ([`GiveUp`]) where after
 //!    [`GIVE_UP_AFTER`] iterations its objective is still
