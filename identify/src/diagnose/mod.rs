@@ -19,6 +19,7 @@ mod bounce_threshold;
 pub mod candidate;
 pub mod cause;
 pub mod evidence;
+mod flux_guided;
 mod impact_windows;
 mod joint;
 pub mod localise;
@@ -342,9 +343,21 @@ fn diagnose_step(
         let options = ranking_options(c, None, &fit_options);
         crate::staged_fit::race(&c.start, &fit_data, &c.params, &options)
     };
+    let beyond_the_floor = options.floor_factor * noise_floor;
     let fit = |c: &Candidate, race: Race, stop: Option<&Stop>| {
         let options = ranking_options(c, stop, &fit_options);
         let report = crate::staged_fit::after_race(&c.start, &fit_data, &c.params, &options, race);
+        // a fringing fit on a bound of the gap's range, beyond the noise:
+        // the second basin (within the noise, the bound is fringing's null)
+        let second_basin = |r: &FitReport| {
+            c.cause == Cause::Fringing
+                && flux_guided::gap_on_a_bound(&c.params, &r.values)
+                && r.wnrmse_current > beyond_the_floor
+        };
+        let report = match report {
+            Ok(r) if second_basin(&r) => Ok(flux_guided::retried(c, r, &fit_data, &options)),
+            report => report,
+        };
         // v_ε moved by the scan is one more parameter
         let (report, scanned) = match (report, bounce_threshold::fits_restitution(&c.params)) {
             (Ok(r), true) => {
