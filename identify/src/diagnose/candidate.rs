@@ -157,6 +157,13 @@ pub fn candidate(
     })
 }
 
+/// Whether a fitted `value` of `range` ended within 0.1 % of the range
+/// from one of its bounds: the data want it beyond what the fit allows.
+pub fn on_bound(value: f64, range: &FitParam) -> bool {
+    let near = |b: f64| (value - b).abs() <= 1e-3 * (range.upper - range.lower);
+    near(range.lower) || near(range.upper)
+}
+
 fn param(path: &str, lower: f64, upper: f64) -> FitParam {
     FitParam {
         path: path.to_owned(),

@@ -16,19 +16,26 @@
 //! weights, the candidate's start's). A fit whose bound is real keeps its
 //! answer, at the cost of the retry.
 
-use super::candidate::Candidate;
+use super::candidate::{on_bound, Candidate};
+use super::Cause;
 use crate::{fit, FitOptions, FitParam, FitReport, Measured};
 
+/// Whether `c`'s fit `report` is in fringing's second basin: a gap
+/// parameter on a bound of its range (as the report's "on the bound of its
+/// range") and the record left beyond `beyond_the_floor` (within it, the
+/// bound is fringing's null).
+pub(super) fn in_second_basin(c: &Candidate, report: &FitReport, beyond_the_floor: f64) -> bool {
+    c.cause == Cause::Fringing
+        && gap_on_a_bound(&c.params, &report.values)
+        && report.wnrmse_current > beyond_the_floor
+}
+
 /// Whether a gap parameter of the fitted `values` (of `params`, in their
-/// order) ended within 0.1 % of its range from a bound (as the report's "on
-/// the bound of its range").
-pub(super) fn gap_on_a_bound(params: &[FitParam], values: &[(String, f64)]) -> bool {
+/// order) ended on a bound of its range.
+fn gap_on_a_bound(params: &[FitParam], values: &[(String, f64)]) -> bool {
     (params.iter().zip(values))
         .filter(|(p, _)| p.path.starts_with("gap."))
-        .any(|(p, (_, v))| {
-            let near = |b: f64| (v - b).abs() <= 1e-3 * (p.upper - p.lower);
-            near(p.lower) || near(p.upper)
-        })
+        .any(|(p, (_, v))| on_bound(*v, p))
 }
 
 /// `report`, or the current fit continued from the flux-guided fit of the

@@ -347,15 +347,10 @@ fn diagnose_step(
     let fit = |c: &Candidate, race: Race, stop: Option<&Stop>| {
         let options = ranking_options(c, stop, &fit_options);
         let report = crate::staged_fit::after_race(&c.start, &fit_data, &c.params, &options, race);
-        // a fringing fit on a bound of the gap's range, beyond the noise:
-        // the second basin (within the noise, the bound is fringing's null)
-        let second_basin = |r: &FitReport| {
-            c.cause == Cause::Fringing
-                && flux_guided::gap_on_a_bound(&c.params, &r.values)
-                && r.wnrmse_current > beyond_the_floor
-        };
         let report = match report {
-            Ok(r) if second_basin(&r) => Ok(flux_guided::retried(c, r, &fit_data, &options)),
+            Ok(r) if flux_guided::in_second_basin(c, &r, beyond_the_floor) => {
+                Ok(flux_guided::retried(c, r, &fit_data, &options))
+            }
             report => report,
         };
         // v_ε moved by the scan is one more parameter

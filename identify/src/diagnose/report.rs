@@ -252,8 +252,7 @@ fn on_bound(step: &Diagnosis, p: &FittedParameter) -> bool {
     else {
         return false;
     };
-    let near = |b: f64| (p.value - b).abs() <= 1e-3 * (range.upper - range.lower);
-    near(range.lower) || near(range.upper)
+    super::candidate::on_bound(p.value, range)
 }
 
 /// The report's section per cause: its gain, why the record identifies it,
