@@ -8,14 +8,14 @@ target dir target/calibration_step) emits examples/self-calibrating-valve.toml
 twice in build.rs: as it is (θ, the 10 adapted parameters, read at run time by the
 law and the UKF; the update `ukf::…::calibrate`) and with self_calibration = false
 (every parameter a const the compiler folds: what a firmware that never adapts
-compiles). The record is one run (closing, opening; 1001 samples at 50 µs) of the
+compiles). The record is one run (closing, opening; 1750 samples at 50 µs) of the
 design on a plant 15 % more resistive with a 10 % softer spring, simulated by the
 designer with the example's noise.
 
 Measures (instructions: valgrind --tool=callgrind, total Ir of a run with 2N calls
 minus that of a run with N calls, / N):
 1. one control sample (UKF step + controller step), fixed and adaptive, f64 and f32,
-   N = 2002 (two passes over the record), net of the loop without the calls; and the
+   N = 2002 (over the record, cycled), net of the loop without the calls; and the
    record's push of one sample (the firmware's other per-sample addition);
 2. one whole update (calibrate on the run's record, from θ_d), f64 and f32, N = 1;
 3. wall clock of the update (best of R) on this machine;

@@ -405,12 +405,15 @@ fn the_perfect_tracking_example_carries_the_papers_design() {
             };
             assert_eq!((s.lambda1, s.lambda2, s.eta), (2000.0, 2000.0, 1e5));
         } else if path.ends_with("self-calibrating-valve.toml") {
-            // sensorless at 50 µs, a longer motion under a lower bound (the guide)
+            // sensorless at 50 µs, a longer motion under a lower bound, a move
+            // of 7 ms ending 50 µm short of each stop, approached at 10 mm/s
+            // (the guide)
             let t = d.trajectory.unwrap();
             assert_eq!(
                 (t.takeoff, t.landing, t.u_bound, t.shape),
-                (1e-3, 8e-3, 18.0, Shape::EnergyOptimal)
+                (1e-3, 14.25e-3, 18.0, Shape::EnergyOptimal)
             );
+            assert_eq!((t.standoff, t.approach_speed), (50e-6, Some(10e-3)));
             let c = d.controller.unwrap();
             assert!(c.self_calibration && c.estimator.is_some());
         } else if designed {
