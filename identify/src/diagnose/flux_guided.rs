@@ -46,9 +46,12 @@ pub(super) fn retried(
     data: &Measured,
     options: &FitOptions,
 ) -> FitReport {
+    // (no give-up: the waves' bar is a current-only cost, and this fit's
+    // cost counts the flux as well)
     let guided = FitOptions {
         use_flux: true,
         only_start: None,
+        give_up: None,
         ..options.clone()
     };
     let Ok(guide) = fit(&c.start, data, &c.params, &guided, &|_| {}) else {
