@@ -196,8 +196,12 @@ pub struct Diagnosis {
     pub extended_replay: SimOutputs,
     /// The |φ̇| weights of [JA 81], from the data.
     pub weights: Vec<f64>,
-    /// Samples of the record used by the fits (the rest is held out).
+    /// Samples of the record the last model was fitted on (the rest is
+    /// held out): the ranked candidates' `ranked_samples`, or more where a
+    /// drift's fit saw the whole fitted part (`joint::refit`).
     pub fitted_samples: usize,
+    /// Samples the ranked candidates were fitted on (the record's head).
+    pub ranked_samples: usize,
     /// The record's voltage steps between samples, placed by the baseline
     /// (every candidate's replay uses them; the extended model's final
     /// replay places its own).
@@ -593,6 +597,7 @@ fn diagnose_step(
         extended_replay,
         weights,
         fitted_samples,
+        ranked_samples: fitted_samples,
         edges,
         named_fit,
         propagated,

@@ -585,7 +585,7 @@ fn text_report(
     let _ = writeln!(
         s,
         "candidates (fitted on the first {} samples, ranked by BIC):",
-        d.fitted_samples
+        d.ranked_samples
     );
     for c in &d.ranking {
         match &c.fit {
@@ -724,6 +724,7 @@ fn json_report(
         "voltage_noise": d.voltage_noise,
         "voltage_floor": d.voltage_floor,
         "fitted_samples": d.fitted_samples,
+        "ranked_samples": d.ranked_samples,
         "candidates": candidates,
         "not_tried": not_tried,
         "localisation": loc.to_string(),
