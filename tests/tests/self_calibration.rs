@@ -206,21 +206,23 @@ fn the_emitted_f32_update_over_sixty_plants() {
 
 fn sixty_plants(updater: Updater) {
     let (text, d, design) = example();
+    let physics = physics_of(&text);
     let n = 10;
     let studies: Vec<Study> = (0..60u64)
         .into_par_iter()
-        .map(|seed| study(&design, &d, &variant(physics_of(&text), seed), n, updater))
+        .map(|seed| study(&design, &d, &variant(physics, seed), n, updater))
         .collect();
     for (name, range) in [
         ("tuning seeds 0–19", 0..20),
         ("held-out seeds 20–39", 20..40),
         ("fresh seeds 40–59", 40..60),
     ] {
+        let drawn = range.len();
         let part: Vec<&Study> = studies[range].iter().filter(|s| s.switches).collect();
         println!(
             "{name}: {} plants that switch ({} whose uncontrolled switching misses a stop left out), {n} runs each",
             part.len(),
-            20 - part.len()
+            drawn - part.len()
         );
         for (k, op) in ["closing", "opening"].iter().enumerate() {
             println!(
