@@ -125,6 +125,16 @@ fn calibration_report(design: &designer::design::Design, sample_period: f64) -> 
                 "  record: {} samples per {per}, every {} sample(s)",
                 c.capacity, c.decimation
             );
+            if c.unexplained.is_finite() {
+                let _ = writeln!(
+                    s,
+                    "  unexplained: an update that leaves a mean squared current error above {:.3e} A² \
+                     ({}·σ_i²) counts towards Calibration::unexplained (the model does not follow \
+                     this valve)",
+                    c.unexplained,
+                    designer::calibrate::UNEXPLAINED
+                );
+            }
         }
         Err(e) => {
             let _ = writeln!(s, "  not designed: {e}");

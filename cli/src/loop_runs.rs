@@ -101,19 +101,49 @@ fn number(x: Option<f64>) -> Value {
         .map_or(Value::Null, |v| json!(v))
 }
 
-fn update_json(update: &Option<Update>) -> Value {
+fn update_json(update: &Option<Update>, calibration: Option<&CalibrationDesign>) -> Value {
     let (error, outcome) = match update {
         None => return Value::Null,
         Some(Update::Replay(o)) => ("rms_current_error", o),
         Some(Update::Innovations(o)) => ("rms_innovation", o),
     };
+    // whether the fitted model still leaves the current unexplained (where
+    // the design states a threshold: an observer's σ_i)
+    let unexplained = calibration
+        .filter(|c| c.unexplained.is_finite())
+        .and_then(|c| c.leaves_unexplained(outcome));
     match outcome {
         Outcome::Updated { before, after } => json!({
             "updated": true,
             format!("{error}_before"): before.sqrt(),
             format!("{error}_after"): after.sqrt(),
+            "unexplained": unexplained,
         }),
         Outcome::Refused(why) => json!({ "updated": false, "refused": format!("{why:?}") }),
+    }
+}
+
+/// What an update did, in a line.
+fn update_text(update: &Update, calibration: Option<&CalibrationDesign>) -> String {
+    let (Update::Replay(outcome) | Update::Innovations(outcome)) = update;
+    match outcome {
+        Outcome::Updated { before, after } => {
+            let unexplained = calibration
+                .filter(|c| c.unexplained.is_finite())
+                .and_then(|c| c.leaves_unexplained(outcome))
+                == Some(true);
+            format!(
+                "RMS current error {:.3e} → {:.3e} A{}",
+                before.sqrt(),
+                after.sqrt(),
+                if unexplained {
+                    " (unexplained: the adapted model does not explain this valve's current)"
+                } else {
+                    ""
+                }
+            )
+        }
+        Outcome::Refused(why) => format!("refused ({why:?})"),
     }
 }
 
@@ -147,7 +177,7 @@ fn to_json(
                         "max_bounce_height": o.outcome.highest_bounce,
                         "arrival_time": number(o.outcome.arrival),
                         "late": late(o.outcome.arrival, late_after),
-                        "calibration": update_json(&o.update),
+                        "calibration": update_json(&o.update, calibration),
                     })
                 })
                 .collect();
@@ -221,6 +251,9 @@ fn text(
                 o.outcome.bounces,
                 o.outcome.highest_bounce
             );
+            if let Some(u) = &o.update {
+                let _ = writeln!(s, "  update: {}", update_text(u, calibration));
+            }
         }
     }
     let _ = writeln!(s, "uncontrolled switching (u_max, then 0 V):");

@@ -87,6 +87,7 @@ pub fn calibration_macro(name: &str, c: &CalibrationDesign) -> Result<String, Em
          \x20               dip_share: {dip_share},\n\
          \x20               motion_evidence: {motion_evidence},\n\
          \x20               difference_step: {difference_step},\n\
+         \x20               unexplained: {unexplained},\n\
          \x20           }};\n",
         max_step = macro_literal("max_step", c.max_step)?,
         ts = macro_literal("sample_period", c.sample_period)?,
@@ -97,6 +98,11 @@ pub fn calibration_macro(name: &str, c: &CalibrationDesign) -> Result<String, Em
         dip_share = macro_literal("dip_share", c.dip_share)?,
         motion_evidence = macro_literal("motion_evidence", c.motion_evidence)?,
         difference_step = macro_literal("difference_step", c.difference_step)?,
+        unexplained = if c.unexplained.is_finite() {
+            macro_literal("unexplained", c.unexplained)?
+        } else {
+            "$f::INFINITY".to_owned()
+        },
     );
     let body = format!(
         "        /// The parameters θ the self-calibration adapts, in θ's order (their\n\
@@ -119,7 +125,10 @@ pub fn calibration_macro(name: &str, c: &CalibrationDesign) -> Result<String, Em
          \x20       /// most `max_step`·θ_d, `iterations` Levenberg–Marquardt steps, forward differences\n\
          \x20       /// of `difference_step`·θ_d; a record shorter than `min_samples`, with a current\n\
          \x20       /// at `current_limit` [A] (a saturated ADC) or more than `dip_share` of its samples\n\
-         \x20       /// `dip_tolerance` [V] below the command (a supply dip) is refused.\n\
+         \x20       /// `dip_tolerance` [V] below the command (a supply dip) is refused. An update that\n\
+         \x20       /// leaves a mean squared current error above `unexplained` [A²] (a multiple of σ_i²; ∞:\n\
+         \x20       /// never) has not found a model that explains the valve's current, whatever θ:\n\
+         \x20       /// `Calibration::unexplained` counts such updates in a row.\n\
          \x20       #[allow(clippy::excessive_precision)]\n\
          {settings}",
         keys = array(&keys),

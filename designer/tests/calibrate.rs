@@ -78,6 +78,7 @@ fn settings<const P: usize>(nominal: [f64; P], ts: f64) -> Settings<f64, P> {
         dip_share: 0.05,
         motion_evidence: 1.0,
         difference_step: 1e-4,
+        unexplained: f64::INFINITY,
     }
 }
 
@@ -380,4 +381,47 @@ fn the_innovations_update_moves_towards_the_plant() {
             a.key
         );
     }
+}
+
+/// `Calibration::unexplained` counts the updates in a row that leave more
+/// than `Settings::unexplained` of the current unexplained: not on the
+/// record of the plant (noise-free), on each record whose current carries a
+/// 1 kHz (1.3 kHz) ripple of 20 mA that no θ explains, and from 0 again after the
+/// plain record.
+#[test]
+fn the_calibration_counts_updates_that_leave_the_current_unexplained() {
+    use reldesign_runtime::calibrate::Calibration;
+    let design = design();
+    let model = predictor(&design, ["R"]);
+    let s = Settings {
+        // (5 mA)²: the ripple's mean square is (20 mA)²/2
+        unexplained: 25e-6,
+        ..settings([75.0], 5e-5)
+    };
+    let plant = plant(&[("resistance = 75.0", "resistance = 80.0")]);
+    let run = quiet_run(&design, &plant);
+    let plain = record_until(&run, 1, &s, 18e-3);
+    let (_, start) = run.operations[1];
+    let rippled = |hz: f64| {
+        let mut r = Box::new(Record::<f64, RECORD>::new());
+        r.start(0.0);
+        for m in (run.measured.iter()).filter(|m| m.t >= start - 1e-12 && m.t < start + 18e-3) {
+            let ripple = 0.02 * (2.0 * std::f64::consts::PI * hz * (m.t - start)).sin();
+            r.push(&s, m.commanded, m.voltage, m.current + ripple);
+        }
+        r
+    };
+    let mut calibration = Calibration::new(&s);
+    let mut counts = Vec::new();
+    for r in [&plain, &rippled(1e3), &rippled(1.3e3), &plain] {
+        let outcome = calibration.update(&model, &s, r);
+        assert!(
+            matches!(outcome, Outcome::Updated { .. }),
+            "{outcome:?} after {counts:?}"
+        );
+        counts.push(calibration.unexplained);
+    }
+    assert_eq!(counts, [0, 1, 2, 0]);
+    calibration.reset(&s);
+    assert_eq!(calibration.unexplained, 0);
 }

@@ -119,7 +119,10 @@ macro_rules! calibration {
         /// most `max_step`·θ_d, `iterations` Levenberg–Marquardt steps, forward differences
         /// of `difference_step`·θ_d; a record shorter than `min_samples`, with a current
         /// at `current_limit` [A] (a saturated ADC) or more than `dip_share` of its samples
-        /// `dip_tolerance` [V] below the command (a supply dip) is refused.
+        /// `dip_tolerance` [V] below the command (a supply dip) is refused. An update that
+        /// leaves a mean squared current error above `unexplained` [A²] (a multiple of σ_i²; ∞:
+        /// never) has not found a model that explains the valve's current, whatever θ:
+        /// `Calibration::unexplained` counts such updates in a row.
         #[allow(clippy::excessive_precision)]
         pub const CALIBRATION: reldesign_runtime::calibrate::Settings<$f, 10> =
             reldesign_runtime::calibrate::Settings {
@@ -138,6 +141,7 @@ macro_rules! calibration {
                 dip_share: 0.05,
                 motion_evidence: 1.0,
                 difference_step: 0.05,
+                unexplained: 1.25e-5,
             };
     };
 }

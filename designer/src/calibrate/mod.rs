@@ -14,7 +14,7 @@ pub mod innovations;
 mod predictor;
 mod runs;
 
-pub use choice::{candidates, choose, Candidate, ChoiceError};
+pub use choice::{candidates, choose, Candidate, ChoiceError, UNEXPLAINED};
 pub use predictor::TapePredictor;
 pub use reldesign_runtime::calibrate::{Outcome, Refusal};
 pub use runs::{run_runs, run_runs_updated_by, OperationRun, Run, RunUpdate, RunsError, Update};
@@ -98,6 +98,23 @@ pub struct CalibrationDesign {
     pub motion_evidence: f64,
     /// The innovations update's forward-difference step, relative to θ_d.
     pub difference_step: f64,
+    /// [A²]: an update that leaves a larger mean squared current error
+    /// leaves the valve's current unexplained (`Settings::unexplained`):
+    /// [`UNEXPLAINED`]·σ_i² where an observer drives the law, ∞ otherwise.
+    pub unexplained: f64,
+}
+
+impl CalibrationDesign {
+    /// Whether an update left the valve's current unexplained (its mean
+    /// squared error above [`CalibrationDesign::unexplained`]); `None` for a
+    /// refusal.
+    pub fn leaves_unexplained(&self, outcome: &Outcome<f64>) -> Option<bool> {
+        match outcome {
+            // a NaN error explains nothing
+            Outcome::Updated { after, .. } => Some(!(*after <= self.unexplained)),
+            Outcome::Refused(_) => None,
+        }
+    }
 }
 
 impl CalibrationDesign {
@@ -130,6 +147,7 @@ impl CalibrationDesign {
             dip_share: self.dip_share,
             motion_evidence: self.motion_evidence,
             difference_step: self.difference_step,
+            unexplained: self.unexplained,
         }
     }
 }

@@ -12,7 +12,10 @@
 //! saturated ADC, a supply dip, non-finite samples) and keeps θ within its
 //! domain; [`SelfCalibratingValve::reset_calibration`] goes back to the
 //! design's values. Store `calibration().theta` in flash to keep what was
-//! learnt across power cycles.
+//! learnt across power cycles. [`SelfCalibratingValve::unexplained`] says
+//! when the adapted model has stopped explaining the valve's current (a
+//! hysteretic core, a fault): its landings are then not to be trusted, and
+//! the valve is one to flag for service.
 
 use reldesign_runtime::calibrate::Outcome;
 
@@ -105,6 +108,14 @@ impl SelfCalibratingValve {
     #[must_use]
     pub fn calibration(&self) -> &filter::Calibration {
         &self.calibration
+    }
+
+    /// Whether the last three updates in a row left more of the current
+    /// unexplained than `CALIBRATION.unexplained` (2·σ_i²): whatever θ, the
+    /// model does not follow this valve.
+    #[must_use]
+    pub fn unexplained(&self) -> bool {
+        self.calibration.unexplained >= 3
     }
 
     /// Whether the operation needed the runtime's push to reach its stop

@@ -85,6 +85,9 @@ fn a_run_lands_and_the_update_moves_r_towards_the_valve() {
     );
     let outcome = valve.calibrate();
     assert!(matches!(outcome, Outcome::Updated { .. }), "{outcome:?}");
+    // a noise-free valve of the model's own family is explained
+    assert_eq!(valve.calibration().unexplained, 0);
+    assert!(!valve.unexplained());
     let r = valve.calibration().theta[0];
     let (design, truth) = (model::THETA_DESIGN[0], theta[0]);
     assert!(

@@ -213,7 +213,7 @@ impl<T: Jitter, const P: usize> Calibration<T, P> {
         record: &Record<T, K>,
     ) -> Outcome<T> {
         let outcome = update::<M, T, N, S, P, K>(model, settings, record, &mut self.theta);
-        self.count(outcome);
+        self.count(outcome, settings);
         outcome
     }
 }

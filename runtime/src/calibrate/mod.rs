@@ -113,6 +113,13 @@ pub struct Settings<T, const P: usize> {
     /// The innovations update's forward-difference step h, relative to θ_d
     /// (unused by the replay, whose sensitivities are symbolic).
     pub difference_step: T,
+    /// [A²]: an update that leaves a larger mean squared current error has
+    /// not found a model that explains the valve's current, whatever θ
+    /// (a valve that departs from its description in a way the adapted
+    /// parameters cannot follow, e.g. a hysteretic core);
+    /// [`Calibration::unexplained`] counts such updates in a row. Infinite:
+    /// never.
+    pub unexplained: T,
 }
 
 /// Why a record changed nothing.
@@ -150,6 +157,11 @@ pub struct Calibration<T, const P: usize> {
     /// Updates taken and refused since the last reset.
     pub updates: u32,
     pub refusals: u32,
+    /// Updates in a row (refusals skipped) that left a mean squared current
+    /// error above [`Settings::unexplained`]: the model, adapted, still does
+    /// not explain this valve's current, and its landings are not to be
+    /// trusted; 0 after an update that explains it, and after a reset.
+    pub unexplained: u32,
 }
 
 impl<T: Scalar, const P: usize> Calibration<T, P> {
@@ -160,6 +172,7 @@ impl<T: Scalar, const P: usize> Calibration<T, P> {
             theta: settings.nominal,
             updates: 0,
             refusals: 0,
+            unexplained: 0,
         }
     }
 
@@ -176,14 +189,23 @@ impl<T: Scalar, const P: usize> Calibration<T, P> {
         record: &Record<T, S>,
     ) -> Outcome<T> {
         let outcome = calibrate(model, settings, record, &mut self.theta);
-        self.count(outcome);
+        self.count(outcome, settings);
         outcome
     }
 
-    /// Counts an update's outcome.
-    fn count(&mut self, outcome: Outcome<T>) {
+    /// Counts an update's outcome, and whether it left the current
+    /// unexplained ([`Settings::unexplained`]).
+    pub fn count(&mut self, outcome: Outcome<T>, settings: &Settings<T, P>) {
         match outcome {
-            Outcome::Updated { .. } => self.updates = self.updates.saturating_add(1),
+            Outcome::Updated { after, .. } => {
+                self.updates = self.updates.saturating_add(1);
+                // a NaN error explains nothing
+                self.unexplained = if after <= settings.unexplained {
+                    0
+                } else {
+                    self.unexplained.saturating_add(1)
+                };
+            }
             Outcome::Refused(_) => self.refusals = self.refusals.saturating_add(1),
         }
     }
