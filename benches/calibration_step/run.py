@@ -19,7 +19,10 @@ minus that of a run with N calls, / N):
    record's push of one sample (the firmware's other per-sample addition);
 2. one whole update (calibrate on the run's record, from θ_d), f64 and f32, N = 1;
 3. wall clock of the update (best of R) on this machine;
-4. RAM of the emitted types (size_of).
+4. RAM of the emitted types (size_of);
+5. the same for the replay update (examples/self-calibrating-sensor-valve.toml, a
+   law on measured states): the controller step folded and with θ, Record::push,
+   one update over its closing's record (N = 1), its RAM.
 """
 from __future__ import annotations
 
@@ -81,12 +84,32 @@ def main() -> None:
             ms = wall(f"update{f}", args.reps) / 1e6
             print(f"f{f:4} {ir / 1e6:8.1f} M instructions, {ms:6.1f} ms here, "
                   f"~{ir / (MHZ * 1e3):6.0f} ms at {MHZ} MHz one instruction a cycle")
+        print()
+        ops = int(sizes["replay_operation_samples"])
+        sbase = {f: per_call(f"sensorbase{f}", 2 * ops, work) for f in ("64", "32")}
+        print(f"the replay (self-calibrating-sensor-valve: {sizes['replay_parameters']} parameters, "
+              f"a record of {sizes['replay_record_samples']} samples, one every "
+              f"{sizes['replay_decimation']})")
+        print(f"{'':6} {'law fixed':>10} {'adaptive':>10} {'added':>8}")
+        for f in ("64", "32"):
+            fixed = per_call(f"law{f}fixed", 2 * ops, work) - sbase[f]
+            adaptive = per_call(f"law{f}adaptive", 2 * ops, work) - sbase[f]
+            push = per_call(f"replaypush{f}", 2 * ops, work) - sbase[f]
+            ir = per_call(f"replay{f}", 1, work)
+            ms = wall(f"replay{f}", args.reps) / 1e6
+            print(f"f{f:4} {fixed:10.0f} {adaptive:10.0f} {adaptive - fixed:+8.0f} "
+                  f"({100 * (adaptive / fixed - 1):+.1f} %); Record::push {push:.0f}; "
+                  f"one update {ir / 1e6:.2f} M instructions, {ms:.2f} ms here, "
+                  f"~{ir / (MHZ * 1e3):.0f} ms at {MHZ} MHz")
     print()
     print("RAM (bytes): record f32 {record32}, f64 {record64}; calibration f32 {calibration32}; "
           "UKF f32 adaptive {filter32_adaptive} (fixed {filter32_fixed}); controller f32 adaptive "
           "{controller32_adaptive} (fixed {controller32_fixed}); the update's P + 1 filters "
           "f32 {update32}".format(update32=(int(sizes["parameters"]) + 1) * int(sizes["filter32_adaptive"]),
                                   **sizes))
+    print("replay RAM (bytes): record f32 {replay_record32}, f64 {replay_record64}; calibration f32 "
+          "{replay_calibration32}; controller f32 adaptive {replay_controller32_adaptive} (fixed "
+          "{replay_controller32_fixed})".format(**sizes))
 
 
 if __name__ == "__main__":

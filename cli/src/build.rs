@@ -140,14 +140,14 @@ fn calibration_report(design: &designer::design::Design, sample_period: f64) -> 
             let _ = writeln!(s, "  not designed: {e}");
         }
     }
-    let emitted = matches!(
-        &chosen,
-        Ok(c) if c.method == designer::calibrate::Method::Innovations
-    );
-    s.push_str(if emitted {
-        "  emitted: θ read at run time by the law and the filter; `ukf::…::calibrate` after each run"
-    } else {
-        "  warning: the emitted file does not carry the replay update; `reldesign loop --runs N` runs it"
+    s.push_str(match &chosen {
+        Ok(c) if c.method == designer::calibrate::Method::Innovations => {
+            "  emitted: θ read at run time by the law and the filter; `ukf::…::calibrate` after each run"
+        }
+        Ok(_) => {
+            "  emitted: θ read at run time by the law; `f64::calibrate` / `f32::calibrate` after each operation"
+        }
+        Err(_) => "",
     });
     s
 }

@@ -147,7 +147,10 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
             name: &d.name,
             discrete,
             floats: floats(&o.floats),
-            calibration: calibration.as_ref(),
+            // the filters read θ where the innovations update adapts it
+            calibration: calibration
+                .as_ref()
+                .filter(|c| c.method == designer::calibrate::Method::Innovations),
         };
         macros.push(emit_kalman_macro(&input).map_err(|e| BuildError::Observer {
             file: file(),
@@ -188,10 +191,10 @@ pub fn emit(design: &Design) -> Result<String, BuildError> {
 }
 
 /// Whether an emitted module declares the parameters with `params!(…)`.
-/// The self-calibration the file carries: the innovations update of a
-/// design whose law the UKF drives (`designer::calibrate::choose`). A design
-/// without an observer calibrates by the replay, which `reldesign loop
-/// --runs` runs and the file does not carry (`None`).
+/// The self-calibration the file carries (`designer::calibrate::choose`):
+/// the innovations update of a design whose law the UKF drives (in the `ukf`
+/// module), or the replay of a design whose law reads measured states (in
+/// the controller's modules, `replay.rs`).
 fn emitted_calibration(
     design: &Design,
 ) -> Result<Option<designer::calibrate::CalibrationDesign>, BuildError> {
@@ -205,8 +208,8 @@ fn emitted_calibration(
     };
     let calibration =
         designer::calibrate::choose(design, c.sample_period).map_err(|e| fail(e.to_string()))?;
-    if calibration.method != designer::calibrate::Method::Innovations {
-        return Ok(None);
+    if calibration.method == designer::calibrate::Method::Replay {
+        return Ok(Some(calibration));
     }
     let ukf = d
         .observer

@@ -77,7 +77,7 @@ pub fn calibration_macro(name: &str, c: &CalibrationDesign) -> Result<String, Em
          \x20               upper: THETA_UPPER,\n\
          \x20               max_step: {max_step},\n\
          \x20               sample_period: {ts},\n\
-         \x20               decimation: 1,\n\
+         \x20               decimation: {decimation},\n\
          \x20               z_min: Z_MIN,\n\
          \x20               z_max: Z_MAX,\n\
          \x20               iterations: {iterations},\n\
@@ -91,6 +91,7 @@ pub fn calibration_macro(name: &str, c: &CalibrationDesign) -> Result<String, Em
          \x20           }};\n",
         max_step = macro_literal("max_step", c.max_step)?,
         ts = macro_literal("sample_period", c.sample_period)?,
+        decimation = c.decimation,
         iterations = c.iterations,
         min_samples = c.min_samples,
         current_limit = macro_literal("current_limit", c.current_limit)?,
@@ -104,13 +105,37 @@ pub fn calibration_macro(name: &str, c: &CalibrationDesign) -> Result<String, Em
             "$f::INFINITY".to_owned()
         },
     );
+    let innovations = c.method == designer::calibrate::Method::Innovations;
+    let (which, starts, record, update, method) = if innovations {
+        (
+            "every physics parameter the filter's model reads, each",
+            "`Design` and `Model` start there.",
+            "Samples a run's `Record` holds: every sample of every operation's window.",
+            "(`reldesign_runtime::calibrate::innovations`): steps of at\n\
+             \x20       /// most `max_step`·θ_d, `iterations` Levenberg–Marquardt steps, forward differences\n\
+             \x20       /// of `difference_step`·θ_d;",
+            "the innovations update: θ chosen so that the filter's one-step current\n\
+             /// predictions over a run are right",
+        )
+    } else {
+        (
+            "the parameters the planned operations' current identifies, each",
+            "`Design` starts there.",
+            "Samples an operation's `Record` holds: every `decimation`-th sample of its window.",
+            "(`reldesign_runtime::calibrate::calibrate`): steps of at\n\
+             \x20       /// most `max_step`·θ_d, `iterations` Levenberg–Marquardt steps on the symbolic\n\
+             \x20       /// sensitivities;",
+            "the replay update: θ chosen so that the model, replayed over an\n\
+             /// operation's measured voltage, predicts its measured current",
+        )
+    };
     let body = format!(
         "        /// The parameters θ the self-calibration adapts, in θ's order (their\n\
-         \x20       /// description keys): every physics parameter the filter's model reads, each\n\
+         \x20       /// description keys): {which}\n\
          \x20       /// from the design's value within its physical domain:\n\
          {list}\
          \x20       pub const ADAPTED: [&str; {p}] = {keys};\n\
-         \x20       /// θ_d: the design's values (the `params!` consts); `Design` and `Model` start there.\n\
+         \x20       /// θ_d: the design's values (the `params!` consts); {starts}\n\
          \x20       pub const THETA_DESIGN: [$f; {p}] = {nominal};\n\
          \x20       /// The lower end of θ's domain: the update never leaves [THETA_LOWER, THETA_UPPER].\n\
          \x20       #[allow(clippy::excessive_precision)]\n\
@@ -118,12 +143,10 @@ pub fn calibration_macro(name: &str, c: &CalibrationDesign) -> Result<String, Em
          \x20       /// The upper end of θ's domain.\n\
          \x20       #[allow(clippy::excessive_precision)]\n\
          \x20       pub const THETA_UPPER: [$f; {p}] = {upper};\n\
-         \x20       /// Samples a run's `Record` holds: every sample of every operation's window.\n\
+         \x20       /// {record}\n\
          \x20       /// RAM: 2·RECORD_CAPACITY floats.\n\
          \x20       pub const RECORD_CAPACITY: usize = {capacity};\n\
-         \x20       /// The update's settings (`reldesign_runtime::calibrate::innovations`): steps of at\n\
-         \x20       /// most `max_step`·θ_d, `iterations` Levenberg–Marquardt steps, forward differences\n\
-         \x20       /// of `difference_step`·θ_d; a record shorter than `min_samples`, with a current\n\
+         \x20       /// The update's settings {update} a record shorter than `min_samples`, with a current\n\
          \x20       /// at `current_limit` [A] (a saturated ADC) or more than `dip_share` of its samples\n\
          \x20       /// `dip_tolerance` [V] below the command (a supply dip) is refused. An update that\n\
          \x20       /// leaves a mean squared current error above `unexplained` [A²] (a multiple of σ_i²; ∞:\n\
@@ -139,8 +162,7 @@ pub fn calibration_macro(name: &str, c: &CalibrationDesign) -> Result<String, Em
     );
     Ok(format!(
         "/// The run-to-run self-calibration of `{name}` (`[controller] self_calibration`,\n\
-         /// the innovations update: θ chosen so that the filter's one-step current\n\
-         /// predictions over a run are right), declared in each float module as\n\
+         /// {method}), declared in each float module as\n\
          /// `calibration!(f64)` / `calibration!(f32)` after `params!`.\n\
          macro_rules! calibration {{\n    ($f:ident) => {{\n{body}    }};\n}}\n"
     ))

@@ -65,11 +65,27 @@ pub fn emit_controller(input: &ControllerInput) -> Result<String, ControllerErro
         theta: &theta,
     };
     let mut out = law_macro_text(&source, floats.contains(&Float::F32))?;
+    if replays(input) {
+        out.push('\n');
+        out.push_str(&crate::replay::predictor_macro_text(
+            input.model,
+            &theta,
+            floats.contains(&Float::F32),
+        )?);
+    }
     for float in floats {
         out.push('\n');
         out.push_str(&float_module(input, float, theta.len())?);
     }
     Ok(out)
+}
+
+/// Whether the file carries the replay update in the controller's modules
+/// (a self-calibrating design whose law reads measured states).
+fn replays(input: &ControllerInput) -> bool {
+    input
+        .calibration
+        .is_some_and(|c| c.method == designer::calibrate::Method::Replay)
 }
 
 /// What the law [PT 50] is emitted from: the model, its linearization and
@@ -453,7 +469,8 @@ fn float_module(
         adapted,
     )?;
     let (calibration, theta) = if adapted > 0 {
-        (quote!(calibration!(#ty);), quote!(, &self.theta))
+        let predictor = replays(input).then(|| quote!(predictor!(#ty);));
+        (quote!(calibration!(#ty); #predictor), quote!(, &self.theta))
     } else {
         (quote!(), quote!())
     };

@@ -24,6 +24,8 @@ pub enum EmitError {
     OutputUsedEarly(String),
     #[error("internal error: the emitted tokens do not parse as Rust: {0}")]
     Syntax(String),
+    #[error("not emitted: {0}")]
+    Unsupported(String),
 }
 
 /// Why a controller could not be emitted (every law's module returns it).

@@ -53,6 +53,7 @@ mod operations;
 mod param;
 mod physical;
 mod plan;
+mod replay;
 mod semera;
 mod sliding;
 

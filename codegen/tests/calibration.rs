@@ -150,3 +150,93 @@ fn a_self_calibration_without_the_ukf_is_refused_naming_the_key() {
         assert!(message.contains(part), "`{part}` not in: {message}");
     }
 }
+
+/// The replay self-calibration of a design on sensors
+/// (`examples/self-calibrating-sensor-valve.toml`): the file compiles
+/// `no_std`, passes clippy's panic lints, and is total: the law at odd θ
+/// gives a finite input within the supply, the model and its Jacobians at
+/// odd states do not panic, and the update on odd records refuses or keeps θ
+/// in its domain.
+#[test]
+fn the_replay_update_compiles_passes_clippy_and_is_total() {
+    let text = std::fs::read_to_string(example_path("self-calibrating-sensor-valve.toml"))
+        .expect("the example");
+    let krate = ScratchCrate::new("codegen-check-replay");
+    krate.write(
+        "src/lib.rs",
+        "//! Emitted by codegen/tests/calibration.rs.\n#![no_std]\n#![forbid(unsafe_code)]\n\npub mod valve;\n",
+    );
+    krate.write("src/valve.rs", &emitted(&text));
+    let odd = ODD_FLOATS.join(", ");
+    let mut main = String::from(
+        "use codegen_check_replay::valve;\nuse reldesign_runtime::calibrate::{Outcome, Predictor};\n\nfn main() {\n",
+    );
+    for module in ["f64", "f32"] {
+        writeln!(
+            main,
+            "    {{
+        use valve::{module}::*;
+        type F = {module};
+        let odd: [F; 9] = [{odd}];
+        let mut thetas = vec![THETA_DESIGN, THETA_LOWER, THETA_UPPER];
+        for (k, x) in odd.iter().enumerate() {{
+            let mut t = THETA_DESIGN;
+            t[k % t.len()] = *x;
+            thetas.push(t);
+        }}
+        for theta in &thetas {{
+            for z in [Z_MIN, Z_MAX, 5e-4, odd[2], odd[8]] {{
+                for phi in [PHI_GUARD, 8e-6, odd[0], odd[8]] {{
+                    let mut c = Controller::with(Design {{ theta: *theta }}, Operation::Opening);
+                    c.start(0.0);
+                    let u = c.step(0.5 * (T_TAKEOFF + T_LANDING), z, 0.1, phi);
+                    println!(\"law {module} {{u:e}}\");
+                    let d = Model.derivative(theta, &[z, 0.1, phi], odd[3]);
+                    let i = Model.current(theta, &[z, 0.1, phi], odd[5]);
+                    println!(\"model {module} {{}}\", d.dx[0].is_nan() && i.i.is_nan());
+                }}
+            }}
+        }}
+        for (u, fill) in [(24.0, 0.1), (12.0, 0.0), (odd[4], odd[6]), (5.0, odd[8])] {{
+            let mut record = Record::new();
+            record.start(Z_MAX);
+            for k in 0..RECORD_CAPACITY * CALIBRATION.decimation as usize {{
+                let i = fill * (1.0 + (k % 7) as F / 10.0);
+                record.push(&CALIBRATION, u, u, i);
+            }}
+            let mut calibration = Calibration::new(&CALIBRATION);
+            let outcome = calibrate(&mut calibration, &record);
+            let inside = calibration.theta.iter().zip(THETA_LOWER.iter().zip(&THETA_UPPER))
+                .all(|(t, (lo, hi))| lo.min(*hi) <= *t && *t <= lo.max(*hi));
+            let updated = matches!(outcome, Outcome::Updated {{ .. }});
+            println!(\"update {module} {{inside}} {{updated}}\");
+        }}
+    }}"
+        )
+        .unwrap();
+    }
+    main.push_str("}\n");
+    krate.write("src/main.rs", &main);
+    let text = krate.run_panic_free(&[]);
+    let (mut laws, mut models, mut updates) = (0, 0, 0);
+    for line in text.lines() {
+        let f: Vec<&str> = line.split(' ').collect();
+        match f[..] {
+            ["law", _, u] => {
+                let u: f64 = u.parse().unwrap();
+                assert!(u.is_finite() && (-24.0..=24.0).contains(&u), "{line}");
+                laws += 1;
+            }
+            ["model", _, _] => models += 1,
+            ["update", _, inside, _] => {
+                assert_eq!(inside, "true", "θ left its domain: {line}");
+                updates += 1;
+            }
+            _ => panic!("{line}"),
+        }
+    }
+    let thetas = 3 + 9;
+    assert_eq!(laws, 2 * thetas * 5 * 4);
+    assert_eq!(models, 2 * thetas * 5 * 4);
+    assert_eq!(updates, 2 * 4);
+}

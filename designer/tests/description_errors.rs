@@ -375,6 +375,7 @@ fn the_perfect_tracking_example_carries_the_papers_design() {
             n == "perfect-tracking-valve.toml"
                 || n == "sliding-mode-valve.toml"
                 || n == "self-calibrating-valve.toml"
+                || n == "self-calibrating-sensor-valve.toml"
                 || n == "uncertain-stop-valve.toml"
         });
         assert_eq!(
@@ -417,6 +418,11 @@ fn the_perfect_tracking_example_carries_the_papers_design() {
             let c = d.controller.unwrap();
             assert!(c.self_calibration && c.estimator.is_some());
         } else if designed {
+            if path.ends_with("self-calibrating-sensor-valve.toml") {
+                // the paper's design on sensors, with the replay self-calibration
+                let c = d.controller.as_ref().unwrap();
+                assert!(c.self_calibration && c.estimator.is_none());
+            }
             let t = d.trajectory.unwrap();
             assert_eq!(
                 (t.takeoff, t.landing, t.u_bound, t.shape),

@@ -46,3 +46,10 @@ pub mod self_calibrating_valve;
 /// for stops spread σ = 10 µm (1 % of the stroke) into the stroke.
 #[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
 pub mod uncertain_stop_valve;
+
+/// `examples/self-calibrating-sensor-valve.toml`: the perfect-tracking valve
+/// and its design on sensors, with the replay self-calibration: the
+/// parameters each operation's current identifies, read at run time by the
+/// law and updated between operations (`docs/guide/self-calibration.md`).
+#[rustfmt::skip] // formatted by the generator (prettyplease); the freshness test keeps it exact
+pub mod self_calibrating_sensor_valve;

@@ -13,7 +13,12 @@
 //! - push{64,32}: `Record::push` of one sample (what the firmware adds to
 //!   each control sample);
 //! - update{64,32}: one whole update, `ukf::…::calibrate` on the run's record
-//!   (from θ_d every call: the same work each time).
+//!   (from θ_d every call: the same work each time);
+//! - law{64,32}{fixed,adaptive}: the replay example's (a law on measured
+//!   states) controller step over its closing's states, folded and with θ;
+//! - replaypush{64,32}: its `Record::push` of one sample (decimated);
+//! - replay{64,32}: one whole replay update, `f…::calibrate` on the closing's
+//!   record (from θ_d every call).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -31,6 +36,111 @@ mod fixed {
 }
 
 use record::RECORD;
+
+mod sensor_record {
+    include!(concat!(env!("OUT_DIR"), "/sensor_record.rs"));
+}
+#[allow(dead_code, clippy::all)]
+mod sensor_adaptive {
+    include!(concat!(env!("OUT_DIR"), "/sensor_adaptive.rs"));
+}
+#[allow(dead_code, clippy::all)]
+mod sensor_fixed {
+    include!(concat!(env!("OUT_DIR"), "/sensor_fixed.rs"));
+}
+use sensor_record::SENSOR_RECORD;
+
+macro_rules! law_loop {
+    ($name:ident, $law:path, $f:ty) => {
+        fn $name(rec: &[[$f; 6]], n: usize) -> f64 {
+            use $law as law;
+            let mut controller = law::Controller::new(law::Operation::Closing);
+            let mut acc: $f = 0.0;
+            let mut k = 0;
+            for _ in 0..n {
+                if k == 0 {
+                    controller = law::Controller::new(law::Operation::Closing);
+                    controller.start(0.0);
+                }
+                let [_, _, _, z, v, phi] = *black_box(&rec[k]);
+                let t = k as $f * law::SAMPLE_PERIOD;
+                acc += black_box(controller.step(t, z, v, phi));
+                k += 1;
+                if k == rec.len() {
+                    k = 0;
+                }
+            }
+            acc as f64
+        }
+    };
+}
+law_loop!(law64fixed, sensor_fixed::f64, f64);
+law_loop!(law32fixed, sensor_fixed::f32, f32);
+law_loop!(law64adaptive, sensor_adaptive::f64, f64);
+law_loop!(law32adaptive, sensor_adaptive::f32, f32);
+
+macro_rules! replay_loop {
+    ($name:ident, $push:ident, $module:path, $f:ty) => {
+        fn $name(rec: &[[$f; 6]], n: usize) -> f64 {
+            use $module as m;
+            let mut record = m::Record::new();
+            record.start(m::Z_MAX);
+            for [c, u, i, ..] in rec {
+                record.push(&m::CALIBRATION, *c, *u, *i);
+            }
+            let mut acc = 0.0;
+            for _ in 0..n {
+                let mut calibration = m::Calibration::new(&m::CALIBRATION);
+                let outcome = m::calibrate(&mut calibration, black_box(&record));
+                if let reldesign_runtime::calibrate::Outcome::Updated { after, .. } = outcome {
+                    acc += f64::from(after);
+                }
+                acc += f64::from(black_box(calibration.theta)[0]);
+            }
+            acc
+        }
+
+        fn $push(rec: &[[$f; 6]], n: usize) -> f64 {
+            use $module as m;
+            let mut record = m::Record::new();
+            let mut k = 0;
+            for _ in 0..n {
+                if k == 0 {
+                    record.start(m::Z_MAX);
+                }
+                let [c, u, i, ..] = *black_box(&rec[k]);
+                record.push(&m::CALIBRATION, c, u, i);
+                k += 1;
+                if k == rec.len() {
+                    k = 0;
+                }
+            }
+            black_box(&record).len() as f64
+        }
+    };
+}
+replay_loop!(replay64, replaypush64, sensor_adaptive::f64, f64);
+replay_loop!(replay32, replaypush32, sensor_adaptive::f32, f32);
+
+macro_rules! sensor_base_loop {
+    ($name:ident, $f:ty) => {
+        fn $name(rec: &[[$f; 6]], n: usize) -> f64 {
+            let mut acc: $f = 0.0;
+            let mut k = 0;
+            for _ in 0..n {
+                let [_, u, ..] = *black_box(&rec[k]);
+                acc += black_box(u);
+                k += 1;
+                if k == rec.len() {
+                    k = 0;
+                }
+            }
+            acc as f64
+        }
+    };
+}
+sensor_base_loop!(sensorbase64, f64);
+sensor_base_loop!(sensorbase32, f32);
 
 macro_rules! step_loop {
     ($name:ident, $law:path, $filter:path, $f:ty) => {
@@ -156,6 +266,16 @@ fn sizes() {
     println!("parameters={}", a32::ADAPTED.len());
     println!("record_samples={}", a32::RECORD_CAPACITY);
     println!("run_samples={}", RECORD.len());
+    use sensor_adaptive::{f32 as s32, f64 as s64};
+    println!("replay_record32={}", size_of::<s32::Record>());
+    println!("replay_record64={}", size_of::<s64::Record>());
+    println!("replay_calibration32={}", size_of::<s32::Calibration>());
+    println!("replay_controller32_adaptive={}", size_of::<s32::Controller>());
+    println!("replay_controller32_fixed={}", size_of::<sensor_fixed::f32::Controller>());
+    println!("replay_parameters={}", s32::ADAPTED.len());
+    println!("replay_record_samples={}", s32::RECORD_CAPACITY);
+    println!("replay_decimation={}", s32::CALIBRATION.decimation);
+    println!("replay_operation_samples={}", SENSOR_RECORD.len());
 }
 
 fn main() {
@@ -170,6 +290,8 @@ fn main() {
     }
     let rec64: Vec<[f64; 3]> = RECORD.to_vec();
     let rec32: Vec<[f32; 3]> = RECORD.iter().map(|s| s.map(|x| x as f32)).collect();
+    let srec64: Vec<[f64; 6]> = SENSOR_RECORD.to_vec();
+    let srec32: Vec<[f32; 6]> = SENSOR_RECORD.iter().map(|s| s.map(|x| x as f32)).collect();
     let kind = args[1].as_str();
     let n: usize = args[2].parse().expect("N");
     let reps: usize = args[3].parse().expect("REPS");
@@ -185,6 +307,16 @@ fn main() {
             "push64" => push64(&rec64, n),
             "push32" => push32(&rec32, n),
             "update32" => update32(&rec32, n),
+            "law64fixed" => law64fixed(&srec64, n),
+            "law32fixed" => law32fixed(&srec32, n),
+            "law64adaptive" => law64adaptive(&srec64, n),
+            "law32adaptive" => law32adaptive(&srec32, n),
+            "sensorbase64" => sensorbase64(&srec64, n),
+            "sensorbase32" => sensorbase32(&srec32, n),
+            "replaypush64" => replaypush64(&srec64, n),
+            "replaypush32" => replaypush32(&srec32, n),
+            "replay64" => replay64(&srec64, n),
+            "replay32" => replay32(&srec32, n),
             _ => {
                 eprintln!("unknown kind {kind}");
                 std::process::exit(2);
