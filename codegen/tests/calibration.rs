@@ -99,30 +99,13 @@ fn emitted_module_compiles_passes_clippy_and_is_total() {
     main.push_str("}\n");
     krate.write("src/main.rs", &main);
     let text = krate.run_panic_free(&[]);
-    let (mut laws, mut filters, mut updates) = (0, 0, 0);
-    for line in text.lines() {
-        let f: Vec<&str> = line.split(' ').collect();
-        match f[..] {
-            ["law", _, u] => {
-                let u: f64 = u.parse().unwrap();
-                assert!(u.is_finite() && (-24.0..=24.0).contains(&u), "{line}");
-                laws += 1;
-            }
-            ["filter", _, z, phi] => {
-                let (z, phi): (f64, f64) = (z.parse().unwrap(), phi.parse().unwrap());
-                assert!(
-                    z.is_finite() && (0.0..=1e-3).contains(&z) && phi.is_finite(),
-                    "{line}"
-                );
-                filters += 1;
-            }
-            ["update", _, inside, _] => {
-                assert_eq!(inside, "true", "θ left its domain: {line}");
-                updates += 1;
-            }
-            _ => panic!("{line}"),
+    let (laws, filters, updates) = tally(&text, |f| match f {
+        ["filter", _, z, phi] => {
+            let (z, phi): (f64, f64) = (z.parse().unwrap(), phi.parse().unwrap());
+            z.is_finite() && (0.0..=1e-3).contains(&z) && phi.is_finite()
         }
-    }
+        _ => panic!("{f:?}"),
+    });
     let thetas = 3 + 9;
     assert_eq!(laws, 2 * thetas * 5 * 6 * 5);
     assert_eq!(filters, 2 * thetas * 5);
@@ -218,7 +201,21 @@ fn the_replay_update_compiles_passes_clippy_and_is_total() {
     main.push_str("}\n");
     krate.write("src/main.rs", &main);
     let text = krate.run_panic_free(&[]);
-    let (mut laws, mut models, mut updates) = (0, 0, 0);
+    let (laws, models, updates) = tally(&text, |f| match f {
+        ["model", _, _] => true,
+        _ => panic!("{f:?}"),
+    });
+    let thetas = 3 + 9;
+    assert_eq!(laws, 2 * thetas * 5 * 4);
+    assert_eq!(models, 2 * thetas * 5 * 4);
+    assert_eq!(updates, 2 * 4);
+}
+
+/// The counts of the scratch program's `law`, other and `update` lines:
+/// every law's input finite within the supply, every update's θ within its
+/// domain, and `other` true of every other line.
+fn tally(text: &str, other: impl Fn(&[&str]) -> bool) -> (usize, usize, usize) {
+    let (mut laws, mut others, mut updates) = (0, 0, 0);
     for line in text.lines() {
         let f: Vec<&str> = line.split(' ').collect();
         match f[..] {
@@ -227,16 +224,15 @@ fn the_replay_update_compiles_passes_clippy_and_is_total() {
                 assert!(u.is_finite() && (-24.0..=24.0).contains(&u), "{line}");
                 laws += 1;
             }
-            ["model", _, _] => models += 1,
             ["update", _, inside, _] => {
                 assert_eq!(inside, "true", "θ left its domain: {line}");
                 updates += 1;
             }
-            _ => panic!("{line}"),
+            _ => {
+                assert!(other(&f), "{line}");
+                others += 1;
+            }
         }
     }
-    let thetas = 3 + 9;
-    assert_eq!(laws, 2 * thetas * 5 * 4);
-    assert_eq!(models, 2 * thetas * 5 * 4);
-    assert_eq!(updates, 2 * 4);
+    (laws, others, updates)
 }
