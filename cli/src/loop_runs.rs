@@ -109,9 +109,7 @@ fn update_json(update: &Option<Update>, calibration: Option<&CalibrationDesign>)
     };
     // whether the fitted model still leaves the current unexplained (where
     // the design states a threshold: an observer's σ_i)
-    let unexplained = calibration
-        .filter(|c| c.unexplained.is_finite())
-        .and_then(|c| c.leaves_unexplained(outcome));
+    let unexplained = calibration.and_then(|c| c.leaves_unexplained(outcome));
     match outcome {
         Outcome::Updated { before, after } => json!({
             "updated": true,
@@ -128,10 +126,7 @@ fn update_text(update: &Update, calibration: Option<&CalibrationDesign>) -> Stri
     let (Update::Replay(outcome) | Update::Innovations(outcome)) = update;
     match outcome {
         Outcome::Updated { before, after } => {
-            let unexplained = calibration
-                .filter(|c| c.unexplained.is_finite())
-                .and_then(|c| c.leaves_unexplained(outcome))
-                == Some(true);
+            let unexplained = calibration.and_then(|c| c.leaves_unexplained(outcome)) == Some(true);
             format!(
                 "RMS current error {:.3e} → {:.3e} A{}",
                 before.sqrt(),

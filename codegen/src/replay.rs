@@ -2,8 +2,8 @@
 //! measured states (`[controller] self_calibration` without an `estimator`):
 //! `macro_rules! predictor`, the model the runtime's
 //! `reldesign_runtime::calibrate::calibrate` replays, with its symbolic
-//! Jacobians (the designer's `calibrate::TapePredictor`, as straight-line
-//! code):
+//! Jacobians as straight-line code (`designer::calibrate::PredictorExpressions`,
+//! which the designer's `TapePredictor` evaluates on tapes):
 //!
 //! - `flow_terms`: f(x, u; θ), ∂f/∂x and ∂f/∂θ of the free motion;
 //! - `current_terms`: i(x, u; θ), ∂i/∂x and ∂i/∂θ;
@@ -14,8 +14,11 @@
 //! `predictor!(f32)` after `params!` and `calibration!`. The update itself
 //! is the runtime's, written once.
 
+use std::collections::HashMap;
+
+use designer::calibrate::PredictorExpressions;
 use designer::model::Model;
-use designer::sym::{Graph, Id};
+use designer::sym::Id;
 use quote::quote;
 
 use crate::calibration::theta_symbols;
@@ -32,33 +35,33 @@ const STATES: [&str; 3] = ["z", "v", "phi"];
 /// `macro_rules! predictor` of `model` with the adapted parameters `theta`,
 /// its literals typed for `f32` too if asked.
 pub fn predictor_macro_text(model: &Model, theta: &Theta, f32: bool) -> Result<String, EmitError> {
-    let mut graph = model.graph.clone();
-    let physical = in_scope(&mut graph, &of_model(model));
+    if model.states.len() != 3 {
+        return Err(EmitError::Unsupported(
+            "the replay calibration's model has three states (no Jiles–Atherton core)".to_owned(),
+        ));
+    }
     let adapted = theta_symbols(theta);
+    // the designer's expressions, which its tapes evaluate
+    let mut derived = model.clone();
+    let e = PredictorExpressions::derive(&mut derived, &adapted);
+    let mut graph = derived.graph;
+    let physical = in_scope(&mut graph, &of_model(model));
     let mut params: Vec<Param> = (model.params.iter())
         .filter(|p| !adapted.contains(&p.1))
         .map(Param::from)
         .collect();
     params.extend_from_slice(&physical);
-    // the replay's model is autonomous in t (the tape's t = 0)
+    // the replay's model is autonomous in t (the tapes' t = 0)
     let zero = graph.constant(0.0);
-    let at_rest_in_time = |g: &mut Graph, e: &[Id]| {
-        let bindings: std::collections::HashMap<Id, Id> =
-            std::iter::once((model.time, zero)).collect();
-        g.substitute_all(e, &bindings)
-    };
-    let x = model.states.clone();
-    if x.len() != 3 {
-        return Err(EmitError::Unsupported(
-            "the replay calibration's model has three states (no Jiles–Atherton core)".to_owned(),
-        ));
-    }
-    let f = at_rest_in_time(&mut graph, &model.f);
-    let f_x = graph.jacobian(&f, &x);
-    let f_theta = graph.jacobian(&f, &adapted);
-    let current = at_rest_in_time(&mut graph, &[model.current]);
-    let i_x = graph.jacobian(&current, &x);
-    let i_theta = graph.jacobian(&current, &adapted);
+    let bindings: HashMap<Id, Id> = std::iter::once((model.time, zero)).collect();
+    let mut at_rest_in_time = |exprs: &[Id]| graph.substitute_all(exprs, &bindings);
+    let f = at_rest_in_time(&e.f);
+    let f_x: Vec<Vec<Id>> = e.f_x.iter().map(|row| at_rest_in_time(row)).collect();
+    let f_theta: Vec<Vec<Id>> = e.f_theta.iter().map(|row| at_rest_in_time(row)).collect();
+    let current = at_rest_in_time(&[e.current]);
+    let i_x = at_rest_in_time(&e.i_x);
+    let i_theta = at_rest_in_time(&e.i_theta);
+    let x = &model.states;
     let scalar = Scalar::Macro { f32 };
     let mut inputs: Vec<(&str, Id)> = STATES.iter().copied().zip(x.iter().copied()).collect();
     inputs.push(("u", model.input));
@@ -89,10 +92,10 @@ pub fn predictor_macro_text(model: &Model, theta: &Theta, f32: bool) -> Result<S
     }
     let mut current_names = vec![("i".to_owned(), current[0], "i(x, u; θ)".to_owned())];
     for (c, col) in STATES.iter().enumerate() {
-        current_names.push((format!("i_{col}"), i_x[0][c], format!("∂i/∂{col}")));
+        current_names.push((format!("i_{col}"), i_x[c], format!("∂i/∂{col}")));
     }
     for (c, col) in theta_names.iter().enumerate() {
-        current_names.push((format!("i_{col}"), i_theta[0][c], format!("∂i/∂{col}")));
+        current_names.push((format!("i_{col}"), i_theta[c], format!("∂i/∂{col}")));
     }
     let function = |name: &str, doc: &str, outputs: &[(String, Id, String)]| {
         let spec = FunctionSpec {

@@ -15,7 +15,7 @@ mod predictor;
 mod runs;
 
 pub use choice::{candidates, choose, Candidate, ChoiceError, UNEXPLAINED};
-pub use predictor::TapePredictor;
+pub use predictor::{PredictorExpressions, TapePredictor};
 pub use reldesign_runtime::calibrate::{Outcome, Refusal};
 pub use runs::{run_runs, run_runs_updated_by, OperationRun, Run, RunUpdate, RunsError, Update};
 
@@ -107,17 +107,17 @@ pub struct CalibrationDesign {
 impl CalibrationDesign {
     /// Whether an update left the valve's current unexplained (its mean
     /// squared error above [`CalibrationDesign::unexplained`]); `None` for a
-    /// refusal.
+    /// refusal, and where the design states no threshold (∞).
     pub fn leaves_unexplained(&self, outcome: &Outcome<f64>) -> Option<bool> {
         match outcome {
             // a NaN error explains nothing
-            Outcome::Updated { after, .. } => Some(!(*after <= self.unexplained)),
-            Outcome::Refused(_) => None,
+            Outcome::Updated { after, .. } if self.unexplained.is_finite() => {
+                Some(!(*after <= self.unexplained))
+            }
+            _ => None,
         }
     }
-}
 
-impl CalibrationDesign {
     /// The runtime's settings for P = `parameters.len()` parameters.
     ///
     /// # Panics

@@ -61,22 +61,56 @@ impl<const P: usize> TapePredictor<P> {
     }
 }
 
+/// The replay's model and its Jacobians in the model's graph: what the
+/// tapes evaluate and the emitted `predictor!` writes as code.
+pub struct PredictorExpressions {
+    /// f(x, u; θ) of the free motion, x = [z, v, φ].
+    pub f: Vec<Id>,
+    /// ∂f/∂x and ∂f/∂θ, by rows.
+    pub f_x: Vec<Vec<Id>>,
+    pub f_theta: Vec<Vec<Id>>,
+    /// i(x, u; θ), ∂i/∂x and ∂i/∂θ.
+    pub current: Id,
+    pub i_x: Vec<Id>,
+    pub i_theta: Vec<Id>,
+}
+
+impl PredictorExpressions {
+    /// The expressions of `model` (three states: no Jiles–Atherton core)
+    /// with the parameters `theta` adapted.
+    ///
+    /// # Panics
+    /// Where the model has other than three states.
+    pub fn derive(model: &mut Model, theta: &[Id]) -> PredictorExpressions {
+        let x = model.states.clone();
+        assert_eq!(x.len(), 3, "the calibration's model has three states");
+        let graph = &mut model.graph;
+        let f = model.f.clone();
+        let f_x = graph.jacobian(&f, &x);
+        let f_theta = graph.jacobian(&f, theta);
+        let current = model.current;
+        let i_x = graph.jacobian(&[current], &x).concat();
+        let i_theta = graph.jacobian(&[current], theta).concat();
+        PredictorExpressions {
+            f,
+            f_x,
+            f_theta,
+            current,
+            i_x,
+            i_theta,
+        }
+    }
+}
+
 /// f, ∂f/∂x and ∂f/∂θ (by rows), i, ∂i/∂x, ∂i/∂θ: 3 + 9 + 3·P + 1 + 3 + P outputs.
 fn expressions<const P: usize>(model: &mut Model, theta: &[Id; P]) -> Vec<Id> {
-    let f = model.f.clone();
-    let x = model.states.clone();
-    assert_eq!(x.len(), 3, "the calibration's model has three states");
-    let f_x = model.graph.jacobian(&f, &x);
-    let f_theta = model.graph.jacobian(&f, theta);
-    let current = model.current;
-    let i_x = model.graph.jacobian(&[current], &x);
-    let i_theta = model.graph.jacobian(&[current], theta);
-    let mut out = f;
-    out.extend(f_x.into_iter().flatten());
-    out.extend(f_theta.into_iter().flatten());
-    out.push(current);
-    out.extend(i_x.into_iter().flatten());
-    out.extend(i_theta.into_iter().flatten());
+    let e = PredictorExpressions::derive(model, theta);
+    let mut out = e.f;
+    out.extend(e.f_x.into_iter().flatten());
+    out.extend(e.f_theta.into_iter().flatten());
+    out.push(e.current);
+    out.extend(e.i_x);
+    out.extend(e.i_theta);
     out
 }
 

@@ -195,7 +195,7 @@ impl<T: Scalar, const P: usize> Calibration<T, P> {
 
     /// Counts an update's outcome, and whether it left the current
     /// unexplained ([`Settings::unexplained`]).
-    pub fn count(&mut self, outcome: Outcome<T>, settings: &Settings<T, P>) {
+    fn count(&mut self, outcome: Outcome<T>, settings: &Settings<T, P>) {
         match outcome {
             Outcome::Updated { after, .. } => {
                 self.updates = self.updates.saturating_add(1);
