@@ -16,7 +16,9 @@
 //!   at its end stop (within `landed_band`: contact, not proximity) the expert
 //!   rules of model-free-sliding-mode-soft-landing [SM 43] apply: closing →
 //!   u = u_max·sgn φ (holds it closed; sgn 0 taken as +1, a NaN φ gives 0),
-//!   opening → u = 0;
+//!   opening → u = 0; they hold for the rest of the operation (an estimate
+//!   flickering in and out of the band at its clamp would otherwise hand the
+//!   held armature back to the law, sample by sample, at ±u_max);
 //! - no hover: after t_f + `arrival_margin` an armature not yet at its end
 //!   stop is driven there ([`finish_stroke`]), and the operation is flagged
 //!   late ([`SoftLanding::finished_late`]);
@@ -314,6 +316,9 @@ pub struct SoftLanding<L: Law<T>, T> {
     tracker: Tracker<L::Operation, T>,
     /// [`finish_stroke`] drove this operation.
     late: bool,
+    /// The expert rule has held the armature at its stop after t_f: it
+    /// holds it for the rest of the operation.
+    held: bool,
 }
 
 impl<L: Law<T> + ConstPlan, T: Scalar + From<u8>> SoftLanding<L, T> {
@@ -332,6 +337,7 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
             law,
             tracker: Tracker::new(operation),
             late: false,
+            held: false,
         }
     }
 
@@ -345,6 +351,7 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
     pub fn start(&mut self, t_start: T) {
         self.tracker.start(t_start);
         self.late = false;
+        self.held = false;
     }
 
     /// Whether the armature was not at its stop (by the position read) at
@@ -367,16 +374,19 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
         self.tracker.reference(&self.law, t)
     }
 
-    /// After t_f at the end stop: the expert rule [SM 43] ([`expert_rule`]);
-    /// `None` elsewhere.
-    fn hold(&self, time: T, z: T, phi: T) -> Option<T> {
+    /// After t_f at the end stop: the expert rule [SM 43] ([`expert_rule`]),
+    /// and from then on for the rest of the operation, wherever the position
+    /// read later says the armature is; `None` before.
+    fn hold(&mut self, time: T, z: T, phi: T) -> Option<T> {
         let settings = self.law.settings();
-        if time > settings.landing {
-            let motion = self.law.motion(self.tracker.operation());
-            expert_rule(&motion, &settings, z, phi)
-        } else {
-            None
+        if !(time > settings.landing) {
+            return None;
         }
+        let motion = self.law.motion(self.tracker.operation());
+        let at_stop = if self.held { motion.zf } else { z };
+        let u = expert_rule(&motion, &settings, at_stop, phi);
+        self.held = u.is_some();
+        u
     }
 
     /// The input u in [u_min, u_max] at time `t` [s] for the measured state
@@ -397,7 +407,7 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
         // or drains the flux the rule would leave to decay (opening), and it
         // does not trust a position estimate that may have lost the armature
         if let Some(u) = finish_stroke(&motion, &settings, time, phi) {
-            self.late |= expert_rule(&motion, &settings, z, phi).is_none();
+            self.late |= !self.held && expert_rule(&motion, &settings, z, phi).is_none();
             return u;
         }
         if let Some(u) = self.hold(time, z, phi) {

@@ -178,14 +178,36 @@ macro_rules! toy {
                 assert_eq!(c.step(3.5, 1e-7, 0.0, 0.0), 20.0);
                 assert_eq!(c.step(3.5, -1.0, 0.0, $f::NAN), 0.0);
                 // not yet at the stop: the law (unsaturated here)
-                let u = c.step(3.5, 0.01, 0.0, 0.3);
+                let mut away = Ctl::new(Operation::Closing);
+                let u = away.step(3.5, 0.01, 0.0, 0.3);
                 assert!(u > -24.0 && u < 20.0, "{u}");
                 // before t_f the rule does not apply
-                assert_ne!(c.step(2.5, 0.0, 0.0, 0.3), 20.0);
+                assert_ne!(away.step(2.5, 0.0, 0.0, 0.3), 20.0);
+                for z in [1.0, 2.0] {
+                    let mut o = Ctl::new(Operation::Opening);
+                    assert_eq!(o.step(3.5, z, 0.0, 0.3), 0.0);
+                }
+                assert_ne!(Ctl::new(Operation::Opening).step(3.5, 0.9, 0.0, 0.3), 0.0);
+            }
+
+            #[test]
+            fn once_held_at_its_stop_the_armature_stays_held_for_the_operation() {
+                // a position read that leaves the band after the rule has
+                // held (an estimate flickering at its clamp, a bounce) does
+                // not hand the armature back to the law
+                let mut c = Ctl::new(Operation::Closing);
+                assert_ne!(c.step(3.2, 0.01, 0.0, 0.3), 20.0);
+                assert_eq!(c.step(3.3, 0.0, 0.0, 0.3), 20.0);
+                assert_eq!(c.step(3.4, 0.01, 0.0, 0.3), 20.0);
+                assert_eq!(c.step(3.5, 0.5, 0.0, -0.3), -20.0);
                 let mut o = Ctl::new(Operation::Opening);
-                assert_eq!(o.step(3.5, 1.0, 0.0, 0.3), 0.0);
-                assert_eq!(o.step(3.5, 2.0, 0.0, 0.3), 0.0);
-                assert_ne!(o.step(3.5, 0.9, 0.0, 0.3), 0.0);
+                assert_eq!(o.step(3.3, 1.0, 0.0, 0.3), 0.0);
+                assert_eq!(o.step(3.4, 0.9, 0.0, 0.3), 0.0);
+                // a new operation is not held
+                c.start(10.0);
+                assert_ne!(c.step(13.5, 0.01, 0.0, 0.3), 20.0);
+                o.start(10.0);
+                assert_ne!(o.step(13.5, 0.9, 0.0, 0.3), 0.0);
             }
 
             #[test]
