@@ -237,6 +237,7 @@ pub fn fit_with_edges(
         status: report.status,
         best_start: 0,
         differenced_jacobians: report.differenced_jacobians,
+        scanned_threshold: None,
     };
     Ok(EdgeFit {
         report: fit,

@@ -169,6 +169,11 @@ pub struct FitReport {
     /// Which start gave the best fit (0 = the description's values).
     pub best_start: usize,
     pub sensitivity: Sensitivity,
+    /// Where a scan after the fit moved the bounce threshold v_ε
+    /// (`diagnose::bounce_threshold`, which has no gradient): the interval
+    /// of v_ε whose replay is the same as the one chosen (between two
+    /// levels of the model's impact speeds). `None` otherwise.
+    pub scanned_threshold: Option<[f64; 2]>,
 }
 
 /// Simulated signals at the data's sample times.
@@ -696,6 +701,7 @@ pub fn fit(
         status: report.status,
         best_start,
         differenced_jacobians: differenced,
+        scanned_threshold: None,
     })
 }
 

@@ -189,10 +189,25 @@ fn a_drift_seen_on_the_held_out_end_is_named() {
 /// with the description's threshold of 1 mm/s, γ and the drift came within
 /// 0.1 % of the truth and 3.84× the floor was left, `unexplained`. The
 /// threshold scanned between the fitted model's impact speeds names both
-/// (2026-12-02, 1.16×).
+/// (2026-12-02, 1.16×). The scanned threshold is among the fitted values,
+/// ± half the interval of thresholds that replay the same, which holds the
+/// relay's own.
 #[test]
 fn the_bounce_threshold_is_scanned() {
-    right_within(Blind::DriftWithBounce, 4, 1.25);
+    let class = Blind::DriftWithBounce;
+    let (causes, line) = right_within(class, 4, 1.25);
+    let case = class.case(4);
+    let (model, data) = case.inputs();
+    let listed: Vec<_> = (causes.steps.iter())
+        .flat_map(|step| step.parameters(&model, &data))
+        .filter(|p| p.path == "mechanics.bounce_threshold")
+        .collect();
+    let truth = case.truth.mechanics.bounce_threshold;
+    assert!(
+        listed.iter().any(|p| (p.value - truth).abs() <= p.std_error
+            && p.baseline == Some(model.mechanics.bounce_threshold)),
+        "{line}: the relay's v_ε {truth}, listed {listed:?}"
+    );
 }
 
 /// A warming relay that bounces (fresh seed 209): the drift fitted jointly

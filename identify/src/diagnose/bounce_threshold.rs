@@ -43,8 +43,11 @@ pub(super) fn fits_restitution(params: &[FitParam]) -> bool {
 const RESTITUTION: &str = "mechanics.restitution";
 
 /// `report` (a ranking fit of `params` on `data` from `start`, that fits
-/// the restitution), or its fit again from the best bounce threshold where
-/// that is better; whether v_ε moved (it is then one more parameter).
+/// the restitution), or, where the best bounce threshold lowers its error,
+/// the better of its fit again from there and the scanned threshold alone
+/// (a refit that fails or gains nothing does not drop it); whether v_ε
+/// moved (it is then one more parameter). A moved v_ε is stated in the
+/// report's `scanned_threshold`.
 ///
 /// Every error here is measured as the ranking measures `report`'s: [JA 81]
 /// with the |φ̇| weights of `start`'s resistance, so that the refit's error
@@ -59,30 +62,55 @@ pub(super) fn scanned(
     let Ok(setup) = Setup::new(start, data, params, options) else {
         return (report, false);
     };
-    let refit = better_threshold(&report.description, &setup, data).and_then(|from| {
-        let once = FitOptions {
-            starts: 1,
-            also_from: Vec::new(),
-            ..options.clone()
-        };
-        let mut refit = fit(&from, data, params, &once, &|_| {}).ok()?;
-        let errors = setup.objective.errors(&refit.description, data).ok()?;
-        refit.wnrmse_current = errors.current;
-        refit.wnrmse_flux = errors.flux;
-        refit.nrmse_position = errors.position;
-        refit.iterations += report.iterations;
-        refit.simulations += report.simulations;
-        Some(refit)
+    let Some(scan) = better_threshold(&report.description, &setup, data) else {
+        return (report, false);
+    };
+    let measured = |mut r: FitReport| {
+        let errors = setup.objective.errors(&r.description, data).ok()?;
+        r.wnrmse_current = errors.current;
+        r.wnrmse_flux = errors.flux;
+        r.nrmse_position = errors.position;
+        r.scanned_threshold = Some(scan.interval);
+        Some(r)
+    };
+    let once = FitOptions {
+        starts: 1,
+        also_from: Vec::new(),
+        ..options.clone()
+    };
+    let refit = fit(&scan.description, data, params, &once, &|_| {})
+        .ok()
+        .and_then(|mut refit| {
+            refit.iterations += report.iterations;
+            refit.simulations += report.simulations;
+            measured(refit)
+        });
+    // the fitted values with the scanned threshold (the fit's cost, an
+    // upper bound of its own, kept)
+    let held = measured(FitReport {
+        description: scan.description.clone(),
+        ..report.clone()
     });
-    match refit {
-        Some(refit) if refit.wnrmse_current < report.wnrmse_current => (refit, true),
+    let best = [refit, held]
+        .into_iter()
+        .flatten()
+        .min_by(|a, b| a.wnrmse_current.total_cmp(&b.wnrmse_current));
+    match best {
+        Some(best) if best.wnrmse_current < report.wnrmse_current => (best, true),
         _ => (report, false),
     }
 }
 
+/// A bounce threshold the scan chose: the fitted description with it, and
+/// the interval of thresholds that give the same replay.
+struct Scan {
+    description: Description,
+    interval: [f64; 2],
+}
+
 /// `fitted` with the threshold that lowers its current's error most, if
 /// one does.
-fn better_threshold(fitted: &Description, setup: &Setup, data: &Measured) -> Option<Description> {
+fn better_threshold(fitted: &Description, setup: &Setup, data: &Measured) -> Option<Scan> {
     let run = replay(fitted, data, &setup.objective.budget).ok()?;
     let own = setup
         .objective
@@ -95,17 +123,20 @@ fn better_threshold(fitted: &Description, setup: &Setup, data: &Measured) -> Opt
         d
     };
     // in parallel, collected in order: the same choice on any number of threads
-    let tried: Vec<(f64, f64)> = (thresholds.par_iter())
-        .map(|&v| {
-            let e = setup.objective.errors(&with_threshold(v), data);
-            (e.map_or(f64::INFINITY, |e| e.current), v)
+    let tried: Vec<(f64, Threshold)> = (thresholds.par_iter())
+        .map(|t| {
+            let e = setup.objective.errors(&with_threshold(t.value), data);
+            (e.map_or(f64::INFINITY, |e| e.current), *t)
         })
         .collect();
     // the first of equal errors
-    let (best, v) = (tried.into_iter())
+    let (best, t) = (tried.into_iter())
         .filter(|(e, _)| e.is_finite())
         .min_by(|a, b| a.0.total_cmp(&b.0))?;
-    (best < own).then(|| with_threshold(v))
+    (best < own).then(|| Scan {
+        description: with_threshold(t.value),
+        interval: t.interval,
+    })
 }
 
 /// |v| before each impact of the replay, sorted (`None` without impacts).
@@ -122,12 +153,20 @@ fn impact_speeds(events: &[crate::sim::Event]) -> Option<Vec<f64>> {
     (!speeds.is_empty()).then_some(speeds)
 }
 
+/// One threshold to try, and the interval of thresholds that replay the
+/// same as it (every impact of the model on the same side of v_ε).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Threshold {
+    value: f64,
+    interval: [f64; 2],
+}
+
 /// The thresholds to try for impacts at `speeds` (sorted): 0 (every impact
 /// bounces: where the model's v_ε is above all of them, γ has no effect),
 /// and between each two neighbouring levels, √(fastest of the slower
 /// level · slowest of the faster), levels being runs of speeds within
 /// [`SAME_LEVEL`] of their neighbour.
-fn candidates(speeds: Vec<f64>) -> Vec<f64> {
+fn candidates(speeds: Vec<f64>) -> Vec<Threshold> {
     // (slowest, fastest) of each level
     let mut levels: Vec<(f64, f64)> = Vec::new();
     for v in speeds {
@@ -136,8 +175,17 @@ fn candidates(speeds: Vec<f64>) -> Vec<f64> {
             _ => levels.push((v, v)),
         }
     }
-    let between = levels.windows(2).map(|w| (w[0].1 * w[1].0).sqrt());
-    std::iter::once(0.0).chain(between).collect()
+    let slowest = levels.first().map_or(0.0, |l| l.0);
+    let between = levels.windows(2).map(|w| Threshold {
+        value: (w[0].1 * w[1].0).sqrt(),
+        interval: [w[0].1, w[1].0],
+    });
+    std::iter::once(Threshold {
+        value: 0.0,
+        interval: [0.0, slowest],
+    })
+    .chain(between)
+    .collect()
 }
 
 #[cfg(test)]
@@ -155,12 +203,18 @@ mod tests {
         speeds.sort_by(f64::total_cmp);
         let tried = candidates(speeds);
         assert_eq!(tried.len(), 4, "{tried:?}");
-        assert_eq!(tried[0], 0.0);
+        assert_eq!(tried[0].value, 0.0);
+        assert_eq!(tried[0].interval, [0.0, 0.98 * 0.108]);
         for (t, w) in tried[1..]
             .iter()
             .zip([[0.108, 0.18], [0.18, 0.3], [0.3, 0.5]])
         {
-            assert!(*t > w[0] && *t < 0.98 * w[1], "{t} between {w:?}");
+            assert!(
+                t.value > w[0] && t.value < 0.98 * w[1],
+                "{t:?} between {w:?}"
+            );
+            // the interval: from the slower level's fastest to the faster's slowest
+            assert_eq!(t.interval, [w[0], 0.98 * w[1]], "{t:?}");
         }
     }
 
@@ -169,7 +223,8 @@ mod tests {
         // a level spread over 5–10 % (a warming coil's cycles): the point
         // tried lies above its fastest speed, not inside it
         let tried = candidates(vec![0.100, 0.104, 0.108, 0.2]);
-        assert!(tried[1] > 0.108 && tried[1] < 0.2, "{tried:?}");
+        assert!(tried[1].value > 0.108 && tried[1].value < 0.2, "{tried:?}");
+        assert_eq!(tried[1].interval, [0.108, 0.2]);
     }
 
     #[test]

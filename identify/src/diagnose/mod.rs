@@ -510,7 +510,14 @@ fn diagnose_step(
                 refit = refit.or(refitted);
                 let own = polished.own;
                 let placed_again = polished.fit.is_some();
-                let named = polished.fit.unwrap_or_else(|| fit.clone());
+                // (the polish holds v_ε where the ranking's scan put it)
+                let named = match polished.fit {
+                    Some(f) => FitReport {
+                        scanned_threshold: f.scanned_threshold.or(fit.scanned_threshold),
+                        ..f
+                    },
+                    None => fit.clone(),
+                };
                 let linearisation = polished.linearisation.as_ref();
                 // The replay over the whole record (on the edges the named
                 // model places) and the propagation (on the fitted part; it
@@ -1040,6 +1047,9 @@ pub struct Propagated {
 }
 
 /// One fitted parameter of the named cause's extension.
+/// The key of the bounce threshold, which a scan fits ([`bounce_threshold`]).
+pub(crate) const BOUNCE_THRESHOLD: &str = "mechanics.bounce_threshold";
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct FittedParameter {
     /// Key path in the description (`coil.eddy`).
@@ -1069,7 +1079,8 @@ impl Diagnosis {
             return Vec::new();
         };
         let rel = &fit.sensitivity.relative_std_errors;
-        fit.values
+        let fitted = fit
+            .values
             .iter()
             .enumerate()
             .map(|(j, (path, value))| FittedParameter {
@@ -1080,8 +1091,16 @@ impl Diagnosis {
                     widen * value.abs() * rel.get(j).copied().unwrap_or(f64::INFINITY),
                 ),
                 baseline: crate::params::get(baseline, path).ok(),
-            })
-            .collect()
+            });
+        // v_ε, where the scan after the fit moved it: ± half the interval
+        // of thresholds that replay the same (it has no gradient)
+        let scanned = fit.scanned_threshold.map(|[lo, hi]| FittedParameter {
+            path: BOUNCE_THRESHOLD.to_owned(),
+            value: fit.description.mechanics.bounce_threshold,
+            std_error: 0.5 * (hi - lo),
+            baseline: Some(baseline.mechanics.bounce_threshold),
+        });
+        fitted.chain(scanned).collect()
     }
 }
 

@@ -221,10 +221,16 @@ fn per_cause<'a>(
     (answer.steps.iter())
         .filter(|s| s.cause != Cause::None)
         .map(|step| {
+            // the bounce threshold goes with the cause whose fit scanned it
+            let scanned = |p: &FittedParameter| {
+                p.path == super::BOUNCE_THRESHOLD
+                    && (step.named_fit.as_ref()).is_some_and(|f| f.scanned_threshold.is_some())
+            };
             let own = |p: &&FittedParameter| {
                 p.path != "coil.resistance"
-                    && (step.named_candidate.as_ref())
+                    && ((step.named_candidate.as_ref())
                         .is_some_and(|c| c.params.iter().any(|q| q.path == p.path))
+                        || scanned(p))
             };
             let values: Vec<&FittedParameter> = parameters.iter().filter(own).collect();
             let at_bound = (values.iter())

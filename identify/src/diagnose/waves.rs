@@ -349,6 +349,7 @@ mod tests {
             status: Status::CostConverged,
             best_start: 0,
             sensitivity,
+            scanned_threshold: None,
         }
     }
 
