@@ -172,6 +172,7 @@ fn to_json(
                         "max_bounce_height": o.outcome.highest_bounce,
                         "arrival_time": number(o.outcome.arrival),
                         "late": late(o.outcome.arrival, late_after),
+                        "flagged_late": o.outcome.flagged_late,
                         "calibration": update_json(&o.update, calibration),
                     })
                 })
@@ -234,10 +235,10 @@ fn text(
                 .outcome
                 .impact_velocity
                 .map_or("never reached the stop".into(), |v| format!("{v:+.4e} m/s"));
-            let pushed = if late(o.outcome.arrival, late_after) {
-                " (late: pushed to its stop)"
-            } else {
-                ""
+            let pushed = match (late(o.outcome.arrival, late_after), o.outcome.flagged_late) {
+                (true, _) => " (late: pushed to its stop)",
+                (false, true) => " (on time, but the controller read it short and flagged it late)",
+                (false, false) => "",
             };
             let _ = writeln!(
                 s,

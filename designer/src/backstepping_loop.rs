@@ -108,6 +108,7 @@ pub fn run_backstepping(
             estimates,
             stops: crate::closed_loop::end_stops(plant_description),
             measured: sensing.take_measured(),
+            flagged_late: Vec::new(),
         },
         modes,
         inside,

@@ -84,6 +84,11 @@ pub struct LoopRun {
     /// the voltage and the current measured (with the observer's noise where
     /// one drives the controller): what a firmware's calibration records.
     pub measured: Vec<Measured>,
+    /// Per operation, the controller's own verdict: whether it pushed an
+    /// armature it read neither held at its stop nor within the arrival band
+    /// (`SoftLanding::finished_late`, what a firmware reports). Empty for a
+    /// position hold.
+    pub flagged_late: Vec<bool>,
 }
 
 /// What a firmware reads at one sample.
@@ -384,6 +389,7 @@ pub fn run_spaced_loop(
     )?;
     let (current, z_ref, estimates) =
         (sequencer.sensing).record(&trajectory, &sequencer.z_ref, f64::NAN);
+    let flagged_late = sequencer.plan.iter().map(|c| c.finished_late()).collect();
     Ok(LoopRun {
         trajectory,
         current,
@@ -393,6 +399,7 @@ pub fn run_spaced_loop(
         estimates,
         stops,
         measured: sequencer.sensing.take_measured(),
+        flagged_late,
     })
 }
 
@@ -469,6 +476,7 @@ pub fn run_hold(
         estimates,
         stops: end_stops(plant_description),
         measured: sensing.take_measured(),
+        flagged_late: Vec::new(),
     })
 }
 
@@ -694,6 +702,9 @@ pub struct OperationOutcome {
     /// the samples, between an impact there that bounced and the next
     /// impact or stick there (or the operation's end); 0 without a bounce.
     pub highest_bounce: f64,
+    /// The controller's own verdict ([`LoopRun::flagged_late`]): what the
+    /// firmware reports, from the position it reads.
+    pub flagged_late: bool,
 }
 
 impl LoopRun {
@@ -701,7 +712,8 @@ impl LoopRun {
     pub fn outcomes(&self, takeoff: f64, landing: f64) -> Vec<OperationOutcome> {
         self.operations
             .iter()
-            .map(|&(operation, start)| {
+            .enumerate()
+            .map(|(k, &(operation, start))| {
                 let end = start + self.operation_length;
                 let (impact_velocity, bounces) =
                     impacts(&self.trajectory, operation, start + takeoff, end);
@@ -722,6 +734,7 @@ impl LoopRun {
                     rmse_z: (n > 0).then(|| (sum / n as f64).sqrt()),
                     bounces,
                     highest_bounce,
+                    flagged_late: self.flagged_late.get(k).copied().unwrap_or(false),
                 }
             })
             .collect()

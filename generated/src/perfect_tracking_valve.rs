@@ -280,6 +280,12 @@ pub mod f32 {
     /// flagged late. The motion time t_f − t₀: a slow landing is not pushed.
     pub const ARRIVAL_MARGIN: f32 = 0.005;
 
+    /// Distance [m] to the end stop within which the armature read at t_f + ARRIVAL_MARGIN
+    /// had arrived in time (not flagged late, though pushed): LANDED_BAND where the law reads
+    /// the position; where it reads an estimate, which creeps onto its clamp, the largest of
+    /// LANDED_BAND, the standoff and 1 % of the stroke.
+    pub const ARRIVAL_BAND: f32 = 1e-12;
+
     /// Reference of the closing motion z_m on [t₀, t_f] [PT 51]: one row
     /// [t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;
     /// a(τ) = c0 + c1·τ + c2·τ² + c3·τ³ with τ = t − t_k, v and z its integrals.
@@ -401,6 +407,7 @@ pub mod f32 {
                 creep: CREEP,
                 creep_max: CREEP_MAX,
                 arrival_margin: ARRIVAL_MARGIN,
+                arrival_band: ARRIVAL_BAND,
             }
         }
 
@@ -496,6 +503,12 @@ pub mod f64 {
     /// there (closing: u_max; opening: the flux quenched, then 0 V) and the operation is
     /// flagged late. The motion time t_f − t₀: a slow landing is not pushed.
     pub const ARRIVAL_MARGIN: f64 = 0.005;
+
+    /// Distance [m] to the end stop within which the armature read at t_f + ARRIVAL_MARGIN
+    /// had arrived in time (not flagged late, though pushed): LANDED_BAND where the law reads
+    /// the position; where it reads an estimate, which creeps onto its clamp, the largest of
+    /// LANDED_BAND, the standoff and 1 % of the stroke.
+    pub const ARRIVAL_BAND: f64 = 1e-12;
 
     /// Reference of the closing motion z_m on [t₀, t_f] [PT 51]: one row
     /// [t_k, z_k, v_k, c0, c1, c2, c3] per segment, t_k from the operation's start;
@@ -618,6 +631,7 @@ pub mod f64 {
                 creep: CREEP,
                 creep_max: CREEP_MAX,
                 arrival_margin: ARRIVAL_MARGIN,
+                arrival_band: ARRIVAL_BAND,
             }
         }
 

@@ -84,6 +84,11 @@ pub struct Settings<T> {
     /// `arrival_margin` is driven there ([`finish_stroke`]): no operation
     /// hovers, whatever the model error.
     pub arrival_margin: T,
+    /// [m]: an armature read farther than this from its end stop at t_f +
+    /// `arrival_margin`, and not held there by then, landed late
+    /// ([`arrived`]). At least `landed_band`: a sensorless estimate creeps
+    /// onto its clamp and need not reach the contact band to have arrived.
+    pub arrival_band: T,
 }
 
 /// What every controller module provides: its operations, design values and
@@ -185,6 +190,16 @@ pub fn expert_rule<T: Scalar>(
             Some(saturate(T::ZERO, settings))
         }
         _ => None,
+    }
+}
+
+/// Whether the position read `z` is within `arrival_band` of the end stop:
+/// at t_f + `arrival_margin` it had arrived in time (a NaN has not).
+#[inline]
+pub fn arrived<T: Scalar>(motion: &Motion<T>, settings: &Settings<T>, z: T) -> bool {
+    match motion.landing {
+        Landing::Closing => z <= motion.zf + settings.arrival_band,
+        Landing::Opening => z >= motion.zf - settings.arrival_band,
     }
 }
 
@@ -354,10 +369,10 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
         self.held = false;
     }
 
-    /// Whether the armature was not at its stop (by the position read) at
-    /// t_f + `arrival_margin` and [`finish_stroke`] drove it there: a landing
-    /// later than planned, for the firmware to report (and its calibration
-    /// to learn from).
+    /// Whether the armature was neither held at its stop nor within
+    /// `arrival_band` of it (by the position read) at t_f + `arrival_margin`
+    /// and [`finish_stroke`] drove it there: a landing later than planned,
+    /// for the firmware to report (and its calibration to learn from).
     #[must_use]
     pub const fn finished_late(&self) -> bool {
         self.late
@@ -407,7 +422,7 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
         // or drains the flux the rule would leave to decay (opening), and it
         // does not trust a position estimate that may have lost the armature
         if let Some(u) = finish_stroke(&motion, &settings, time, phi) {
-            self.late |= !self.held && expert_rule(&motion, &settings, z, phi).is_none();
+            self.late |= !self.held && !arrived(&motion, &settings, z);
             return u;
         }
         if let Some(u) = self.hold(time, z, phi) {

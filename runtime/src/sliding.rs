@@ -23,7 +23,9 @@
 //! No model function is evaluated: the law is two comparisons and a
 //! multiplication, with the reference lookup.
 
-use crate::control::{expert_rule, finish_stroke, flux_sign, saturate, ConstPlan, Plan, Tracker};
+use crate::control::{
+    arrived, expert_rule, finish_stroke, flux_sign, saturate, ConstPlan, Plan, Tracker,
+};
 use crate::linalg::Scalar;
 
 /// The surface's constants.
@@ -140,7 +142,7 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
         };
         let landed = expert_rule(&motion, &settings, z, flux);
         if let Some(u) = finish_stroke(&motion, &settings, self.tracker.elapsed(t), phi) {
-            self.late |= landed.is_none();
+            self.late |= landed.is_none() && !arrived(&motion, &settings, z);
             return u;
         }
         // [SM 43]

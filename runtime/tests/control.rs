@@ -47,6 +47,7 @@ macro_rules! toy {
                     creep: 0.5,
                     creep_max: 0.05,
                     arrival_margin: 1.0,
+                    arrival_band: 1e-6,
                 };
 
             impl Plan<$f> for Toy {
@@ -234,6 +235,43 @@ macro_rules! toy {
                 let mut c = Ctl::new(Operation::Closing);
                 assert_eq!(c.step(4.1, 0.0, 0.0, 1.0), 20.0);
                 assert!(!c.finished_late());
+            }
+
+            /// A plan whose arrival band is wider than its contact band (a
+            /// sensorless design: its estimate creeps onto the clamp).
+            #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+            pub struct Estimated;
+
+            impl Plan<$f> for Estimated {
+                type Operation = Operation;
+                fn settings(&self) -> Settings<$f> {
+                    Settings { arrival_band: 0.05, ..SETTINGS }
+                }
+                fn motion(&self, operation: Operation) -> Motion<'_, $f> {
+                    Toy.motion(operation)
+                }
+            }
+
+            impl Law<$f> for Estimated {
+                fn law(&self, x: [$f; 4], r: [$f; 4]) -> $f {
+                    Toy.law(x, r)
+                }
+            }
+
+            #[test]
+            fn a_push_within_the_arrival_band_is_not_late() {
+                // t_f + margin = 4: the estimate 0.01 short of its stop (not
+                // in the contact band) is pushed, and had arrived
+                for (op, z) in [(Operation::Opening, 0.99), (Operation::Closing, 0.01)] {
+                    let mut c = SoftLanding::with(Estimated, op);
+                    c.step(4.1, z, 0.0, 1.0);
+                    assert!(!c.finished_late(), "{op:?} at {z}");
+                    // 0.1 short: late
+                    let mut c = SoftLanding::with(Estimated, op);
+                    let far = if op == Operation::Opening { 0.9 } else { 0.1 };
+                    c.step(4.1, far, 0.0, 1.0);
+                    assert!(c.finished_late(), "{op:?} at {far}");
+                }
             }
 
             #[test]

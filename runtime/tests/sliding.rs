@@ -49,6 +49,7 @@ macro_rules! toy {
                             creep: 0.0,
                             creep_max: 0.0,
                             arrival_margin: 1.0,
+                            arrival_band: 1e-6,
                             }
                         }
                         fn motion(&self, operation: Operation) -> Motion<'_, $f> {

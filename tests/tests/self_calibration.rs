@@ -162,6 +162,43 @@ fn no_operation_hovers_on_plants_within_twenty_per_cent() {
     }
 }
 
+/// The controller's own "late" (what the firmware reports) agrees with the
+/// plant on the design's own valve: every operation lands in time, and none
+/// is flagged, though the filter's estimate creeps onto its clamp at the open
+/// stop and never reaches the 1 pm contact band (before `ARRIVAL_BAND`,
+/// every opening was flagged at t_f + the arrival margin).
+#[test]
+fn an_operation_in_time_is_not_flagged_late() {
+    let (_, d, design) = example();
+    let done = run_runs(
+        &design,
+        None,
+        Some(&d),
+        2,
+        design.controller.as_ref().map_or(5e-5, |c| c.sample_period),
+        Noise::seeded(1),
+        &Default::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let landing = d.trajectory.as_ref().map_or(f64::NAN, |t| t.landing);
+    for run in &done {
+        for o in &run.operations {
+            let arrival = o.outcome.arrival.unwrap_or(f64::INFINITY);
+            assert!(
+                arrival < 2.0 * landing,
+                "run {}: {:?} arrived at {arrival}",
+                run.run,
+                o.outcome.operation
+            );
+            assert!(
+                !o.outcome.flagged_late,
+                "run {}: {:?} flagged late",
+                run.run, o.outcome.operation
+            );
+        }
+    }
+}
+
 /// The update says when the adapted model still does not explain a valve's
 /// current: on a Jiles–Atherton plant (whose remanence the description's
 /// saturating core cannot follow) every update after the first leaves more

@@ -133,6 +133,8 @@ pub fn design_controller(
         // after t_f the creep goes on at the approach's speed, unless set
         creep_speed: (controller.creep_speed).or(trajectory.approach().map(|a| a.speed)),
         landed_band: controller.landed_band,
+        estimated: controller.estimator.is_some(),
+        standoff: trajectory.approach().map_or(0.0, |a| a.standoff),
     };
     ControllerDesign::decide(model, linearization, &spec, operations)
 }

@@ -103,6 +103,15 @@ impl RuntimeController<'_> {
         }
     }
 
+    /// Whether the controller pushed an armature it read neither held at
+    /// its stop nor within the arrival band (`finished_late`).
+    pub fn finished_late(&self) -> bool {
+        match self {
+            RuntimeController::FeedbackLinearization(c) => c.finished_late(),
+            RuntimeController::SlidingMode(c) => c.finished_late(),
+        }
+    }
+
     /// [z_r, v_r, a_r, j_r] at `t`.
     pub fn reference(&mut self, t: f64) -> [f64; 4] {
         match self {
@@ -139,6 +148,7 @@ impl Plan<f64> for RuntimePlan<'_> {
             creep: d.creep,
             creep_max: d.creep_max,
             arrival_margin: d.arrival_margin,
+            arrival_band: d.arrival_band,
         }
     }
 

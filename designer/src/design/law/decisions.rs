@@ -21,6 +21,9 @@ const GUARD_FRACTION: f64 = 1e-3;
 
 /// Fraction of the stroke within which the armature counts as landed.
 const LANDED_FRACTION: f64 = 1e-9;
+/// Fraction of the stroke within which an estimated armature had arrived at
+/// t_f + the arrival margin (the bounce that counts, issue 35).
+const ESTIMATED_ARRIVAL_FRACTION: f64 = 1e-2;
 /// The reference after t_f lies this fraction of the stroke beyond the end stop.
 const PRESS_FRACTION: f64 = 1e-6;
 /// After t_f the reference creeps on beyond the stop by this fraction of the
@@ -124,6 +127,10 @@ pub struct ControllerSpec {
     pub creep_speed: Option<f64>,
     /// `[controller] landed_band` [m]; `None`: 10⁻⁹ of the stroke.
     pub landed_band: Option<f64>,
+    /// The law reads an estimate of the position (`[controller] estimator`).
+    pub estimated: bool,
+    /// δ [m] of `[trajectory] standoff` (0 without one).
+    pub standoff: f64,
 }
 
 /// The designed controller: everything the emitted module states, as numbers.
@@ -156,6 +163,11 @@ pub struct ControllerDesign {
     /// (`reldesign_runtime::control::finish_stroke`): the motion time
     /// t_f − t₀, so that a slow landing is not pushed.
     pub arrival_margin: f64,
+    /// [m]: read farther than this from its stop at t_f + `arrival_margin`
+    /// (and not held there) the armature landed late. `landed_band` where
+    /// the law reads the position; where it reads an estimate, which creeps
+    /// onto its clamp, the largest of it, the standoff and 1 % of the stroke.
+    pub arrival_band: f64,
     /// In the order of `[trajectory].operations`, no operation twice.
     pub operations: Vec<DesignedOperation>,
 }
@@ -176,6 +188,16 @@ impl ControllerDesign {
             Some(speed) => speed / stroke,
             None => CREEP_FRACTION / (spec.landing - spec.takeoff),
         };
+        let landed_band = spec
+            .landed_band
+            .unwrap_or_else(|| round_down_1sig(LANDED_FRACTION * stroke));
+        let arrival_band = if spec.estimated {
+            landed_band
+                .max(spec.standoff)
+                .max(ESTIMATED_ARRIVAL_FRACTION * stroke)
+        } else {
+            landed_band
+        };
         Ok(ControllerDesign {
             linearization,
             law: spec.law,
@@ -185,9 +207,7 @@ impl ControllerDesign {
             takeoff: spec.takeoff,
             landing: spec.landing,
             phi_guard: round_down_1sig(GUARD_FRACTION * phi_min),
-            landed_band: spec
-                .landed_band
-                .unwrap_or_else(|| round_down_1sig(LANDED_FRACTION * stroke)),
+            landed_band,
             press: PRESS_FRACTION,
             creep,
             creep_max: CREEP_MAX_FRACTION,
@@ -195,6 +215,7 @@ impl ControllerDesign {
             // time (a slow but landing approach, e.g. sensorless creeping
             // onto the stop, is left to land)
             arrival_margin: spec.landing - spec.takeoff,
+            arrival_band,
             operations,
         })
     }
