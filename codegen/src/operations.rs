@@ -117,8 +117,8 @@ fn plan_consts(d: &ControllerDesign, float: Float) -> Result<TokenStream, Contro
             ("PRESS", d.press, "After t_f the reference lies PRESS·stroke beyond the end stop: the loop closes\nthe last gap gently and the contact is certain."),
             ("CREEP", d.creep, "After t_f the reference creeps on beyond the stop at CREEP·stroke per second [1/s]:\nwhere the plant differs from the model and a pure hold would hover short of the\nstop, the armature still lands, at about that speed."),
             ("CREEP_MAX", d.creep_max, "The creep stops CREEP_MAX·stroke beyond the end stop."),
-            ("ARRIVAL_MARGIN", d.arrival_margin, "No hover [s]: an armature not at its end stop by t_f + ARRIVAL_MARGIN is driven\nthere (closing: u_max; opening: the flux quenched, then 0 V) and the operation is\nflagged late. The motion time t_f − t₀: a slow landing is not pushed."),
-            ("ARRIVAL_BAND", d.arrival_band, "Distance [m] to the end stop within which the armature read at t_f + ARRIVAL_MARGIN\nhad arrived in time (not flagged late, though pushed): LANDED_BAND where the law reads\nthe position; where it reads an estimate, which creeps onto its clamp, the largest of\nLANDED_BAND, the standoff and 1 % of the stroke."),
+            ("ARRIVAL_MARGIN", d.arrival_margin, "No hover [s]: an armature not at its end stop by t_f + ARRIVAL_MARGIN is driven\nthere (closing: u_max; opening: the flux quenched, then 0 V), and the operation is\nflagged late unless it was then held or read within ARRIVAL_BAND of its stop. The\nmotion time t_f − t₀: a slow landing is not pushed."),
+            ("ARRIVAL_BAND", d.arrival_band, "Distance [m] to the end stop within which the armature read at t_f + ARRIVAL_MARGIN\nhad arrived in time (not flagged late, though pushed): LANDED_BAND where the law reads\nthe position; where it reads an estimate, which creeps onto its clamp, the larger of\nLANDED_BAND and 1 % of the stroke."),
         ],
     )
 }

@@ -118,7 +118,6 @@ fn design(v: &Valve, both: bool) -> ControllerDesign {
         creep_speed: None,
         landed_band: None,
         estimated: false,
-        standoff: 0.0,
     };
     ControllerDesign::decide(&v.model, v.lin.clone(), &spec, operations)
         .unwrap_or_else(|e| panic!("{e}"))

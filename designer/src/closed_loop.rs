@@ -694,7 +694,8 @@ pub struct OperationOutcome {
     /// The time [s from the operation's start] of the first impact (or
     /// arrival at rest) at the end stop after takeoff; `None` with
     /// `impact_velocity`. Later than t_f + the arrival margin, the runtime
-    /// pushed the armature there (`SoftLanding::finished_late`).
+    /// pushed the armature there (the controller's own verdict, from the
+    /// position it reads, is [`OperationOutcome::flagged_late`]).
     pub arrival: Option<f64>,
     /// Impacts at the end stop within the operation that bounced.
     pub bounces: usize,

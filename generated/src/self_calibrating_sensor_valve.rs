@@ -600,14 +600,15 @@ pub mod f32 {
     pub const CREEP_MAX: f32 = 0.05;
 
     /// No hover [s]: an armature not at its end stop by t_f + ARRIVAL_MARGIN is driven
-    /// there (closing: u_max; opening: the flux quenched, then 0 V) and the operation is
-    /// flagged late. The motion time t_f − t₀: a slow landing is not pushed.
+    /// there (closing: u_max; opening: the flux quenched, then 0 V), and the operation is
+    /// flagged late unless it was then held or read within ARRIVAL_BAND of its stop. The
+    /// motion time t_f − t₀: a slow landing is not pushed.
     pub const ARRIVAL_MARGIN: f32 = 0.005;
 
     /// Distance [m] to the end stop within which the armature read at t_f + ARRIVAL_MARGIN
     /// had arrived in time (not flagged late, though pushed): LANDED_BAND where the law reads
-    /// the position; where it reads an estimate, which creeps onto its clamp, the largest of
-    /// LANDED_BAND, the standoff and 1 % of the stroke.
+    /// the position; where it reads an estimate, which creeps onto its clamp, the larger of
+    /// LANDED_BAND and 1 % of the stroke.
     pub const ARRIVAL_BAND: f32 = 1e-12;
 
     /// Reference of the closing motion z_m on [t₀, t_f] [PT 51]: one row
@@ -836,14 +837,15 @@ pub mod f64 {
     pub const CREEP_MAX: f64 = 0.05;
 
     /// No hover [s]: an armature not at its end stop by t_f + ARRIVAL_MARGIN is driven
-    /// there (closing: u_max; opening: the flux quenched, then 0 V) and the operation is
-    /// flagged late. The motion time t_f − t₀: a slow landing is not pushed.
+    /// there (closing: u_max; opening: the flux quenched, then 0 V), and the operation is
+    /// flagged late unless it was then held or read within ARRIVAL_BAND of its stop. The
+    /// motion time t_f − t₀: a slow landing is not pushed.
     pub const ARRIVAL_MARGIN: f64 = 0.005;
 
     /// Distance [m] to the end stop within which the armature read at t_f + ARRIVAL_MARGIN
     /// had arrived in time (not flagged late, though pushed): LANDED_BAND where the law reads
-    /// the position; where it reads an estimate, which creeps onto its clamp, the largest of
-    /// LANDED_BAND, the standoff and 1 % of the stroke.
+    /// the position; where it reads an estimate, which creeps onto its clamp, the larger of
+    /// LANDED_BAND and 1 % of the stroke.
     pub const ARRIVAL_BAND: f64 = 1e-12;
 
     /// Reference of the closing motion z_m on [t₀, t_f] [PT 51]: one row

@@ -172,7 +172,8 @@ pub struct FitReport {
     /// Where a scan after the fit moved the bounce threshold v_ε
     /// (`diagnose::bounce_threshold`, which has no gradient): the interval
     /// of v_ε whose replay is the same as the one chosen (between two
-    /// levels of the model's impact speeds). `None` otherwise.
+    /// levels of the impact speeds of the model the scan started from).
+    /// `None` otherwise.
     pub scanned_threshold: Option<[f64; 2]>,
 }
 

@@ -21,7 +21,8 @@
 //!   held armature back to the law, sample by sample, at ±u_max);
 //! - no hover: after t_f + `arrival_margin` an armature not yet at its end
 //!   stop is driven there ([`finish_stroke`]), and the operation is flagged
-//!   late ([`SoftLanding::finished_late`]);
+//!   late ([`SoftLanding::finished_late`]) where it was then neither held nor
+//!   read within `arrival_band` of its stop;
 //! - guard at φ → 0: where φ ≤ `phi_guard` the law is not evaluated and
 //!   u = u_max drives the flux into D₀⁺ = {φ > 0} ([`guarded_law`]);
 //! - every output is saturated to [u_min, u_max] (NaN → the bound nearest 0,
@@ -193,13 +194,19 @@ pub fn expert_rule<T: Scalar>(
     }
 }
 
-/// Whether the position read `z` is within `arrival_band` of the end stop:
-/// at t_f + `arrival_margin` it had arrived in time (a NaN has not).
+/// Whether the position read `z` is within `arrival_band` (and never less
+/// than `landed_band`) of the end stop: at t_f + `arrival_margin` it had
+/// arrived in time (a NaN has not).
 #[inline]
 pub fn arrived<T: Scalar>(motion: &Motion<T>, settings: &Settings<T>, z: T) -> bool {
+    let band = if settings.arrival_band > settings.landed_band {
+        settings.arrival_band
+    } else {
+        settings.landed_band
+    };
     match motion.landing {
-        Landing::Closing => z <= motion.zf + settings.arrival_band,
-        Landing::Opening => z >= motion.zf - settings.arrival_band,
+        Landing::Closing => z <= motion.zf + band,
+        Landing::Opening => z >= motion.zf - band,
     }
 }
 
@@ -329,7 +336,10 @@ impl<O: Copy, T: Scalar + From<u8>> Tracker<O, T> {
 pub struct SoftLanding<L: Law<T>, T> {
     law: L,
     tracker: Tracker<L::Operation, T>,
-    /// [`finish_stroke`] drove this operation.
+    /// [`finish_stroke`] drove this operation …
+    pushed: bool,
+    /// … and at its first sample the armature was neither held nor read
+    /// within the arrival band.
     late: bool,
     /// The expert rule has held the armature at its stop after t_f: it
     /// holds it for the rest of the operation.
@@ -351,6 +361,7 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
         SoftLanding {
             law,
             tracker: Tracker::new(operation),
+            pushed: false,
             late: false,
             held: false,
         }
@@ -365,14 +376,16 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
     /// Starts the operation at `t_start` [s]: reference times count from here.
     pub fn start(&mut self, t_start: T) {
         self.tracker.start(t_start);
+        self.pushed = false;
         self.late = false;
         self.held = false;
     }
 
-    /// Whether the armature was neither held at its stop nor within
-    /// `arrival_band` of it (by the position read) at t_f + `arrival_margin`
-    /// and [`finish_stroke`] drove it there: a landing later than planned,
-    /// for the firmware to report (and its calibration to learn from).
+    /// Whether, when [`finish_stroke`] took over at t_f + `arrival_margin`,
+    /// the armature was neither held at its stop nor read within
+    /// `arrival_band` of it: a landing later than planned, for the firmware
+    /// to report (and its calibration to learn from). Decided once, at the
+    /// push's first sample.
     #[must_use]
     pub const fn finished_late(&self) -> bool {
         self.late
@@ -422,7 +435,10 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
         // or drains the flux the rule would leave to decay (opening), and it
         // does not trust a position estimate that may have lost the armature
         if let Some(u) = finish_stroke(&motion, &settings, time, phi) {
-            self.late |= !self.held && !arrived(&motion, &settings, z);
+            if !self.pushed {
+                self.pushed = true;
+                self.late = !self.held && !arrived(&motion, &settings, z);
+            }
             return u;
         }
         if let Some(u) = self.hold(time, z, phi) {

@@ -75,7 +75,10 @@ pub fn switching_sign<T: Scalar>(s: T, at_z_min: bool) -> Option<T> {
 pub struct SlidingMode<S: Surface<T>, T> {
     plan: S,
     tracker: Tracker<S::Operation, T>,
-    /// [`finish_stroke`] drove this operation.
+    /// [`finish_stroke`] drove this operation …
+    pushed: bool,
+    /// … and at its first sample the armature was neither at its stop (the
+    /// expert rule's band) nor read within the arrival band.
     late: bool,
 }
 
@@ -94,6 +97,7 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
         SlidingMode {
             plan,
             tracker: Tracker::new(operation),
+            pushed: false,
             late: false,
         }
     }
@@ -101,11 +105,14 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
     /// Starts the operation at `t_start` [s]: reference times count from here.
     pub fn start(&mut self, t_start: T) {
         self.tracker.start(t_start);
+        self.pushed = false;
         self.late = false;
     }
 
-    /// Whether [`finish_stroke`] drove the armature to its stop: a landing
-    /// later than planned.
+    /// Whether, when [`finish_stroke`] took over at t_f + `arrival_margin`,
+    /// the armature was neither at its stop nor read within `arrival_band`
+    /// of it: a landing later than planned. Decided once, at the push's
+    /// first sample.
     #[must_use]
     pub const fn finished_late(&self) -> bool {
         self.late
@@ -142,7 +149,10 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
         };
         let landed = expert_rule(&motion, &settings, z, flux);
         if let Some(u) = finish_stroke(&motion, &settings, self.tracker.elapsed(t), phi) {
-            self.late |= landed.is_none() && !arrived(&motion, &settings, z);
+            if !self.pushed {
+                self.pushed = true;
+                self.late = landed.is_none() && !arrived(&motion, &settings, z);
+            }
             return u;
         }
         // [SM 43]

@@ -266,12 +266,22 @@ macro_rules! toy {
                     let mut c = SoftLanding::with(Estimated, op);
                     c.step(4.1, z, 0.0, 1.0);
                     assert!(!c.finished_late(), "{op:?} at {z}");
-                    // 0.1 short: late
+                    // 0.1 short: late, and still late once read at the stop
                     let mut c = SoftLanding::with(Estimated, op);
                     let far = if op == Operation::Opening { 0.9 } else { 0.1 };
                     c.step(4.1, far, 0.0, 1.0);
+                    c.step(4.2, Toy.motion(op).zf, 0.0, 1.0);
                     assert!(c.finished_late(), "{op:?} at {far}");
+                    // within the band at the push: a later read far away does not make it late
+                    let mut c = SoftLanding::with(Estimated, op);
+                    c.step(4.1, z, 0.0, 1.0);
+                    c.step(4.2, far, 0.0, 1.0);
+                    assert!(!c.finished_late(), "{op:?} at {z}, then {far}");
                 }
+                // a band narrower than the contact band counts as the contact band
+                let narrow = Settings { arrival_band: 0.0, ..SETTINGS };
+                let closing = Toy.motion(Operation::Closing);
+                assert!(reldesign_runtime::control::arrived(&closing, &narrow, 1e-7));
             }
 
             #[test]

@@ -135,6 +135,26 @@ macro_rules! toy {
             }
 
             #[test]
+            fn late_is_decided_at_the_push_s_first_sample() {
+                // t_f + margin = 4: short of the stop then → late, whatever follows
+                let mut c = Ctl::new(Operation::Closing);
+                c.step(4.1, 0.5, 0.0, 0.0, 1e-5);
+                c.step(4.2, 0.0, 0.0, 0.0, 1e-5);
+                assert!(c.finished_late());
+                // at its stop then → not late, though a bounce reads it away later
+                let mut c = Ctl::new(Operation::Closing);
+                c.step(4.1, 0.0, 0.0, 0.0, 1e-5);
+                c.step(4.2, 0.5, 0.0, 0.0, 1e-5);
+                assert!(!c.finished_late());
+                // a NaN position has not arrived; a new operation starts on time
+                let mut c = Ctl::new(Operation::Opening);
+                c.step(4.1, $f::NAN, 0.0, 0.0, 1e-5);
+                assert!(c.finished_late());
+                c.start(10.0);
+                assert!(!c.finished_late());
+            }
+
+            #[test]
             fn a_non_negative_current_is_never_driven_below_zero() {
                 let mut c = SlidingMode::<Unipolar, $f>::new(Operation::Opening);
                 let r = c.clone().reference(1.5);

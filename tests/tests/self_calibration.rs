@@ -180,12 +180,16 @@ fn an_operation_in_time_is_not_flagged_late() {
         &Default::default(),
     )
     .unwrap_or_else(|e| panic!("{e}"));
-    let landing = d.trajectory.as_ref().map_or(f64::NAN, |t| t.landing);
+    // the plant's verdict: on its stop by t_f + the arrival margin (t_f − t₀)
+    let late_after = d
+        .trajectory
+        .as_ref()
+        .map_or(f64::NAN, |t| 2.0 * t.landing - t.takeoff);
     for run in &done {
         for o in &run.operations {
             let arrival = o.outcome.arrival.unwrap_or(f64::INFINITY);
             assert!(
-                arrival < 2.0 * landing,
+                arrival <= late_after,
                 "run {}: {:?} arrived at {arrival}",
                 run.run,
                 o.outcome.operation
@@ -218,9 +222,6 @@ fn the_update_flags_a_valve_its_model_cannot_explain() {
             updates.len() >= 2 && updates.iter().all(|&f| f == hysteretic),
             "plant {seed} (hysteretic: {hysteretic}): unexplained after runs 1–4 {flags:?}"
         );
-        if hysteretic {
-            assert!(in_a_row(&flags) >= 2, "{flags:?}");
-        }
     }
 }
 

@@ -134,7 +134,6 @@ pub fn design_controller(
         creep_speed: (controller.creep_speed).or(trajectory.approach().map(|a| a.speed)),
         landed_band: controller.landed_band,
         estimated: controller.estimator.is_some(),
-        standoff: trajectory.approach().map_or(0.0, |a| a.standoff),
     };
     ControllerDesign::decide(model, linearization, &spec, operations)
 }

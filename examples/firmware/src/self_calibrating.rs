@@ -118,8 +118,9 @@ impl SelfCalibratingValve {
         self.calibration.unexplained >= 3
     }
 
-    /// Whether the operation needed the runtime's push to reach its stop
-    /// (it landed later than planned).
+    /// Whether the operation landed later than planned: at t_f +
+    /// `ARRIVAL_MARGIN` the runtime pushed an armature whose estimate was
+    /// neither held at its stop nor within `ARRIVAL_BAND` of it.
     #[must_use]
     pub fn finished_late(&self) -> bool {
         self.controller.finished_late()

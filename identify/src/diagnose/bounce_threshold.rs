@@ -85,12 +85,26 @@ pub(super) fn scanned(
             refit.simulations += report.simulations;
             measured(refit)
         });
-    // the fitted values with the scanned threshold (the fit's cost, an
-    // upper bound of its own, kept)
-    let held = measured(FitReport {
-        description: scan.description.clone(),
-        ..report.clone()
-    });
+    // the fitted values with the scanned threshold: its errors and cost
+    // replayed (the cost is a give-up bar downstream), its sensitivity the
+    // fit's at the threshold before
+    let held = replay(&scan.description, data, &setup.objective.budget)
+        .ok()
+        .map(|run| {
+            let d = &scan.description;
+            let out = outputs(d, &run);
+            let errors = setup.objective.errors_of(d, &out);
+            let residuals = setup.objective.residuals_of(d, &out);
+            FitReport {
+                description: d.clone(),
+                wnrmse_current: errors.current,
+                wnrmse_flux: errors.flux,
+                nrmse_position: errors.position,
+                cost: residuals.iter().map(|r| r * r).sum(),
+                scanned_threshold: Some(scan.interval),
+                ..report.clone()
+            }
+        });
     let best = [refit, held]
         .into_iter()
         .flatten()
@@ -102,7 +116,8 @@ pub(super) fn scanned(
 }
 
 /// A bounce threshold the scan chose: the fitted description with it, and
-/// the interval of thresholds that give the same replay.
+/// the interval of thresholds that give the same replay of that description
+/// (a refit from it may move its impacts a little).
 struct Scan {
     description: Description,
     interval: [f64; 2],

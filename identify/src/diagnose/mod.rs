@@ -1046,10 +1046,10 @@ pub struct Propagated {
     pub current: Option<Vec<f64>>,
 }
 
-/// One fitted parameter of the named cause's extension.
 /// The key of the bounce threshold, which a scan fits ([`bounce_threshold`]).
 pub(crate) const BOUNCE_THRESHOLD: &str = "mechanics.bounce_threshold";
 
+/// One fitted parameter of the named cause's extension.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FittedParameter {
     /// Key path in the description (`coil.eddy`).

@@ -221,7 +221,8 @@ fn per_cause<'a>(
     (answer.steps.iter())
         .filter(|s| s.cause != Cause::None)
         .map(|step| {
-            // the bounce threshold goes with the cause whose fit scanned it
+            // the bounce threshold goes with every cause whose fit scanned it,
+            // at the last step's value (a later step's replaces an earlier's)
             let scanned = |p: &FittedParameter| {
                 p.path == super::BOUNCE_THRESHOLD
                     && (step.named_fit.as_ref()).is_some_and(|f| f.scanned_threshold.is_some())

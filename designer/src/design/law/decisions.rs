@@ -129,8 +129,6 @@ pub struct ControllerSpec {
     pub landed_band: Option<f64>,
     /// The law reads an estimate of the position (`[controller] estimator`).
     pub estimated: bool,
-    /// δ [m] of `[trajectory] standoff` (0 without one).
-    pub standoff: f64,
 }
 
 /// The designed controller: everything the emitted module states, as numbers.
@@ -166,7 +164,8 @@ pub struct ControllerDesign {
     /// [m]: read farther than this from its stop at t_f + `arrival_margin`
     /// (and not held there) the armature landed late. `landed_band` where
     /// the law reads the position; where it reads an estimate, which creeps
-    /// onto its clamp, the largest of it, the standoff and 1 % of the stroke.
+    /// onto its clamp, the larger of it and 1 % of the stroke (below a
+    /// standoff: an estimate hovering where the approach starts is late).
     pub arrival_band: f64,
     /// In the order of `[trajectory].operations`, no operation twice.
     pub operations: Vec<DesignedOperation>,
@@ -192,9 +191,7 @@ impl ControllerDesign {
             .landed_band
             .unwrap_or_else(|| round_down_1sig(LANDED_FRACTION * stroke));
         let arrival_band = if spec.estimated {
-            landed_band
-                .max(spec.standoff)
-                .max(ESTIMATED_ARRIVAL_FRACTION * stroke)
+            landed_band.max(ESTIMATED_ARRIVAL_FRACTION * stroke)
         } else {
             landed_band
         };
