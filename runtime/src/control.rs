@@ -336,11 +336,9 @@ impl<O: Copy, T: Scalar + From<u8>> Tracker<O, T> {
 pub struct SoftLanding<L: Law<T>, T> {
     law: L,
     tracker: Tracker<L::Operation, T>,
-    /// [`finish_stroke`] drove this operation …
-    pushed: bool,
-    /// … and at its first sample the armature was neither held nor read
-    /// within the arrival band.
-    late: bool,
+    /// Once [`finish_stroke`] drives this operation: whether at its first
+    /// sample the armature was neither held nor read within the arrival band.
+    late: Option<bool>,
     /// The expert rule has held the armature at its stop after t_f: it
     /// holds it for the rest of the operation.
     held: bool,
@@ -361,8 +359,7 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
         SoftLanding {
             law,
             tracker: Tracker::new(operation),
-            pushed: false,
-            late: false,
+            late: None,
             held: false,
         }
     }
@@ -376,8 +373,7 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
     /// Starts the operation at `t_start` [s]: reference times count from here.
     pub fn start(&mut self, t_start: T) {
         self.tracker.start(t_start);
-        self.pushed = false;
-        self.late = false;
+        self.late = None;
         self.held = false;
     }
 
@@ -388,7 +384,7 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
     /// push's first sample.
     #[must_use]
     pub const fn finished_late(&self) -> bool {
-        self.late
+        matches!(self.late, Some(true))
     }
 
     /// The operation this controller runs.
@@ -435,10 +431,8 @@ impl<L: Law<T>, T: Scalar + From<u8>> SoftLanding<L, T> {
         // or drains the flux the rule would leave to decay (opening), and it
         // does not trust a position estimate that may have lost the armature
         if let Some(u) = finish_stroke(&motion, &settings, time, phi) {
-            if !self.pushed {
-                self.pushed = true;
-                self.late = !self.held && !arrived(&motion, &settings, z);
-            }
+            let held = self.held;
+            (self.late).get_or_insert_with(|| !held && !arrived(&motion, &settings, z));
             return u;
         }
         if let Some(u) = self.hold(time, z, phi) {

@@ -75,11 +75,10 @@ pub fn switching_sign<T: Scalar>(s: T, at_z_min: bool) -> Option<T> {
 pub struct SlidingMode<S: Surface<T>, T> {
     plan: S,
     tracker: Tracker<S::Operation, T>,
-    /// [`finish_stroke`] drove this operation …
-    pushed: bool,
-    /// … and at its first sample the armature was neither at its stop (the
-    /// expert rule's band) nor read within the arrival band.
-    late: bool,
+    /// Once [`finish_stroke`] drives this operation: whether at its first
+    /// sample the armature was neither at its stop (the expert rule's band)
+    /// nor read within the arrival band.
+    late: Option<bool>,
 }
 
 impl<S: Surface<T> + ConstPlan, T: Scalar + From<u8>> SlidingMode<S, T> {
@@ -97,16 +96,14 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
         SlidingMode {
             plan,
             tracker: Tracker::new(operation),
-            pushed: false,
-            late: false,
+            late: None,
         }
     }
 
     /// Starts the operation at `t_start` [s]: reference times count from here.
     pub fn start(&mut self, t_start: T) {
         self.tracker.start(t_start);
-        self.pushed = false;
-        self.late = false;
+        self.late = None;
     }
 
     /// Whether, when [`finish_stroke`] took over at t_f + `arrival_margin`,
@@ -115,7 +112,7 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
     /// first sample.
     #[must_use]
     pub const fn finished_late(&self) -> bool {
-        self.late
+        matches!(self.late, Some(true))
     }
 
     /// The operation this controller runs.
@@ -149,10 +146,7 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
         };
         let landed = expert_rule(&motion, &settings, z, flux);
         if let Some(u) = finish_stroke(&motion, &settings, self.tracker.elapsed(t), phi) {
-            if !self.pushed {
-                self.pushed = true;
-                self.late = landed.is_none() && !arrived(&motion, &settings, z);
-            }
+            (self.late).get_or_insert_with(|| landed.is_none() && !arrived(&motion, &settings, z));
             return u;
         }
         // [SM 43]

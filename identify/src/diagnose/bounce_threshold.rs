@@ -65,13 +65,20 @@ pub(super) fn scanned(
     let Some(scan) = better_threshold(&report.description, &setup, data) else {
         return (report, false);
     };
+    // a report with its errors replayed, the scan stated, and the replay's
+    // cost (the sum of its squared residuals)
     let measured = |mut r: FitReport| {
-        let errors = setup.objective.errors(&r.description, data).ok()?;
+        let d = &r.description;
+        let out = outputs(d, &replay(d, data, &setup.objective.budget).ok()?);
+        let errors = setup.objective.errors_of(d, &out);
+        let cost = (setup.objective.residuals_of(d, &out).iter())
+            .map(|e| e * e)
+            .sum();
         r.wnrmse_current = errors.current;
         r.wnrmse_flux = errors.flux;
         r.nrmse_position = errors.position;
         r.scanned_threshold = Some(scan.interval);
-        Some(r)
+        Some((r, cost))
     };
     let once = FitOptions {
         starts: 1,
@@ -83,28 +90,16 @@ pub(super) fn scanned(
         .and_then(|mut refit| {
             refit.iterations += report.iterations;
             refit.simulations += report.simulations;
-            measured(refit)
+            measured(refit).map(|(refit, _)| refit)
         });
-    // the fitted values with the scanned threshold: its errors and cost
-    // replayed (the cost is a give-up bar downstream), its sensitivity the
-    // fit's at the threshold before
-    let held = replay(&scan.description, data, &setup.objective.budget)
-        .ok()
-        .map(|run| {
-            let d = &scan.description;
-            let out = outputs(d, &run);
-            let errors = setup.objective.errors_of(d, &out);
-            let residuals = setup.objective.residuals_of(d, &out);
-            FitReport {
-                description: d.clone(),
-                wnrmse_current: errors.current,
-                wnrmse_flux: errors.flux,
-                nrmse_position: errors.position,
-                cost: residuals.iter().map(|r| r * r).sum(),
-                scanned_threshold: Some(scan.interval),
-                ..report.clone()
-            }
-        });
+    // the fitted values with the scanned threshold: its cost replayed too
+    // (a give-up bar downstream), its sensitivity the fit's at the
+    // threshold before
+    let held = measured(FitReport {
+        description: scan.description.clone(),
+        ..report.clone()
+    })
+    .map(|(held, cost)| FitReport { cost, ..held });
     let best = [refit, held]
         .into_iter()
         .flatten()
@@ -152,6 +147,16 @@ fn better_threshold(fitted: &Description, setup: &Setup, data: &Measured) -> Opt
         description: with_threshold(t.value),
         interval: t.interval,
     })
+}
+
+/// `fit`, stating the scan of `earlier` (the same step's fit before a
+/// polish or a joint fit, which hold v_ε where the scan put it) where its
+/// own fit scanned nothing.
+pub(super) fn keeping_scan(fit: FitReport, earlier: Option<&FitReport>) -> FitReport {
+    FitReport {
+        scanned_threshold: (fit.scanned_threshold).or(earlier.and_then(|f| f.scanned_threshold)),
+        ..fit
+    }
 }
 
 /// |v| before each impact of the replay, sorted (`None` without impacts).

@@ -11,7 +11,7 @@
 
 use super::candidate::Candidate;
 use super::{polish, Cause, Diagnosis, Gain};
-use crate::{FitOptions, FitParam, FitReport, Measured};
+use crate::{FitOptions, FitParam, Measured};
 
 /// Refits every named cause of `steps` jointly and, where that lowers the
 /// error on the whole record, makes it the last step's model: its fit (with
@@ -100,12 +100,10 @@ pub(super) fn refit(
     last.fitted_samples = k;
     last.extended = fit.description.clone();
     last.extended_replay = replay;
-    // the joint fit holds v_ε where the step's scan put it
-    let scanned = (last.named_fit.as_ref()).and_then(|f| f.scanned_threshold);
-    last.named_fit = Some(FitReport {
-        scanned_threshold: fit.scanned_threshold.or(scanned),
-        ..fit
-    });
+    last.named_fit = Some(super::bounce_threshold::keeping_scan(
+        fit,
+        last.named_fit.as_ref(),
+    ));
     true
 }
 

@@ -510,12 +510,8 @@ fn diagnose_step(
                 refit = refit.or(refitted);
                 let own = polished.own;
                 let placed_again = polished.fit.is_some();
-                // (the polish holds v_ε where the ranking's scan put it)
                 let named = match polished.fit {
-                    Some(f) => FitReport {
-                        scanned_threshold: f.scanned_threshold.or(fit.scanned_threshold),
-                        ..f
-                    },
+                    Some(f) => bounce_threshold::keeping_scan(f, Some(fit)),
                     None => fit.clone(),
                 };
                 let linearisation = polished.linearisation.as_ref();
