@@ -46,6 +46,11 @@ pub fn run(args: &Args) -> Result<(), Report> {
                 eprintln!("{}", calibration_report(&design, c.sample_period));
             }
         }
+        match designer::precision::report(&design) {
+            Ok(Some(text)) => eprintln!("{text}"),
+            Ok(None) => {}
+            Err(e) => eprintln!("sensorless precision: not stated ({e})"),
+        }
     }
     let report = args
         .report_json

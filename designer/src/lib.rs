@@ -10,6 +10,7 @@
 //! - [`description`]: the validated actuator description (`valve.toml`).
 //! - [`model`]: the actuator's state-space model, built symbolically.
 //! - [`observe`]: observers (SEMERA, integral estimator, EKF, UKF).
+//! - [`precision`]: how well a sensorless design knows its armature at each approach.
 //! - [`random`]: seeded SplitMix64 draws (Monte Carlo, simulated noise).
 //! - [`record`]: recorded signals in the measured-data CSV format.
 //! - [`replay`]: an input replayed through the hybrid model (`simulate`).
@@ -25,6 +26,7 @@ pub mod design_json;
 pub mod model;
 pub mod observe;
 mod parallel;
+pub mod precision;
 pub mod random;
 pub mod record;
 pub mod replay;

@@ -1,0 +1,186 @@
+//! How well a sensorless design knows its armature when each approach starts,
+//! and how hard that lets it meet the stop.
+//!
+//! The filter runs on the measurements of the design's noise-free closed loop
+//! on its own model; its covariance there is what the measurement noise of
+//! `[observer]` leaves (it predicts the spread of z − ẑ over noise draws:
+//! `tests/tests/estimate_precision.rs`). A flux σ_φ off moves the armature's
+//! acceleration by |∂a/∂φ|·σ_φ (at constant z, the plant's own right-hand
+//! side), and over the standoff δ that meets the stop at
+//! v ≈ √(v_c² + 2·|∂a/∂φ|·σ_φ·δ): the law keeps the estimate at v_c, not the
+//! armature. Only the measurement noise is in it; a plant that differs from
+//! the description adds its own error.
+
+use crate::closed_loop::{run_loop, LoopError, LoopRun, Noise};
+use crate::description::{Approach, Estimator, Operation};
+use crate::design::Design;
+use crate::model::{Model, ModelPlant};
+use crate::observe::discrete::{DiscreteModel, MAX_DIM as FILTER_DIM};
+use crate::observe::{ekf::Ekf, ukf::Ukf};
+use crate::sim::{Plant, State, MAX_DIM};
+
+/// One operation's approach, as its sensorless design sees it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ApproachPrecision {
+    pub operation: Operation,
+    /// When the approach starts [s after the operation's start]: t_f − 5·δ/(4·v_c).
+    pub at: f64,
+    /// The filter's standard deviation of z there [m].
+    pub sigma_z: f64,
+    /// The filter's standard deviation of φ there [Wb], and φ itself.
+    pub sigma_phi: f64,
+    pub phi: f64,
+    /// |∂a/∂φ| at constant z there [m/s²/Wb].
+    pub accel_per_flux: f64,
+    pub approach: Approach,
+    /// √(v_c² + 2·|∂a/∂φ|·σ_φ·δ) [m/s].
+    pub impact: f64,
+}
+
+/// Per designed operation, where the controller reads an estimate and the
+/// trajectory has an approach; empty otherwise.
+pub fn at_approaches(design: &Design) -> Result<Vec<ApproachPrecision>, LoopError> {
+    let (Some(c), Some(t), Some(discrete)) = (
+        &design.controller,
+        &design.description.trajectory,
+        &design.kalman,
+    ) else {
+        return Ok(Vec::new());
+    };
+    let estimator = (design.description.controller.as_ref()).and_then(|c| c.estimator);
+    let (Some(estimator), Some(approach)) = (estimator, t.approach()) else {
+        return Ok(Vec::new());
+    };
+    let quiet = Noise {
+        seed: 0,
+        sigma: Some([0.0, 0.0]),
+    };
+    let run = run_loop(
+        design,
+        None,
+        c.sample_period,
+        None,
+        quiet,
+        &Default::default(),
+    )?;
+    let spread = covariance_along(&run, discrete, estimator);
+    let mut model = Model::build(&design.description);
+    let plant = ModelPlant::new(&mut model);
+    let at = t.landing - approach.duration();
+    let found = run.operations.iter().filter_map(|&(operation, start)| {
+        let k = run.measured.iter().position(|m| m.t >= start + at)?;
+        let j = run
+            .trajectory
+            .t
+            .iter()
+            .position(|&s| s >= run.measured[k].t)?;
+        let x = run.trajectory.x[j];
+        let (sigma_z, sigma_phi) = spread[k];
+        let accel_per_flux = accel_per_flux(&plant, &x);
+        let impact =
+            (approach.speed.powi(2) + 2.0 * accel_per_flux * sigma_phi * approach.standoff).sqrt();
+        Some(ApproachPrecision {
+            operation,
+            at,
+            sigma_z,
+            sigma_phi,
+            phi: x[2],
+            accel_per_flux,
+            approach,
+            impact,
+        })
+    });
+    Ok(found.collect())
+}
+
+/// (σ_z, σ_φ) of a fresh filter fed the run's measured voltage and current,
+/// at every sample.
+fn covariance_along(
+    run: &LoopRun,
+    discrete: &DiscreteModel,
+    estimator: Estimator,
+) -> Vec<(f64, f64)> {
+    let spread =
+        |p: [[f64; FILTER_DIM]; FILTER_DIM]| (p[0][0].max(0.0).sqrt(), p[2][2].max(0.0).sqrt());
+    match estimator {
+        Estimator::Ekf => {
+            let mut f = Ekf::new(discrete);
+            (run.measured.iter())
+                .map(|m| {
+                    f.step(m.voltage, m.current);
+                    spread(f.covariance())
+                })
+                .collect()
+        }
+        _ => {
+            let mut f = Ukf::new(discrete);
+            (run.measured.iter())
+                .map(|m| {
+                    f.step(m.voltage, m.current);
+                    spread(f.covariance())
+                })
+                .collect()
+        }
+    }
+}
+
+/// |∂a/∂φ| at the plant state `x`, at rest, by central differences of the
+/// plant's own right-hand side.
+fn accel_per_flux(plant: &ModelPlant, x: &State) -> f64 {
+    let accel = |phi: f64| {
+        let mut s: State = [0.0; MAX_DIM];
+        s[0] = x[0];
+        s[2] = phi;
+        let mut dx: State = [0.0; MAX_DIM];
+        plant.deriv(0.0, &s, 0.0, &mut dx);
+        dx[1]
+    };
+    let h = 1e-4 * x[2].abs().max(1e-9);
+    ((accel(x[2] + h) - accel(x[2] - h)) / (2.0 * h)).abs()
+}
+
+/// The lines `reldesign build` prints for a sensorless design with an
+/// approach (`None` otherwise), with each first impact against the
+/// uncontrolled switching's on the description.
+pub fn report(design: &Design) -> Result<Option<String>, LoopError> {
+    use std::fmt::Write as _;
+    let found = at_approaches(design)?;
+    let Some(o) = (!found.is_empty())
+        .then_some(())
+        .and(design.description.observer.as_ref())
+    else {
+        return Ok(None);
+    };
+    let switching =
+        crate::closed_loop::switching_baseline(&design.description, None, &Default::default())?;
+    let mut s = format!(
+        "sensorless precision (the filter's covariance along the noise-free loop on the description; σ_v = {:e} V, σ_i = {:e} A):\n",
+        o.voltage_noise, o.current_noise
+    );
+    for p in &found {
+        let versus = (switching.iter())
+            .find(|(op, _)| *op == p.operation)
+            .and_then(|(_, v)| *v)
+            .map_or(String::new(), |v| {
+                format!(", {:.0}× softer than switching", v.abs() / p.impact)
+            });
+        let _ = writeln!(
+            s,
+            "  {}: when the approach starts ({:.4} ms, {:e} m short of the stop) σ_z = {:.3e} m, σ_φ = {:.2} % of {:.4e} Wb; \
+             a flux σ_φ off over the standoff meets the stop at ≈ {:.4e} m/s (v_c = {:e} m/s){versus}",
+            p.operation.name(),
+            p.at * 1e3,
+            p.approach.standoff,
+            p.sigma_z,
+            100.0 * p.sigma_phi / p.phi.abs(),
+            p.phi,
+            p.impact,
+            p.approach.speed,
+        );
+    }
+    s.push_str(
+        "  the measurement noise's share of each first impact; a valve that differs from the description adds its own \
+         (docs/guide/self-calibration.md#what-bounds-the-landings)",
+    );
+    Ok(Some(s))
+}
