@@ -8,7 +8,11 @@
 //!
 //! - [SM 43] at the end stop z_f (within `landed_band`, whenever the armature
 //!   is there, also before t_f: a premature landing is held, not undone):
-//!   closing → u = u_max·sgn φ, opening → u = 0;
+//!   closing → u = u_max·sgn φ, opening → u = 0; once the rule has held the
+//!   armature after t_f it holds it for the rest of the operation, wherever a
+//!   later position says it is (a sensorless estimate flickers in and out of
+//!   the band at its clamp, and each flicker would hand the held armature
+//!   back to the law for a sample at ±u_max);
 //! - otherwise [SM 17] s = ã + (λ₁ + λ₂)·ṽ + λ₁λ₂·z̃ against the reference of
 //!   [`Tracker::reference`] (z₀ at rest before t₀, the table, z_f after t_f),
 //!   and [SM 34] u = u_max·sgn(φ)·sgn*(s) with [SM 35] sgn*(0) = −1 at
@@ -79,6 +83,9 @@ pub struct SlidingMode<S: Surface<T>, T> {
     /// sample the armature was neither at its stop (the expert rule's band)
     /// nor read within the arrival band.
     late: Option<bool>,
+    /// The expert rule has held the armature at its stop after t_f: it holds
+    /// it for the rest of the operation.
+    held: bool,
 }
 
 impl<S: Surface<T> + ConstPlan, T: Scalar + From<u8>> SlidingMode<S, T> {
@@ -97,6 +104,7 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
             plan,
             tracker: Tracker::new(operation),
             late: None,
+            held: false,
         }
     }
 
@@ -104,6 +112,7 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
     pub fn start(&mut self, t_start: T) {
         self.tracker.start(t_start);
         self.late = None;
+        self.held = false;
     }
 
     /// Whether, when [`finish_stroke`] took over at t_f + `arrival_margin`,
@@ -144,8 +153,11 @@ impl<S: Surface<T>, T: Scalar + From<u8>> SlidingMode<S, T> {
         } else {
             flux_sign(phi)
         };
-        let landed = expert_rule(&motion, &settings, z, flux);
-        if let Some(u) = finish_stroke(&motion, &settings, self.tracker.elapsed(t), phi) {
+        let time = self.tracker.elapsed(t);
+        let at_stop = if self.held { motion.zf } else { z };
+        let landed = expert_rule(&motion, &settings, at_stop, flux);
+        self.held = landed.is_some() && time > settings.landing;
+        if let Some(u) = finish_stroke(&motion, &settings, time, phi) {
             (self.late).get_or_insert_with(|| landed.is_none() && !arrived(&motion, &settings, z));
             return u;
         }

@@ -135,6 +135,29 @@ macro_rules! toy {
             }
 
             #[test]
+            fn once_held_after_t_f_the_armature_stays_held_for_the_operation() {
+                // t_f = 3: a position read that leaves the band after the rule
+                // has held (an estimate flickering at its clamp, a bounce)
+                // does not hand the armature back to the law
+                let mut c = Ctl::new(Operation::Closing);
+                assert_eq!(c.step(3.2, 0.0, 0.0, 0.0, 1e-5), 20.0);
+                assert_eq!(c.step(3.3, 0.01, 0.3, 0.0, 1e-5), 20.0);
+                assert_eq!(c.step(3.4, 0.5, 0.3, 0.0, -1e-5), -20.0, "u_max·sgn φ");
+                let mut o = Ctl::new(Operation::Opening);
+                assert_eq!(o.step(3.3, 1.0, 0.0, 0.0, 1e-5), 0.0);
+                assert_eq!(o.step(3.4, 0.9, -0.3, 0.0, 1e-5), 0.0);
+                // before t_f the rule holds only while the armature is there
+                let mut c = Ctl::new(Operation::Closing);
+                assert_eq!(c.step(2.0, 0.0, 0.0, 0.0, 1e-5), 20.0);
+                let r = c.clone().reference(2.1);
+                assert_eq!(c.step(2.1, r[0] - 0.01, r[1], r[2], 1e-5), -20.0);
+                // a new operation is not held
+                o.start(10.0);
+                let r = o.clone().reference(13.5);
+                assert_ne!(o.step(13.5, r[0] - 0.1, r[1], r[2], 1e-5), 0.0);
+            }
+
+            #[test]
             fn late_is_decided_at_the_push_s_first_sample() {
                 // t_f + margin = 4: short of the stop then → late, whatever follows
                 let mut c = Ctl::new(Operation::Closing);
