@@ -11,8 +11,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use designer::closed_loop::{
-    check_sample_period, resample_observer, run_hold, run_loop, HoldOutcome, LoopRun, Noise,
-    OperationOutcome, HOLD_DURATION, SETTLED_FRACTION, SETTLING_WINDOW,
+    check_sample_period, loop_spacing, resample_observer, run_hold, run_spaced_loop, HoldOutcome,
+    LoopRun, Noise, OperationOutcome, HOLD_DURATION, SETTLED_FRACTION, SETTLING_WINDOW,
 };
 use designer::description::{Law, ModelSurface};
 use designer::design::Design;
@@ -42,7 +42,7 @@ pub struct Args {
     /// Sample period T_s [s] (default: controller.sample_period)
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) sample_period: Option<f64>,
-    /// Simulated time [s] (default: every operation once, takeoff + landing each)
+    /// Simulated time [s] (default: every operation once, takeoff + landing each; with an estimator or another --plant, 2·(takeoff + landing) + the motion time each, room for the no-hover push)
     #[arg(long, allow_hyphen_values = true)]
     pub(crate) duration: Option<f64>,
     /// Also draw position and reference, input and current to this SVG file (with
@@ -144,11 +144,12 @@ pub fn run(args: &Args) -> Result<(), Report> {
             &Options::default(),
         )
     } else {
-        run_loop(
+        run_spaced_loop(
             &design,
             plant.as_ref(),
             ts,
             duration,
+            loop_spacing(&design, plant.as_ref()),
             noise,
             &Options::default(),
         )
@@ -167,7 +168,12 @@ pub fn run(args: &Args) -> Result<(), Report> {
         .map_or((0.0, 0.0), |t| (t.takeoff, t.landing));
     print!(
         "{}",
-        summary(&run.outcomes(t.0, t.1), controller.law.name(), ts)
+        summary(
+            &run.outcomes(t.0, t.1),
+            controller.law.name(),
+            ts,
+            designer::closed_loop::late_after(&design)
+        )
     );
     Ok(())
 }
@@ -202,7 +208,7 @@ pub(crate) fn positive(name: &str, x: Option<f64>) -> Result<Option<f64>, Report
     }
 }
 
-fn summary(outcomes: &[OperationOutcome], law: &str, ts: f64) -> String {
+fn summary(outcomes: &[OperationOutcome], law: &str, ts: f64, late_after: f64) -> String {
     let mut s = format!("{law} at T_s = {ts:e} s\n");
     for o in outcomes {
         let impact = o
@@ -210,9 +216,20 @@ fn summary(outcomes: &[OperationOutcome], law: &str, ts: f64) -> String {
             .map_or("never reached the stop".to_string(), |v| {
                 format!("{v:+.4e} m/s")
             });
+        let arrival = o.arrival.map_or(String::new(), |t| {
+            let verdict = match (o.arrived_late(late_after), o.flagged_late) {
+                (true, true) => ", late: pushed to its stop",
+                (true, false) => {
+                    ", late: pushed to its stop, though the controller read it there in time"
+                }
+                (false, true) => ", on time, but the controller read it short and flagged it late",
+                (false, false) => "",
+            };
+            format!(" at {:.4} ms{verdict}", t * 1e3)
+        });
         let _ = writeln!(
             s,
-            "  {:<8} first impact {impact}, RMSE_z {} during the motion, {} bounce(s)",
+            "  {:<8} first impact {impact}{arrival}, RMSE_z {} during the motion, {} bounce(s)",
             o.operation.name(),
             o.rmse_z
                 .map_or("— (no sample)".into(), |r| format!("{r:.3e} m")),

@@ -79,8 +79,7 @@ pub fn run(args: &Args) -> Result<(), Report> {
     }
     crate::atomic::write_all(&files).map_err(fail)?;
     // the runtime pushes an armature not at its stop by t_f + the design's margin
-    let late_after =
-        (design.controller.as_ref()).map_or(f64::INFINITY, |c| c.landing + c.arrival_margin);
+    let late_after = designer::closed_loop::late_after(&design);
     if args.json {
         println!(
             "{}",
@@ -143,10 +142,6 @@ fn update_text(update: &Update, calibration: Option<&CalibrationDesign>) -> Stri
 }
 
 /// Whether an arrival [s from the operation's start] came after the push.
-fn late(arrival: Option<f64>, late_after: f64) -> bool {
-    arrival.is_some_and(|t| t > late_after)
-}
-
 fn to_json(
     runs: &[Run],
     baseline: &[(Operation, Option<f64>)],
@@ -171,7 +166,7 @@ fn to_json(
                         "bounces": o.outcome.bounces,
                         "max_bounce_height": o.outcome.highest_bounce,
                         "arrival_time": number(o.outcome.arrival),
-                        "late": late(o.outcome.arrival, late_after),
+                        "late": o.outcome.arrived_late(late_after),
                         "flagged_late": o.outcome.flagged_late,
                         "calibration": update_json(&o.update, calibration),
                     })
@@ -235,7 +230,7 @@ fn text(
                 .outcome
                 .impact_velocity
                 .map_or("never reached the stop".into(), |v| format!("{v:+.4e} m/s"));
-            let landed_late = late(o.outcome.arrival, late_after);
+            let landed_late = o.outcome.arrived_late(late_after);
             let pushed = match (
                 o.outcome.arrival.is_some(),
                 landed_late,

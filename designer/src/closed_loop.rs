@@ -324,6 +324,29 @@ pub fn run_loop(
     run_spaced_loop(design, plant, sample_period, duration, None, noise, options)
 }
 
+/// The time [s] between two operations' starts in a run-to-run study (and
+/// the window a record covers): twice takeoff + landing and a motion time,
+/// so that an operation the runtime had to finish ([`reldesign_runtime::control::finish_stroke`])
+/// ends before the next one starts.
+pub fn operation_window(t: &crate::description::Trajectory) -> f64 {
+    // the push comes at 2·t_f − t₀; the window leaves as long again
+    2.0 * operation_end(t.takeoff, t.landing) + (t.landing - t.takeoff)
+}
+
+/// The spacing of `reldesign loop`'s operations: [SM 45]'s takeoff + landing
+/// where the controller reads the description's own plant, and the
+/// run-to-run study's window ([`operation_window`]) where a
+/// landing later than t_f is to be expected (the controller reads an
+/// estimate, or the plant is not the description): the runtime pushes an
+/// armature not at its stop by t_f + the arrival margin, and the operation's
+/// window must still hold that push.
+pub fn loop_spacing(design: &Design, plant: Option<&Description>) -> Option<f64> {
+    let estimated = (design.description.controller.as_ref()).is_some_and(|c| c.estimator.is_some());
+    let other_plant = plant.is_some_and(|p| *p != design.description);
+    let t = design.description.trajectory.as_ref()?;
+    (estimated || other_plant).then(|| operation_window(t))
+}
+
 /// [`run_loop`] with the operations `spacing` [s] apart (default: takeoff +
 /// landing, [SM 45]): a run-to-run study leaves a late landing time to end.
 pub fn run_spaced_loop(
@@ -706,6 +729,21 @@ pub struct OperationOutcome {
     /// The controller's own verdict ([`LoopRun::flagged_late`]): what the
     /// firmware reports, from the position it reads.
     pub flagged_late: bool,
+}
+
+impl OperationOutcome {
+    /// The plant's verdict: the armature reached its stop only after
+    /// `late_after` ([`late_after`]), i.e. the runtime pushed it there.
+    pub fn arrived_late(&self, late_after: f64) -> bool {
+        self.arrival.is_some_and(|t| t > late_after)
+    }
+}
+
+/// When the runtime pushes an armature not yet at its stop [s from the
+/// operation's start]: t_f + the design's arrival margin (∞ without a
+/// soft-landing controller).
+pub fn late_after(design: &Design) -> f64 {
+    (design.controller.as_ref()).map_or(f64::INFINITY, |c| c.landing + c.arrival_margin)
 }
 
 impl LoopRun {

@@ -72,6 +72,8 @@ fn region_json(b: &BacksteppingDesign) -> serde_json::Value {
 /// The design figures, for scripts and oracles.
 pub fn report_json(design: &Design) -> String {
     let no_operations = Vec::new();
+    // a loop that cannot run states no precision; the design still reports
+    let precision = crate::precision::at_approaches(design).unwrap_or_default();
     let operations: serde_json::Map<String, serde_json::Value> = design
         .controller
         .as_ref()
@@ -97,6 +99,18 @@ pub fn report_json(design: &Design) -> String {
                     "duration": a.duration(),
                 });
                 map.insert("approach".into(), approach);
+            }
+            let stated = precision.iter().find(|p| p.operation == o.operation);
+            if let (Some(p), Some(map)) = (stated, entry.as_object_mut()) {
+                let precision = serde_json::json!({
+                    "at": p.at,
+                    "sigma_z": p.sigma_z,
+                    "sigma_phi": p.sigma_phi,
+                    "phi": p.phi,
+                    "accel_per_flux": p.accel_per_flux,
+                    "impact": p.impact,
+                });
+                map.insert("sensorless_precision".into(), precision);
             }
             (o.operation.name().to_string(), entry)
         })

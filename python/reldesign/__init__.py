@@ -209,9 +209,12 @@ def loop(
 
     Returns the command line's columns ``t, u, i, z, vz, phi[, Hc], mode,
     z_ref[, z_hat, v_hat, phi_hat[, Hc_hat]]``; ``.attrs["outcomes"]`` holds
-    per operation the first impact velocity, RMSE_z and bounces (or the
-    position hold's settling). The backstepping law's loop is the command
-    line's only.
+    per operation the first impact velocity, RMSE_z, bounces, the highest
+    bounce, its arrival time, ``late`` (the runtime pushed it to its stop
+    after t_f + the arrival margin) and ``flagged_late`` (the controller's
+    own verdict), or the position hold's settling. With an estimator or
+    another ``plant`` each operation's window leaves room for that push. The
+    backstepping law's loop is the command line's only.
     """
     columns, outcomes = _reldesign.closed_loop(
         _actuator(actuator),

@@ -6,8 +6,8 @@
 //! (`designer::closed_loop`) and the same defaults as the command line.
 
 use designer::closed_loop::{
-    check_sample_period, resample_observer, run_hold, run_loop, sweep as sweep_periods,
-    switching_baseline, Noise,
+    check_sample_period, late_after, loop_spacing, resample_observer, run_hold, run_spaced_loop,
+    sweep as sweep_periods, switching_baseline, Noise,
 };
 use designer::description::{Law, ModelSurface};
 use designer::design::Design;
@@ -28,8 +28,9 @@ fn failed(message: impl Into<String>) -> PyErr {
 /// Runs the designed controller in a sampled loop on the model of `plant`
 /// (default: the description itself): `reldesign loop`. Returns the columns
 /// `t, u, i, z, vz, phi[, Hc], mode, z_ref[, z_hat, v_hat, phi_hat[, Hc_hat]]`
-/// as numpy arrays, and per operation its first impact, RMSE_z and bounces
-/// (or the hold's settling).
+/// as numpy arrays, and per operation its first impact, RMSE_z, bounces, the
+/// highest bounce, when it arrived, whether the runtime pushed it there late
+/// and whether the controller flagged it late (or the hold's settling).
 #[pyfunction]
 #[pyo3(signature = (actuator, plant = None, sample_period = None, duration = None, seed = 0, noise = None, initial_field = 0.0))]
 #[allow(clippy::too_many_arguments)]
@@ -86,7 +87,7 @@ fn closed_loop<'py>(
     let timing = (description.trajectory.as_ref()).map_or((0.0, 0.0), |t| (t.takeoff, t.landing));
     let plant = plant.as_ref().map(|p| &p.description);
     let noise = Noise { seed, sigma };
-    let (run, with_field) = py
+    let (run, with_field, late_after) = py
         .allow_threads(|| {
             if !holds {
                 check_sample_period(description, ts).map_err(|e| format!("{file}: {e}"))?;
@@ -103,9 +104,10 @@ fn closed_loop<'py>(
             let run = if holds {
                 run_hold(&design, plant, ts, duration, noise, initial_field, &options)
             } else {
-                run_loop(&design, plant, ts, duration, noise, &options)
+                let spacing = loop_spacing(&design, plant);
+                run_spaced_loop(&design, plant, ts, duration, spacing, noise, &options)
             };
-            run.map(|r| (r, design.model.dim() > 3))
+            run.map(|r| (r, design.model.dim() > 3, late_after(&design)))
                 .map_err(|e| format!("{file}: {e}"))
         })
         .map_err(failed)?;
@@ -162,6 +164,9 @@ fn closed_loop<'py>(
             row.set_item("rmse_z", o.rmse_z)?;
             row.set_item("bounces", o.bounces)?;
             row.set_item("highest_bounce", o.highest_bounce)?;
+            row.set_item("arrival", o.arrival)?;
+            row.set_item("late", o.arrived_late(late_after))?;
+            row.set_item("flagged_late", o.flagged_late)?;
             summary.append(row)?;
         }
     }

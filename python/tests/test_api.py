@@ -116,6 +116,8 @@ def test_loop_and_sweep_equal_the_command_line(tmp_path, cli):
         np.testing.assert_array_equal(got[column].to_numpy(), expected[column].to_numpy(), column)
     for outcome in got.attrs["outcomes"]:
         assert f"{outcome['bounces']} bounce(s)" in run.stdout
+        assert f"at {outcome['arrival'] * 1e3:.4f} ms" in run.stdout
+        assert outcome["late"] is False and outcome["flagged_late"] is False
     run = run_cli(cli, "sweep", model, "--sample-periods", "1e-5,2e-5", "--json")
     assert run.returncode == 0, run.stderr
     expected = json.loads(run.stdout)

@@ -28,14 +28,7 @@ use crate::description::{params, Description};
 use crate::design::{design_kalman, Design, Linearization};
 use crate::model::Model;
 
-/// The time [s] between two operations' starts in a run-to-run study (and
-/// the window a record covers): twice takeoff + landing and a motion time,
-/// so that an operation the runtime had to finish ([`reldesign_runtime::control::finish_stroke`])
-/// ends before the next one starts.
-pub fn operation_window(t: &crate::description::Trajectory) -> f64 {
-    // the push comes at 2·t_f − t₀; the window leaves as long again
-    2.0 * crate::design::operation_end(t.takeoff, t.landing) + (t.landing - t.takeoff)
-}
+pub use crate::closed_loop::operation_window;
 
 /// One adapted parameter: its description key, the model's symbol, the
 /// design's value and the physical domain the update keeps it in.
