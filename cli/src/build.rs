@@ -19,8 +19,8 @@ pub struct Args {
     #[arg(long)]
     quiet: bool,
     /// Also write the design figures as JSON (per operation: J, max |u|,
-    /// saturation switches, mesh size, residuals, table size; the backstepping
-    /// law's certified region)
+    /// saturation switches, mesh size, residuals, table size, the sensorless
+    /// precision; the backstepping law's certified region)
     #[arg(long)]
     report_json: Option<PathBuf>,
     /// Also draw the backstepping law's certified region (the (z₁, z₂) plane: F_d = 0,
@@ -49,7 +49,9 @@ pub fn run(args: &Args) -> Result<(), Report> {
         match designer::precision::report(&design) {
             Ok(Some(text)) => eprintln!("{text}"),
             Ok(None) => {}
-            Err(e) => eprintln!("sensorless precision: not stated ({e})"),
+            Err(e) => {
+                eprintln!("sensorless precision: not stated (its noise-free loop failed: {e})")
+            }
         }
     }
     let report = args

@@ -334,15 +334,14 @@ pub fn operation_window(t: &crate::description::Trajectory) -> f64 {
 }
 
 /// The spacing of `reldesign loop`'s operations: [SM 45]'s takeoff + landing
-/// where the controller reads the description's own plant, and the
-/// run-to-run study's window ([`operation_window`]) where a
-/// landing later than t_f is to be expected (the controller reads an
-/// estimate, or the plant is not the description): the runtime pushes an
-/// armature not at its stop by t_f + the arrival margin, and the operation's
-/// window must still hold that push.
+/// where the controller reads the position on the description's own plant,
+/// and the run-to-run study's window ([`operation_window`]) where a landing
+/// later than t_f is to be expected (the controller reads an estimate, or a
+/// plant is given): the runtime pushes an armature not at its stop by t_f +
+/// the arrival margin, and the operation's window must still hold that push.
 pub fn loop_spacing(design: &Design, plant: Option<&Description>) -> Option<f64> {
     let estimated = (design.description.controller.as_ref()).is_some_and(|c| c.estimator.is_some());
-    let other_plant = plant.is_some_and(|p| *p != design.description);
+    let other_plant = plant.is_some();
     let t = design.description.trajectory.as_ref()?;
     (estimated || other_plant).then(|| operation_window(t))
 }

@@ -11,9 +11,9 @@
 //! armature. Only the measurement noise is in it; a plant that differs from
 //! the description adds its own error.
 
-use crate::closed_loop::{run_loop, LoopError, LoopRun, Noise};
+use crate::closed_loop::{loop_spacing, run_spaced_loop, LoopError, LoopRun, Noise};
 use crate::description::{Approach, Estimator, Operation};
-use crate::design::Design;
+use crate::design::{Design, LawDesign};
 use crate::model::{Model, ModelPlant};
 use crate::observe::discrete::{DiscreteModel, MAX_DIM as FILTER_DIM};
 use crate::observe::{ekf::Ekf, ukf::Ukf};
@@ -37,8 +37,9 @@ pub struct ApproachPrecision {
     pub impact: f64,
 }
 
-/// Per designed operation, where the controller reads an estimate and the
-/// trajectory has an approach; empty otherwise.
+/// Per designed operation, where the feedback-linearizing law reads an
+/// estimate and the trajectory has an approach (what the impact's reasoning
+/// and its check cover); empty otherwise.
 pub fn at_approaches(design: &Design) -> Result<Vec<ApproachPrecision>, LoopError> {
     let (Some(c), Some(t), Some(discrete)) = (
         &design.controller,
@@ -48,18 +49,21 @@ pub fn at_approaches(design: &Design) -> Result<Vec<ApproachPrecision>, LoopErro
         return Ok(Vec::new());
     };
     let estimator = (design.description.controller.as_ref()).and_then(|c| c.estimator);
-    let (Some(estimator), Some(approach)) = (estimator, t.approach()) else {
+    let linearizing = matches!(c.law, LawDesign::FeedbackLinearization { .. });
+    let (Some(estimator), Some(approach), true) = (estimator, t.approach(), linearizing) else {
         return Ok(Vec::new());
     };
     let quiet = Noise {
         seed: 0,
         sigma: Some([0.0, 0.0]),
     };
-    let run = run_loop(
+    let window = loop_spacing(design, None);
+    let run = run_spaced_loop(
         design,
         None,
         c.sample_period,
         None,
+        window,
         quiet,
         &Default::default(),
     )?;
@@ -68,7 +72,8 @@ pub fn at_approaches(design: &Design) -> Result<Vec<ApproachPrecision>, LoopErro
     let plant = ModelPlant::new(&mut model);
     let at = t.landing - approach.duration();
     let found = run.operations.iter().filter_map(|&(operation, start)| {
-        let k = run.measured.iter().position(|m| m.t >= start + at)?;
+        // the sample at the approach's start, rounding aside
+        let k = (run.measured.iter()).position(|m| m.t >= start + at - 1e-9 * c.sample_period)?;
         let j = run
             .trajectory
             .t
@@ -164,23 +169,28 @@ pub fn report(design: &Design) -> Result<Option<String>, LoopError> {
             .map_or(String::new(), |v| {
                 format!(", {:.0}× softer than switching", v.abs() / p.impact)
             });
+        // σ_φ relative to φ, unless φ is ~0 there
+        let relative = 100.0 * p.sigma_phi / p.phi.abs();
+        let sigma_phi = if relative.is_finite() && relative < 100.0 {
+            format!("{relative:.2} % of {:.4e} Wb", p.phi)
+        } else {
+            format!("{:.3e} Wb", p.sigma_phi)
+        };
         let _ = writeln!(
             s,
-            "  {}: when the approach starts ({:.4} ms, {:e} m short of the stop) σ_z = {:.3e} m, σ_φ = {:.2} % of {:.4e} Wb; \
+            "  {}: when the approach starts ({:.4} ms, {:e} m short of the stop) σ_z = {:.3e} m, σ_φ = {sigma_phi}; \
              a flux σ_φ off over the standoff meets the stop at ≈ {:.4e} m/s (v_c = {:e} m/s){versus}",
             p.operation.name(),
             p.at * 1e3,
             p.approach.standoff,
             p.sigma_z,
-            100.0 * p.sigma_phi / p.phi.abs(),
-            p.phi,
             p.impact,
             p.approach.speed,
         );
     }
     s.push_str(
         "  the measurement noise's share of each first impact; a valve that differs from the description adds its own \
-         (docs/guide/self-calibration.md#what-bounds-the-landings)",
+         (docs/guide/self-calibration.md#the-currents-noise-bounds-the-landing)",
     );
     Ok(Some(s))
 }

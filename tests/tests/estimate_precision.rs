@@ -4,9 +4,10 @@
 //! 0.5 mA, which nothing was tuned on): the filter's σ_z when each approach
 //! starts against the RMS of z − ẑ there, and the predicted first impact
 //! √(v_c² + 2·|∂a/∂φ|·σ_φ·δ) against the median first impact, over 40 noise
-//! seeds of the design's own valve.
+//! seeds of the design's own valve, each operation given the room of
+//! `loop --runs` to land late.
 
-use designer::closed_loop::{run_loop, LoopRun, Noise};
+use designer::closed_loop::{loop_spacing, run_spaced_loop, LoopRun, Noise};
 use designer::description::{parse_str, Operation};
 use designer::design::Design;
 use designer::precision::{at_approaches, ApproachPrecision};
@@ -65,14 +66,9 @@ fn compare(design: &Design) -> Vec<(ApproachPrecision, f64, f64)> {
     let runs: Vec<LoopRun> = (1..=SEEDS)
         .into_par_iter()
         .map(|k| {
-            run_loop(
-                design,
-                None,
-                ts,
-                None,
-                Noise::seeded(k),
-                &Default::default(),
-            )
+            let window = loop_spacing(design, None);
+            let noise = Noise::seeded(k);
+            run_spaced_loop(design, None, ts, None, window, noise, &Default::default())
         })
         .collect::<Result<_, _>>()
         .unwrap_or_else(|e| panic!("{e}"));
