@@ -46,7 +46,17 @@ pub fn run(args: &Args) -> Result<(), Report> {
                 eprintln!("{}", calibration_report(&design, c.sample_period));
             }
         }
-        match designer::precision::report(&design) {
+    }
+    // one noise-free loop states the precision for the report and the JSON
+    let precision = (!args.quiet || args.report_json.is_some())
+        .then(|| designer::precision::at_approaches(&design));
+    if !args.quiet {
+        let text = match &precision {
+            Some(Ok(found)) => designer::precision::report(&design, found),
+            Some(Err(e)) => Err(e.clone()),
+            None => Ok(None),
+        };
+        match text {
             Ok(Some(text)) => eprintln!("{text}"),
             Ok(None) => {}
             Err(e) => {
@@ -54,10 +64,16 @@ pub fn run(args: &Args) -> Result<(), Report> {
             }
         }
     }
-    let report = args
-        .report_json
-        .as_ref()
-        .map(|path| (path, designer::design_json::report_json(&design)));
+    let stated = match &precision {
+        Some(Ok(found)) => found.as_slice(),
+        _ => &[],
+    };
+    let report = (args.report_json.as_ref()).map(|path| {
+        (
+            path,
+            designer::design_json::report_json_with(&design, stated),
+        )
+    });
     let plot = match (&args.plot, &design.backstepping) {
         (None, _) => None,
         (Some(path), Some(b)) => {

@@ -216,31 +216,13 @@ fn summary(outcomes: &[OperationOutcome], law: &str, ts: f64, late_after: f64) -
             .map_or("never reached the stop".to_string(), |v| {
                 format!("{v:+.4e} m/s")
             });
-        let arrival =
-            o.arrival.map_or_else(
-                || {
-                    let flagged = if o.flagged_late {
-                        ", flagged late by the controller"
-                    } else {
-                        ""
-                    };
-                    flagged.to_string()
-                },
-                |t| {
-                    let verdict = match (o.arrived_late(late_after), o.flagged_late) {
-                (true, true) => ", late: pushed to its stop",
-                (true, false) => {
-                    ", late: pushed to its stop, though the controller read it there in time"
-                }
-                (false, true) => ", on time, but the controller read it short and flagged it late",
-                (false, false) => "",
-            };
-                    format!(" at {:.4} ms{verdict}", t * 1e3)
-                },
-            );
+        let arrival = o
+            .arrival
+            .map_or(String::new(), |t| format!(" at {:.4} ms", t * 1e3));
+        let verdict = o.verdict(late_after);
         let _ = writeln!(
             s,
-            "  {:<8} first impact {impact}{arrival}, RMSE_z {} during the motion, {} bounce(s)",
+            "  {:<8} first impact {impact}{arrival}, RMSE_z {} during the motion, {} bounce(s){verdict}",
             o.operation.name(),
             o.rmse_z
                 .map_or("— (no sample)".into(), |r| format!("{r:.3e} m")),

@@ -230,23 +230,7 @@ fn text(
                 .outcome
                 .impact_velocity
                 .map_or("never reached the stop".into(), |v| format!("{v:+.4e} m/s"));
-            let landed_late = o.outcome.arrived_late(late_after);
-            let pushed = match (
-                o.outcome.arrival.is_some(),
-                landed_late,
-                o.outcome.flagged_late,
-            ) {
-                (false, _, true) => " (flagged late by the controller)",
-                (false, _, false) => " (not flagged late by the controller)",
-                (true, true, true) => " (late: pushed to its stop)",
-                (true, true, false) => {
-                    " (late: pushed to its stop; the controller read it there in time)"
-                }
-                (true, false, true) => {
-                    " (on time, but the controller read it short and flagged it late)"
-                }
-                (true, false, false) => "",
-            };
+            let pushed = o.outcome.verdict(late_after);
             let _ = writeln!(
                 s,
                 "  {:<8} first impact {v}, {} bounce(s), highest {:.2e} m{pushed}",

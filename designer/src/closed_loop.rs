@@ -736,6 +736,27 @@ impl OperationOutcome {
     pub fn arrived_late(&self, late_after: f64) -> bool {
         self.arrival.is_some_and(|t| t > late_after)
     }
+
+    /// The plant's and the controller's verdicts, as `loop`'s summaries
+    /// state them ("" where it arrived in time, unflagged).
+    pub fn verdict(&self, late_after: f64) -> &'static str {
+        match (
+            self.arrival.is_some(),
+            self.arrived_late(late_after),
+            self.flagged_late,
+        ) {
+            (false, _, true) => " (flagged late by the controller)",
+            (false, _, false) => " (not flagged late by the controller)",
+            (true, true, true) => " (late: pushed to its stop)",
+            (true, true, false) => {
+                " (late: pushed to its stop; the controller read it there in time)"
+            }
+            (true, false, true) => {
+                " (on time, but the controller read it short and flagged it late)"
+            }
+            (true, false, false) => "",
+        }
+    }
 }
 
 /// When the runtime pushes an armature not yet at its stop [s from the

@@ -71,9 +71,18 @@ fn region_json(b: &BacksteppingDesign) -> serde_json::Value {
 
 /// The design figures, for scripts and oracles.
 pub fn report_json(design: &Design) -> String {
-    let no_operations = Vec::new();
     // a loop that cannot run states no precision; the design still reports
     let precision = crate::precision::at_approaches(design).unwrap_or_default();
+    report_json_with(design, &precision)
+}
+
+/// [`report_json`] with the sensorless precision already stated
+/// ([`crate::precision::at_approaches`]).
+pub fn report_json_with(
+    design: &Design,
+    precision: &[crate::precision::ApproachPrecision],
+) -> String {
+    let no_operations = Vec::new();
     let operations: serde_json::Map<String, serde_json::Value> = design
         .controller
         .as_ref()

@@ -15,7 +15,8 @@ use crate::closed_loop::{loop_spacing, run_spaced_loop, LoopError, LoopRun, Nois
 use crate::description::{Approach, Estimator, Operation};
 use crate::design::{Design, LawDesign};
 use crate::model::{Model, ModelPlant};
-use crate::observe::discrete::{DiscreteModel, MAX_DIM as FILTER_DIM};
+use crate::observe::discrete::DiscreteModel;
+use crate::observe::filter::{Reference, Runtime};
 use crate::observe::{ekf::Ekf, ukf::Ukf};
 use crate::sim::{Plant, State, MAX_DIM};
 
@@ -98,35 +99,32 @@ pub fn at_approaches(design: &Design) -> Result<Vec<ApproachPrecision>, LoopErro
     Ok(found.collect())
 }
 
-/// (σ_z, σ_φ) of a fresh filter fed the run's measured voltage and current,
-/// at every sample.
+/// (σ_z, σ_φ) of a fresh filter of `[controller] estimator` fed the run's
+/// measured voltage and current, at every sample.
 fn covariance_along(
     run: &LoopRun,
     discrete: &DiscreteModel,
     estimator: Estimator,
 ) -> Vec<(f64, f64)> {
-    let spread =
-        |p: [[f64; FILTER_DIM]; FILTER_DIM]| (p[0][0].max(0.0).sqrt(), p[2][2].max(0.0).sqrt());
     match estimator {
-        Estimator::Ekf => {
-            let mut f = Ekf::new(discrete);
-            (run.measured.iter())
-                .map(|m| {
-                    f.step(m.voltage, m.current);
-                    spread(f.covariance())
-                })
-                .collect()
-        }
-        _ => {
-            let mut f = Ukf::new(discrete);
-            (run.measured.iter())
-                .map(|m| {
-                    f.step(m.voltage, m.current);
-                    spread(f.covariance())
-                })
-                .collect()
-        }
+        Estimator::Ekf => spread_along(Ekf::new(discrete), run),
+        _ => spread_along(Ukf::new(discrete), run),
     }
+}
+
+/// (σ_z, σ_φ) of `filter` after each of the run's samples (the state's
+/// entries 0 and 2 are z and φ for every filter dimension).
+fn spread_along<A: Runtime<3>, B: Runtime<4>, C: Runtime<5>>(
+    mut filter: Reference<A, B, C>,
+    run: &LoopRun,
+) -> Vec<(f64, f64)> {
+    (run.measured.iter())
+        .map(|m| {
+            filter.step(m.voltage, m.current);
+            let p = filter.covariance();
+            (p[0][0].max(0.0).sqrt(), p[2][2].max(0.0).sqrt())
+        })
+        .collect()
 }
 
 /// |∂a/∂φ| at the plant state `x`, at rest, by central differences of the
@@ -144,25 +142,24 @@ fn accel_per_flux(plant: &ModelPlant, x: &State) -> f64 {
     ((accel(x[2] + h) - accel(x[2] - h)) / (2.0 * h)).abs()
 }
 
-/// The lines `reldesign build` prints for a sensorless design with an
-/// approach (`None` otherwise), with each first impact against the
+/// The lines `reldesign build` prints for `found` ([`at_approaches`] of
+/// `design`; `None` where it is empty), with each first impact against the
 /// uncontrolled switching's on the description.
-pub fn report(design: &Design) -> Result<Option<String>, LoopError> {
+pub fn report(design: &Design, found: &[ApproachPrecision]) -> Result<Option<String>, LoopError> {
     use std::fmt::Write as _;
-    let found = at_approaches(design)?;
-    let Some(o) = (!found.is_empty())
-        .then_some(())
-        .and(design.description.observer.as_ref())
-    else {
+    let Some(o) = design.description.observer.as_ref() else {
         return Ok(None);
     };
+    if found.is_empty() {
+        return Ok(None);
+    }
     let switching =
         crate::closed_loop::switching_baseline(&design.description, None, &Default::default())?;
     let mut s = format!(
         "sensorless precision (the filter's covariance along the noise-free loop on the description; σ_v = {:e} V, σ_i = {:e} A):\n",
         o.voltage_noise, o.current_noise
     );
-    for p in &found {
+    for p in found {
         let versus = (switching.iter())
             .find(|(op, _)| *op == p.operation)
             .and_then(|(_, v)| *v)
