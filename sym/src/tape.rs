@@ -339,7 +339,12 @@ impl Tape {
                 let bit = 1u64.checked_shl(i as u32).unwrap_or(u64::MAX);
                 if used & bit != 0 {
                     let lanes = column_lanes(col, start, m);
-                    if lanes.map(f64::to_bits) != slot.map(f64::to_bits) {
+                    // (Lane by lane: an array's `!=` is a `memcmp` call.)
+                    if lanes
+                        .iter()
+                        .zip(&*slot)
+                        .any(|(a, b)| a.to_bits() != b.to_bits())
+                    {
                         changed |= bit;
                         *slot = lanes;
                     }
@@ -381,7 +386,7 @@ fn run_lanes<S: Slot, M: IndexMut<usize, Output = Lanes> + ?Sized>(code: &[Op<S>
                 Func::Abs => lanes1(s, d, a, f64::abs),
                 Func::Sign => lanes1(s, d, a, sign),
                 Func::Tanh => lanes1(s, d, a, f64::tanh),
-                Func::Coth => lanes1(s, d, a, |x| 1.0 / x.tanh()),
+                Func::Coth => lanes1(s, d, a, crate::graph::coth),
             },
             Op::Min(d, a, b) => lanes2(s, d, a, b, f64::min),
             Op::Max(d, a, b) => lanes2(s, d, a, b, f64::max),

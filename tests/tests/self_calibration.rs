@@ -205,22 +205,34 @@ fn an_operation_in_time_is_not_flagged_late() {
 
 /// The update says when the adapted model still does not explain a valve's
 /// current: on a Jiles–Atherton plant (whose remanence the description's
-/// saturating core cannot follow) every update after the first leaves more
-/// than `UNEXPLAINED`·σ_i², on a saturating one none does (a refused
-/// update says neither, and the runtime's count skips it). Tuning seeds
-/// (the threshold was chosen on seeds 0–19).
+/// saturating core cannot follow) most updates leave more than
+/// `UNEXPLAINED`·σ_i², and the runtime's count of them in a row reaches the
+/// firmware example's flag (three) within eight runs; on a saturating one no
+/// update after the first does (a refused update says neither, and the
+/// count skips it). Not every update on the hysteretic plant: its closed
+/// loop is chaotic in its last bits (the core's branch follows the sign of
+/// φ̇), and a run whose landing happened to suit the model leaves 1.6·σ_i².
+/// Tuning seeds (the threshold was chosen on seeds 0–19).
 #[test]
 fn the_update_flags_a_valve_its_model_cannot_explain() {
+    const RUNS: usize = 8;
+    const FLAG_AT: u32 = 3; // examples/firmware: `SelfCalibratingValve::unexplained`
     let (text, _, design) = example();
     let calibration = calibration_of(&design);
     for (seed, hysteretic) in [(1, false), (11, true)] {
         let plant = variant(physics_of(&text), seed);
         assert_eq!(plant.hysteretic, hysteretic);
-        let flags = unexplained(&calibration, &runs(&design, &plant, 4));
+        let flags = unexplained(&calibration, &runs(&design, &plant, RUNS));
         let updates: Vec<bool> = flags[1..].iter().flatten().copied().collect();
+        let flagged = updates.iter().filter(|&&f| f).count();
+        let longest = (1..=flags.len()).map(|k| in_a_row(&flags[..k])).max();
+        let verdict = match hysteretic {
+            true => 2 * flagged > updates.len() && longest >= Some(FLAG_AT),
+            false => updates.len() >= RUNS / 2 && flagged == 0,
+        };
         assert!(
-            updates.len() >= 2 && updates.iter().all(|&f| f == hysteretic),
-            "plant {seed} (hysteretic: {hysteretic}): unexplained after runs 1–4 {flags:?}"
+            verdict,
+            "plant {seed} (hysteretic: {hysteretic}): unexplained after runs 1–{RUNS} {flags:?}"
         );
     }
 }
