@@ -81,6 +81,10 @@ pub struct FitOptions {
     /// sample of the record: a trial parameter set that makes the model so
     /// stiff that it needs more fails fast, and the solver shrinks its step.
     pub max_steps_per_sample: usize,
+    /// A trial replay may take at most this many times the steps of the
+    /// start's replay (None: only the per-sample cap); see
+    /// [`TRIAL_STEPS_OVER_START`], the default.
+    pub trial_steps_over_start: Option<usize>,
     /// How the Jacobian is computed (analytic falls back to finite
     /// differences when a fitted parameter has no analytic sensitivity).
     pub sensitivities: Sensitivities,
@@ -118,6 +122,7 @@ impl Default for FitOptions {
             fd_step: 1e-6,
             ftol: 1e-8,
             max_steps_per_sample: 200,
+            trial_steps_over_start: Some(TRIAL_STEPS_OVER_START),
             sensitivities: Sensitivities::Analytic,
             stop: None,
             give_up: None,
@@ -240,6 +245,8 @@ pub fn simulate_outputs(d: &Description, data: &Measured) -> Result<SimOutputs, 
 pub(crate) struct Budget {
     rtol: f64,
     max_steps_per_sample: usize,
+    /// At most this many steps in all (as well as per sample).
+    max_steps: usize,
 }
 
 impl Budget {
@@ -247,7 +254,62 @@ impl Budget {
         Budget {
             rtol: options.rtol,
             max_steps_per_sample: options.max_steps_per_sample,
+            max_steps: usize::MAX,
         }
+    }
+
+    /// The steps one replay of `samples` samples may take (at least 10 000).
+    fn steps_for(&self, samples: usize) -> usize {
+        (self.max_steps_per_sample.saturating_mul(samples))
+            .min(self.max_steps)
+            .max(10_000)
+    }
+}
+
+/// A trial replay may take at most this many times the steps of the start's
+/// replay (within the options' own per-sample cap) by default
+/// ([`FitOptions::trial_steps_over_start`]). A trial that makes the
+/// model stiff fails fast and the solver shortens its step: on the
+/// benchmark's 40 000-sample Jiles–Atherton fit the first step reached
+/// c's bound, where the replay took 93 steps a sample against the start's
+/// 2.3 (3 s a replay), and the Jacobian there, differenced since the
+/// sensitivities give up on so stiff a field, took five more: 18 of the
+/// fit's 20 s. (The diagnosis's ranking fits cap every replay at 4 steps a
+/// sample in all, `DiagnoseOptions::max_steps_per_sample`.)
+const TRIAL_STEPS_OVER_START: usize = 4;
+
+/// The replays of one start: the first (the start's) at the options'
+/// budget, every later one within `over_start` times its steps.
+struct TrialReplays<'a> {
+    budget: Budget,
+    over_start: Option<usize>,
+    data: &'a Measured,
+    start_steps: std::cell::OnceCell<usize>,
+}
+
+impl<'a> TrialReplays<'a> {
+    fn new(options: &FitOptions, data: &'a Measured) -> Self {
+        TrialReplays {
+            budget: Budget::of(options),
+            over_start: options.trial_steps_over_start,
+            data,
+            start_steps: std::cell::OnceCell::new(),
+        }
+    }
+
+    fn replay(&self, d: &Description) -> Option<Replay> {
+        let budget = match (self.start_steps.get(), self.over_start) {
+            (Some(&steps), Some(k)) => Budget {
+                max_steps: steps.saturating_mul(k),
+                ..self.budget
+            },
+            _ => self.budget,
+        };
+        let replay = replay(d, self.data, &budget).ok()?;
+        let stats = &replay.trajectory.stats;
+        self.start_steps
+            .get_or_init(|| stats.accepted + stats.rejected);
+        Some(replay)
     }
 }
 
@@ -293,10 +355,7 @@ pub(crate) fn replay(
     let plant = ModelPlant::new(&mut model);
     let options = Options {
         rtol: budget.rtol,
-        max_steps: budget
-            .max_steps_per_sample
-            .saturating_mul(data.t.len())
-            .max(10_000),
+        max_steps: budget.steps_for(data.t.len()),
         ..Options::default()
     };
     replay_plant(&plant, &model, &input, &data.t, &options).map_err(|e| FitError::Simulation {
@@ -621,20 +680,17 @@ pub fn fit(
             })
         };
         let kept = KeptReplay::default();
+        let trials = TrialReplays::new(options, data);
         let keeping = |theta: &[f64]| {
             let d = with_values(description, params, theta).ok()?;
-            let replay = replay(&d, data, &setup.objective.budget).ok()?;
+            let replay = trials.replay(&d)?;
             let r = setup.objective.residuals_of(&d, &outputs(&d, &replay));
             kept.keep(theta, replay.trajectory);
             Some(r)
         };
         let jacobian = |theta: &[f64]| {
             let d = with_values(description, params, theta).ok()?;
-            let trajectory = kept.at(theta, || {
-                replay(&d, data, &setup.objective.budget)
-                    .ok()
-                    .map(|r| r.trajectory)
-            })?;
+            let trajectory = kept.at(theta, || trials.replay(&d).map(|r| r.trajectory))?;
             // none (or not finite): `lm` differences the residual instead
             setup.objective.jacobian(&d, &paths, &trajectory)
         };
@@ -972,5 +1028,71 @@ mod tests {
         // `starts` counts the given points
         assert_eq!(start_points(&x0, &given, &params, 2, 7).len(), 2);
         assert_eq!(start_points(&x0, &given, &params, 1, 7), vec![x0.to_vec()]);
+    }
+
+    /// The benchmark's first trial (`benches/fit.sh`: c on its bound)
+    /// replayed after the Jiles–Atherton valve's own: it takes many times
+    /// the start's steps, so with the default cap it fails, without it
+    /// it finishes.
+    #[test]
+    fn a_trial_far_stiffer_than_the_start_fails_fast() {
+        use super::{params, FitOptions, TrialReplays};
+        use crate::description::parse_file;
+        let path = support::example_path("jiles-atherton-valve.toml");
+        let start = parse_file(&path).unwrap();
+        let mut stiff = start.clone();
+        for (key, value) in [
+            ("core.m_sat", 1.5556e6),
+            ("core.b", 3.303e-3),
+            ("core.c", 0.3),
+            ("core.kappa", 1058.8),
+            ("core.alpha", 4.201e-3),
+        ] {
+            params::set(&mut stiff, key, value).unwrap();
+        }
+        let dt = 1e-5;
+        let t: Vec<f64> = (0..4000).map(|k| k as f64 * dt).collect();
+        // ±24 V, 20 ms period, with a deterministic ±15 mV ripple (the
+        // measured voltage's noise is what makes the stiff trial slow)
+        let v = (t.iter().enumerate())
+            .map(|(k, t)| {
+                let level = if (t / 20e-3).fract() < 0.5 {
+                    24.0
+                } else {
+                    -24.0
+                };
+                level + 15e-3 * ((k * 7919 % 101) as f64 / 50.0 - 1.0)
+            })
+            .collect();
+        let data = crate::Measured {
+            i: vec![0.0; t.len()],
+            z: None,
+            phi: None,
+            lambda: None,
+            dt,
+            file_name: "ripple.csv".into(),
+            edges: None,
+            t,
+            v,
+        };
+        let steps = |r: &super::Replay| r.trajectory.stats.accepted + r.trajectory.stats.rejected;
+        let uncapped = FitOptions {
+            trial_steps_over_start: None,
+            ..FitOptions::default()
+        };
+        let free = TrialReplays::new(&uncapped, &data);
+        let own = steps(&free.replay(&start).unwrap());
+        let far = steps(&free.replay(&stiff).expect("uncapped, the trial finishes"));
+        assert!(far > 8 * own, "{far} steps against the start's {own}");
+        let capped = TrialReplays::new(&FitOptions::default(), &data);
+        assert!(capped.replay(&start).is_some());
+        assert!(
+            capped.replay(&stiff).is_none(),
+            "the cap lets {far} steps through"
+        );
+        assert!(
+            capped.replay(&start).is_some(),
+            "the start itself still replays"
+        );
     }
 }
