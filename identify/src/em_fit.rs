@@ -275,8 +275,10 @@ impl Budget {
 /// 2.3 (3 s a replay), and the Jacobian there, differenced since the
 /// sensitivities give up on so stiff a field, took five more: 18 of the
 /// fit's 20 s. (The diagnosis's ranking fits cap every replay at 4 steps a
-/// sample in all, `DiagnoseOptions::max_steps_per_sample`.)
-const TRIAL_STEPS_OVER_START: usize = 4;
+/// sample in all, `diagnose::Options::max_steps_per_sample`.) A fit that
+/// caps its trials also halves the step after a failed one
+/// ([`lm::OnFailedEvaluation::HalveStep`]).
+pub const TRIAL_STEPS_OVER_START: usize = 4;
 
 /// The replays of one start: the first (the start's) at the options'
 /// budget, every later one within `over_start` times its steps.
@@ -813,6 +815,13 @@ pub(crate) fn lm_options(options: &FitOptions) -> lm::Options {
         fd_step: options.fd_step,
         stop: options.stop.clone(),
         give_up: options.give_up,
+        // a fit that caps its trials' replays halves the step after a trial
+        // over the cap (Nielsen's growth left the benchmark fit's damping
+        // 2¹⁵-fold after five such trials)
+        on_failed_evaluation: match options.trial_steps_over_start {
+            Some(_) => lm::OnFailedEvaluation::HalveStep,
+            None => lm::OnFailedEvaluation::Nielsen,
+        },
         ..lm::Options::default()
     }
 }

@@ -51,6 +51,22 @@ pub struct Options {
     /// Gives up a start that is still far above a cost known to be
     /// reachable ([`Status::GaveUp`]).
     pub give_up: Option<GiveUp>,
+    /// What a trial whose residual could not be evaluated does to μ.
+    pub on_failed_evaluation: OnFailedEvaluation,
+}
+
+/// The damping after a trial step whose residual could not be evaluated
+/// (`None`, e.g. a replay over its step budget).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OnFailedEvaluation {
+    /// As after a cost increase: μ·ν, ν doubling (after n failures in a row
+    /// μ has grown 2^(n(n+1)/2)-fold, and a step ∝ 1/μ as much shorter).
+    #[default]
+    Nielsen,
+    /// The least μ·2^k that halves the step's largest component: n failures
+    /// in a row shorten the step 2^n-fold, and the damping stays near the
+    /// longest step that can be evaluated.
+    HalveStep,
 }
 
 /// After `after` accepted iterations, a cost (½‖r‖²) above `above` ends
@@ -104,6 +120,7 @@ impl Default for Options {
             max_rejections: 30,
             stop: None,
             give_up: None,
+            on_failed_evaluation: OnFailedEvaluation::Nielsen,
         }
     }
 }
@@ -574,11 +591,27 @@ where
             if actual.abs() <= options.ftol * pt.cost && predicted <= options.ftol * pt.cost {
                 return Outcome::Stop(Status::CostConverged);
             }
+        } else if options.on_failed_evaluation == OnFailedEvaluation::HalveStep {
+            *mu = damping_that_halves(step, p.map, &pt.y, *mu, h.amax());
+            continue;
         }
         *mu *= *nu;
         *nu *= 2.0;
     }
     Outcome::Stop(Status::NoProgress)
+}
+
+/// The least μ·2^k (k ≥ 1) whose step's largest component is at most half
+/// of `amax` (μ·2^64 at most).
+fn damping_that_halves(step: &Step, map: &Map, y: &[f64], mu: f64, amax: f64) -> f64 {
+    let mut mu = mu;
+    for _ in 0..64 {
+        mu *= 2.0;
+        if step.projected(map, y, mu).amax() <= 0.5 * amax {
+            break;
+        }
+    }
+    mu
 }
 
 /// The SVD of the scaled free columns, J_f·D_f⁻¹ = U·S·Vᵀ, and Uᵀr.
@@ -905,6 +938,58 @@ mod tests {
         assert_eq!(rep.theta, vec![2.0, 0.0]);
         assert!(rep.status.converged(), "{:?}", rep.status);
         assert!((rep.cost - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_failed_evaluation_halves_the_step_with_the_least_damping() {
+        let map = Map::new(&[0.5, -0.2], &[(-5.0, 5.0), (-5.0, 5.0)]).unwrap();
+        let jac = DMatrix::from_row_slice(3, 2, &[1.0, 0.2, 0.0, 3.0, 0.5, 0.1]);
+        let r = DVector::from_vec(vec![1.0, -2.0, 0.5]);
+        let step = Step::new(&jac, &r, &[0, 1], &[1.1, 3.0]);
+        let y = map.y0.clone();
+        for mu in [1e-6, 1e-2, 1.0, 1e3] {
+            let amax = step.projected(&map, &y, mu).amax();
+            let halved = damping_that_halves(&step, &map, &y, mu, amax);
+            assert!(step.projected(&map, &y, halved).amax() <= 0.5 * amax);
+            assert!(
+                step.projected(&map, &y, 0.5 * halved).amax() > 0.5 * amax || halved == 2.0 * mu
+            );
+        }
+    }
+
+    #[test]
+    fn halving_the_step_after_failed_evaluations_takes_fewer_evaluations() {
+        // r = eˣ − e, undefined from x = 1.2 on: from x = −3 the Gauss–Newton
+        // step is 50 long, far into the undefined part, and again from every
+        // point short of the minimum. Both rules reach x = 1; halving the
+        // step raises μ no more, and takes fewer evaluations (24 against 27).
+        let f = |x: &[f64]| (x[0] < 1.2).then(|| vec![x[0].exp() - 1f64.exp()]);
+        let run = |rule| {
+            let mut top = 0.0f64;
+            let mut watch = |it: &Iteration| top = top.max(it.damping);
+            let options = Options {
+                on_failed_evaluation: rule,
+                ..Options::default()
+            };
+            let rep = minimize(f, &[-3.0], &[(-10.0, 10.0)], &options, &mut watch).unwrap();
+            assert!(rep.status.converged(), "{rule:?}: {:?}", rep.status);
+            assert!(
+                (rep.theta[0] - 1.0).abs() < 1e-6,
+                "{rule:?}: {:?}",
+                rep.theta
+            );
+            (top, rep.evaluations)
+        };
+        let nielsen = run(OnFailedEvaluation::Nielsen);
+        let halving = run(OnFailedEvaluation::HalveStep);
+        assert!(
+            halving.0 <= nielsen.0,
+            "largest μ {halving:?} against {nielsen:?}"
+        );
+        assert!(
+            halving.1 < nielsen.1,
+            "evaluations {halving:?} against {nielsen:?}"
+        );
     }
 
     #[test]

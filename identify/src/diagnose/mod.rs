@@ -658,7 +658,8 @@ fn fit_options(options: &Options) -> FitOptions {
         // (the cap above and the give-ups bound the diagnosis's fits; one
         // relative to the start as well cost the fresh set 5 % more time in
         // all, its median record 11 %: failed trials the cap above lets
-        // finish)
+        // finish. Without it the solver keeps Nielsen's rule after a failed
+        // trial, `em_fit::lm_options`.)
         trial_steps_over_start: None,
         ..FitOptions::default()
     }
