@@ -308,9 +308,8 @@ impl<'a> TrialReplays<'a> {
             _ => self.budget,
         };
         let replay = replay(d, self.data, &budget).ok()?;
-        let stats = &replay.trajectory.stats;
         self.start_steps
-            .get_or_init(|| stats.accepted + stats.rejected);
+            .get_or_init(|| replay.trajectory.stats.attempted());
         Some(replay)
     }
 }
@@ -1084,7 +1083,7 @@ mod tests {
             t,
             v,
         };
-        let steps = |r: &super::Replay| r.trajectory.stats.accepted + r.trajectory.stats.rejected;
+        let steps = |r: &super::Replay| r.trajectory.stats.attempted();
         let uncapped = FitOptions {
             trial_steps_over_start: None,
             ..FitOptions::default()

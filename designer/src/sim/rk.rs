@@ -41,6 +41,14 @@ pub struct StepStats {
     pub evaluations: usize,
 }
 
+impl StepStats {
+    /// Steps attempted, accepted and rejected: what the hybrid simulator's
+    /// `max_steps` bounds.
+    pub fn attempted(&self) -> usize {
+        self.accepted + self.rejected
+    }
+}
+
 impl std::ops::AddAssign for StepStats {
     fn add_assign(&mut self, o: Self) {
         self.accepted += o.accepted;

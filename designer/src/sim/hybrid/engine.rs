@@ -214,8 +214,7 @@ impl<'a, P: Plant, Q: Quadrature> Engine<'a, P, Q> {
     }
 
     fn check_step_budget(&self) -> Result<(), SimError> {
-        let s = self.rk.stats();
-        if s.accepted + s.rejected >= self.opts.max_steps {
+        if self.rk.stats().attempted() >= self.opts.max_steps {
             return Err(SimError::TooManySteps {
                 t: self.rk.t(),
                 max: self.opts.max_steps,
